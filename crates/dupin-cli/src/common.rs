@@ -1,0 +1,64 @@
+//! What every command shares: the error type, file I/O, timing and the JSON report.
+
+use std::path::Path;
+use thiserror::Error;
+
+/// Any failure of a command; printed as one `error:` line with exit code 2.
+#[derive(Debug, Error)]
+pub enum CliError {
+    /// Reading or writing a file failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// What the OS said.
+        source: std::io::Error,
+    },
+    /// Input was malformed or out of range; the message says what to change.
+    #[error("{0}")]
+    Input(String),
+}
+
+impl CliError {
+    /// Wraps any displayable error as bad input, prefixed with context.
+    pub fn input(context: &str, e: impl std::fmt::Display) -> Self {
+        if context.is_empty() {
+            CliError::Input(e.to_string())
+        } else {
+            CliError::Input(format!("{context}: {e}"))
+        }
+    }
+}
+
+/// Reads a whole text file.
+#[allow(dead_code)]
+pub fn read_text(path: &Path) -> Result<String, CliError> {
+    std::fs::read_to_string(path).map_err(|source| CliError::Io {
+        path: path.display().to_string(),
+        source,
+    })
+}
+
+/// Writes a whole text file.
+#[allow(dead_code)]
+pub fn write_text(path: &Path, text: &str) -> Result<(), CliError> {
+    std::fs::write(path, text).map_err(|source| CliError::Io {
+        path: path.display().to_string(),
+        source,
+    })
+}
+
+/// Writes `report` as one JSON object to `path` when a report was asked for.
+#[allow(dead_code)]
+pub fn write_report(path: Option<&Path>, report: &serde_json::Value) -> Result<(), CliError> {
+    match path {
+        Some(p) => write_text(
+            p,
+            &format!(
+                "{}\n",
+                serde_json::to_string_pretty(report).unwrap_or_default()
+            ),
+        ),
+        None => Ok(()),
+    }
+}

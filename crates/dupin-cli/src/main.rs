@@ -1,0 +1,48 @@
+//! The `dupin` command line (see `../shared/contract.md` and the README).
+//!
+//! Exit code 0 on success; 2 on bad input with one line on stderr starting `error:`.
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+mod common;
+
+/// Planar-panel geometry for architecture.
+#[derive(Parser)]
+#[command(name = "dupin", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {}
+
+fn run(cli: Cli) -> Result<(), common::CliError> {
+    match cli.command {}
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+                let _ = e.print();
+                return ExitCode::SUCCESS;
+            }
+            // clap's message already starts with `error:`; keep it to one line.
+            let msg = e.to_string();
+            let first = msg.lines().next().unwrap_or("error: bad arguments");
+            eprintln!("{first}");
+            return ExitCode::from(2);
+        }
+    };
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {}", e.to_string().replace('\n', " "));
+            ExitCode::from(2)
+        }
+    }
+}

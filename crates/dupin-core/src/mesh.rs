@@ -1,0 +1,205 @@
+//! Polygon meshes of any face size, stored compactly (one index array plus face offsets).
+
+use crate::math::Vec3;
+use std::collections::BTreeMap;
+use thiserror::Error;
+
+/// Why a polygon mesh was rejected.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum MeshError {
+    /// A face names a vertex index that does not exist.
+    #[error("face {face} refers to vertex {index}, but the mesh has only {vertices} vertices")]
+    IndexOutOfRange {
+        /// Face number (0-based).
+        face: usize,
+        /// The offending vertex index (0-based).
+        index: usize,
+        /// Number of vertices in the mesh.
+        vertices: usize,
+    },
+    /// A face has fewer than three corners.
+    #[error("face {face} has {size} vertices; a face needs at least 3")]
+    FaceTooSmall {
+        /// Face number (0-based).
+        face: usize,
+        /// Its number of corners.
+        size: usize,
+    },
+    /// A face visits the same vertex twice.
+    #[error("face {face} repeats vertex {index}")]
+    RepeatedVertex {
+        /// Face number (0-based).
+        face: usize,
+        /// The repeated vertex index (0-based).
+        index: usize,
+    },
+    /// A vertex coordinate is NaN or infinite.
+    #[error("vertex {vertex} has a non-finite coordinate")]
+    NonFiniteVertex {
+        /// Vertex number (0-based).
+        vertex: usize,
+    },
+}
+
+/// A polygon mesh: vertex positions and faces of any size (triangles, quads, hexagons, mixed).
+///
+/// Faces are stored as one flat index array with offsets, so a mesh of 50k hexagons is two
+/// allocations, not 50k.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PolyMesh {
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    face_start: Vec<u32>,
+    face_verts: Vec<u32>,
+}
+
+impl PolyMesh {
+    /// Builds a mesh, checking that every face has at least three distinct, existing vertices and
+    /// that every coordinate is finite.
+    pub fn new<F, I>(positions: Vec<Vec3>, faces: F) -> Result<Self, MeshError>
+    where
+        F: IntoIterator<Item = I>,
+        I: AsRef<[u32]>,
+    {
+        if let Some(vertex) = positions
+            .iter()
+            .position(|p| !p.iter().all(|c| c.is_finite()))
+        {
+            return Err(MeshError::NonFiniteVertex { vertex });
+        }
+        let mut mesh = PolyMesh {
+            positions,
+            face_start: vec![0],
+            face_verts: Vec::new(),
+        };
+        for (face, f) in faces.into_iter().enumerate() {
+            let f = f.as_ref();
+            if f.len() < 3 {
+                return Err(MeshError::FaceTooSmall {
+                    face,
+                    size: f.len(),
+                });
+            }
+            for (k, &i) in f.iter().enumerate() {
+                if i as usize >= mesh.positions.len() {
+                    return Err(MeshError::IndexOutOfRange {
+                        face,
+                        index: i as usize,
+                        vertices: mesh.positions.len(),
+                    });
+                }
+                if f[..k].contains(&i) {
+                    return Err(MeshError::RepeatedVertex {
+                        face,
+                        index: i as usize,
+                    });
+                }
+            }
+            mesh.face_verts.extend_from_slice(f);
+            mesh.face_start.push(mesh.face_verts.len() as u32);
+        }
+        Ok(mesh)
+    }
+
+    /// Number of vertices.
+    pub fn num_vertices(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// Number of faces.
+    pub fn num_faces(&self) -> usize {
+        self.face_start.len() - 1
+    }
+
+    /// The vertex indices of face `i`, in order.
+    pub fn face(&self, i: usize) -> &[u32] {
+        &self.face_verts[self.face_start[i] as usize..self.face_start[i + 1] as usize]
+    }
+
+    /// Iterates over all faces.
+    pub fn faces(&self) -> impl ExactSizeIterator<Item = &[u32]> + '_ {
+        (0..self.num_faces()).map(move |i| self.face(i))
+    }
+
+    /// Histogram of face sizes: polygon size -> number of faces.
+    pub fn face_sizes(&self) -> BTreeMap<usize, usize> {
+        let mut h = BTreeMap::new();
+        for f in self.faces() {
+            *h.entry(f.len()).or_insert(0) += 1;
+        }
+        h
+    }
+
+    /// Length of the diagonal of the axis-aligned bounding box (0 for an empty mesh).
+    pub fn bbox_diagonal(&self) -> f64 {
+        let mut lo = Vec3::repeat(f64::INFINITY);
+        let mut hi = Vec3::repeat(f64::NEG_INFINITY);
+        for p in &self.positions {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        if self.positions.is_empty() {
+            0.0
+        } else {
+            (hi - lo).norm()
+        }
+    }
+
+    /// Mean length of the edges of face `i`.
+    pub fn face_mean_edge(&self, i: usize) -> f64 {
+        let f = self.face(i);
+        let n = f.len();
+        (0..n)
+            .map(|k| {
+                (self.positions[f[(k + 1) % n] as usize] - self.positions[f[k] as usize]).norm()
+            })
+            .sum::<f64>()
+            / n as f64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square() -> Vec<Vec3> {
+        vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        ]
+    }
+
+    #[test]
+    fn builds_and_reports_sizes() {
+        let m = PolyMesh::new(square(), [[0u32, 1, 2, 3]]).unwrap();
+        assert_eq!(m.num_faces(), 1);
+        assert_eq!(m.face(0), &[0, 1, 2, 3]);
+        assert_eq!(m.face_sizes().get(&4), Some(&1));
+        assert!((m.bbox_diagonal() - 2f64.sqrt()).abs() < 1e-15);
+        assert!((m.face_mean_edge(0) - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn rejects_bad_faces() {
+        assert!(matches!(
+            PolyMesh::new(square(), [[0u32, 1, 7]]),
+            Err(MeshError::IndexOutOfRange { index: 7, .. })
+        ));
+        assert!(matches!(
+            PolyMesh::new(square(), [[0u32, 1]]),
+            Err(MeshError::FaceTooSmall { size: 2, .. })
+        ));
+        assert!(matches!(
+            PolyMesh::new(square(), [[0u32, 1, 0]]),
+            Err(MeshError::RepeatedVertex { index: 0, .. })
+        ));
+        let mut p = square();
+        p[2].x = f64::NAN;
+        assert!(matches!(
+            PolyMesh::new(p, [[0u32, 1, 2]]),
+            Err(MeshError::NonFiniteVertex { vertex: 2 })
+        ));
+    }
+}
