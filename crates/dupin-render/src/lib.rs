@@ -1,1 +1,17 @@
-//! Work in progress.
+//! # dupin-render
+//!
+//! A small wgpu renderer for Dupin meshes. It takes plain buffers from `dupin-core`
+//! ([`dupin_core::TriangleBuffers`], line segments) and draws them lit into any colour target:
+//! a browser canvas (WebGPU, or WebGL2 as the fallback) or an offscreen texture read back to RGBA
+//! for tests. The core never knows about this crate.
+
+mod camera;
+mod mesh_renderer;
+#[cfg(not(target_arch = "wasm32"))]
+mod offscreen;
+
+pub use camera::OrbitCamera;
+pub use mesh_renderer::{BACKGROUND, MeshRenderer, RenderError};
+#[cfg(not(target_arch = "wasm32"))]
+pub use offscreen::{OffscreenImage, render_offscreen};
+pub use wgpu;

@@ -1,0 +1,164 @@
+//! Native offscreen rendering to RGBA pixels (lavapipe/llvmpipe in CI, any GPU elsewhere).
+
+use crate::camera::OrbitCamera;
+use crate::mesh_renderer::{MeshRenderer, RenderError};
+use dupin_core::TriangleBuffers;
+
+/// An 8-bit sRGB RGBA image, rows top to bottom.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OffscreenImage {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `width * height * 4` bytes.
+    pub rgba: Vec<u8>,
+    /// Name of the adapter that drew it (e.g. `llvmpipe (LLVM 15.0.6, 256 bits)`).
+    pub adapter: String,
+}
+
+/// Renders `mesh` (and optional line segments) seen by `camera` into a `width` x `height` image.
+///
+/// Blocks until the GPU is done. Fails with [`RenderError::NoAdapter`] when no Vulkan or GL
+/// adapter exists (install `mesa-vulkan-drivers` for the software rasteriser).
+pub fn render_offscreen(
+    mesh: &TriangleBuffers,
+    lines: Option<&[f32]>,
+    camera: &OrbitCamera,
+    width: u32,
+    height: u32,
+) -> Result<OffscreenImage, RenderError> {
+    pollster::block_on(render_async(
+        mesh,
+        lines,
+        camera,
+        width.max(1),
+        height.max(1),
+    ))
+}
+
+async fn render_async(
+    mesh: &TriangleBuffers,
+    lines: Option<&[f32]>,
+    camera: &OrbitCamera,
+    width: u32,
+    height: u32,
+) -> Result<OffscreenImage, RenderError> {
+    // Vulkan (lavapipe on CI) or Metal first; GL only when neither exists, since EGL probing is
+    // noisy on headless machines.
+    let mut last_error = String::new();
+    let mut found = None;
+    for backends in [
+        wgpu::Backends::VULKAN | wgpu::Backends::METAL | wgpu::Backends::DX12,
+        wgpu::Backends::GL,
+    ] {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        desc.backends = backends;
+        let instance = wgpu::Instance::new(desc);
+        match instance
+            .request_adapter(&wgpu::RequestAdapterOptions::default())
+            .await
+        {
+            Ok(a) => {
+                found = Some(a);
+                break;
+            }
+            Err(e) => last_error = e.to_string(),
+        }
+    }
+    let adapter = found.ok_or(RenderError::NoAdapter(last_error))?;
+    let (device, queue) = adapter
+        .request_device(&wgpu::DeviceDescriptor {
+            label: Some("dupin offscreen"),
+            required_limits: wgpu::Limits::downlevel_webgl2_defaults()
+                .using_resolution(adapter.limits()),
+            ..Default::default()
+        })
+        .await
+        .map_err(|e| RenderError::Device(e.to_string()))?;
+    let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("dupin offscreen target"),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    });
+    let view = texture.create_view(&Default::default());
+    let mut renderer = MeshRenderer::new(&device, format);
+    renderer.set_mesh(&device, mesh, None)?;
+    if let Some(l) = lines {
+        renderer.set_lines(&device, l, [0.05, 0.05, 0.06]);
+    }
+    renderer.render(&device, &queue, &view, width, height, camera);
+
+    // Rows of a texture-to-buffer copy are padded to 256 bytes.
+    let row = width * 4;
+    let padded =
+        row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("dupin readback"),
+        size: (padded * height) as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture: &texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded),
+                rows_per_image: Some(height),
+            },
+        },
+        wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+    );
+    queue.submit([encoder.finish()]);
+    let (tx, rx) = std::sync::mpsc::channel();
+    buffer.map_async(wgpu::MapMode::Read, .., move |r| {
+        let _ = tx.send(r);
+    });
+    device
+        .poll(wgpu::PollType::Wait {
+            submission_index: None,
+            timeout: None,
+        })
+        .map_err(|e| RenderError::Readback(e.to_string()))?;
+    rx.recv()
+        .map_err(|e| RenderError::Readback(e.to_string()))?
+        .map_err(|e| RenderError::Readback(e.to_string()))?;
+    let data = buffer
+        .get_mapped_range(..)
+        .map_err(|e| RenderError::Readback(e.to_string()))?;
+    let mut rgba = Vec::with_capacity((row * height) as usize);
+    for y in 0..height as usize {
+        let start = y * padded as usize;
+        rgba.extend_from_slice(&data[start..start + row as usize]);
+    }
+    drop(data);
+    buffer.unmap();
+    Ok(OffscreenImage {
+        width,
+        height,
+        rgba,
+        adapter: adapter.get_info().name,
+    })
+}

@@ -1,0 +1,64 @@
+// Lit mesh and flat lines. Two-sided Blinn-Phong with a camera-attached key light and a fill, so
+// panels read clearly from any orbit angle.
+
+struct Uniforms {
+    view_proj: mat4x4<f32>,
+    eye: vec4<f32>,
+    key_dir: vec4<f32>,
+    base_color: vec4<f32>,
+    // x: 1 to gamma-encode in the shader (non-sRGB target), y: 1 to use vertex colours.
+    flags: vec4<f32>,
+};
+
+@group(0) @binding(0) var<uniform> u: Uniforms;
+
+struct VsIn {
+    @location(0) pos: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) color: vec3<f32>,
+};
+
+struct VsOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) color: vec3<f32>,
+};
+
+@vertex
+fn vs_main(v: VsIn) -> VsOut {
+    var o: VsOut;
+    o.clip = u.view_proj * vec4<f32>(v.pos, 1.0);
+    o.world = v.pos;
+    o.normal = v.normal;
+    o.color = mix(u.base_color.rgb, v.color, u.flags.y);
+    return o;
+}
+
+fn encode(c: vec3<f32>) -> vec4<f32> {
+    let g = pow(clamp(c, vec3<f32>(0.0), vec3<f32>(1.0)), vec3<f32>(1.0 / 2.2));
+    return vec4<f32>(mix(c, g, u.flags.x), 1.0);
+}
+
+@fragment
+fn fs_main(i: VsOut) -> @location(0) vec4<f32> {
+    let view = normalize(u.eye.xyz - i.world);
+    var n = normalize(i.normal);
+    // Two-sided: light the side the viewer sees, whatever the winding.
+    if (dot(n, view) < 0.0) {
+        n = -n;
+    }
+    let key = normalize(u.key_dir.xyz);
+    let fill = normalize(vec3<f32>(-key.x, 0.5, -key.z));
+    let diffuse = max(dot(n, key), 0.0) * 0.75 + max(dot(n, fill), 0.0) * 0.25;
+    let h = normalize(key + view);
+    let spec = pow(max(dot(n, h), 0.0), 48.0) * 0.25;
+    let ambient = 0.18;
+    let c = i.color * (ambient + diffuse) + vec3<f32>(spec);
+    return encode(c);
+}
+
+@fragment
+fn fs_line(i: VsOut) -> @location(0) vec4<f32> {
+    return encode(i.color);
+}

@@ -1,0 +1,138 @@
+//! Native offscreen render test: the torus of the web slice, drawn through `dupin-render` on
+//! whatever Vulkan/GL adapter exists (lavapipe in CI), compared with a stored reference image.
+//!
+//! `DUPIN_BLESS=1 cargo test -p dupin-render --test offscreen` rewrites the reference after an
+//! intended visual change; look at `target/render-tests/*.png` before committing it.
+
+use dupin_core::{Torus, sample_surface};
+use dupin_render::{BACKGROUND, OffscreenImage, OrbitCamera, render_offscreen};
+use std::path::PathBuf;
+
+const W: u32 = 320;
+const H: u32 = 240;
+
+fn torus_image(camera: impl FnOnce(&mut OrbitCamera)) -> OffscreenImage {
+    let mesh = sample_surface(
+        &Torus {
+            major: 2.0,
+            minor: 0.7,
+        },
+        96,
+        48,
+    );
+    let mut cam = OrbitCamera::framing_points(&mesh.positions);
+    camera(&mut cam);
+    render_offscreen(&mesh, None, &cam, W, H).unwrap_or_else(|e| {
+        panic!("offscreen rendering failed: {e}. Install a Vulkan driver (apt-get install mesa-vulkan-drivers) or run `cargo xtask test`, which does.")
+    })
+}
+
+fn out_dir() -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target/render-tests");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn save(img: &OffscreenImage, name: &str) -> PathBuf {
+    let path = out_dir().join(name);
+    image::save_buffer(
+        &path,
+        &img.rgba,
+        img.width,
+        img.height,
+        image::ColorType::Rgba8,
+    )
+    .unwrap();
+    path
+}
+
+fn srgb8(c: f64) -> u8 {
+    let s = if c <= 0.0031308 {
+        12.92 * c
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    };
+    (s * 255.0).round() as u8
+}
+
+/// Fraction of pixels farther than 8 levels (any channel) from the background colour.
+fn covered_fraction(img: &OffscreenImage) -> f64 {
+    let bg = [
+        srgb8(BACKGROUND.r),
+        srgb8(BACKGROUND.g),
+        srgb8(BACKGROUND.b),
+    ];
+    let covered = img
+        .rgba
+        .chunks_exact(4)
+        .filter(|p| (0..3).any(|k| (p[k] as i32 - bg[k] as i32).abs() > 8))
+        .count();
+    covered as f64 / (img.width * img.height) as f64
+}
+
+/// (fraction of pixels differing by more than 24 levels in some channel, mean absolute difference)
+fn difference(a: &[u8], b: &[u8]) -> (f64, f64) {
+    assert_eq!(a.len(), b.len());
+    let mut differing = 0usize;
+    let mut sum = 0u64;
+    for (p, q) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
+        let d = (0..3)
+            .map(|k| (p[k] as i32 - q[k] as i32).unsigned_abs())
+            .max()
+            .unwrap();
+        sum += d as u64;
+        if d > 24 {
+            differing += 1;
+        }
+    }
+    let n = (a.len() / 4) as f64;
+    (differing as f64 / n, sum as f64 / n)
+}
+
+#[test]
+fn torus_matches_reference_image() {
+    let img = torus_image(|_| {});
+    let actual = save(&img, "torus.png");
+    let covered = covered_fraction(&img);
+    assert!(
+        covered > 0.05,
+        "only {:.1}% of pixels are covered",
+        covered * 100.0
+    );
+
+    let reference = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/reference/torus.png");
+    if std::env::var_os("DUPIN_BLESS").is_some() {
+        std::fs::copy(&actual, &reference).unwrap();
+    }
+    let want = image::open(&reference)
+        .unwrap_or_else(|e| {
+            panic!(
+                "{}: {e}; run with DUPIN_BLESS=1 to create it",
+                reference.display()
+            )
+        })
+        .to_rgba8();
+    assert_eq!((want.width(), want.height()), (W, H));
+    let (differing, mean) = difference(&img.rgba, want.as_raw());
+    assert!(
+        differing < 0.005 && mean < 1.5,
+        "render differs from reference ({}): {:.2}% pixels off, mean |d| {mean:.2}; adapter {}; see {}",
+        reference.display(),
+        differing * 100.0,
+        img.adapter,
+        actual.display()
+    );
+}
+
+#[test]
+fn orbiting_changes_the_picture() {
+    let a = torus_image(|_| {});
+    let b = torus_image(|c| c.orbit(0.6, -0.3));
+    save(&b, "torus-orbited.png");
+    let (differing, _) = difference(&a.rgba, &b.rgba);
+    assert!(
+        differing > 0.05,
+        "orbit changed only {:.2}% of pixels",
+        differing * 100.0
+    );
+}
