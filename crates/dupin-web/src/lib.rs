@@ -1,1 +1,25 @@
-//! Work in progress.
+//! # dupin-web
+//!
+//! The browser face of Dupin: the only crate with `#[wasm_bindgen]`. It exposes the core's
+//! computations to JavaScript as typed arrays and plain objects, and a [`Viewer`] that draws
+//! them with `dupin-render` into a canvas (WebGPU, or WebGL2 where WebGPU is missing).
+//! Errors cross the boundary as JS `Error`s carrying the Rust message.
+
+mod mesh_data;
+// The canvas viewer needs wgpu's browser backends, which exist only on wasm32.
+#[cfg(target_arch = "wasm32")]
+mod viewer;
+
+pub use mesh_data::{MeshData, torus_mesh};
+#[cfg(target_arch = "wasm32")]
+pub use viewer::Viewer;
+
+use wasm_bindgen::prelude::*;
+
+/// Installs a panic hook that forwards Rust panics to `console.error` (called once by the page).
+#[wasm_bindgen(start)]
+pub fn start() {
+    std::panic::set_hook(Box::new(|info| {
+        web_sys::console::error_1(&format!("dupin panicked: {info}").into());
+    }));
+}

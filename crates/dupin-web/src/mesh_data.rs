@@ -1,0 +1,67 @@
+//! Triangle buffers handed to JavaScript as typed arrays.
+
+use dupin_core::{Torus, TriangleBuffers, sample_surface};
+use wasm_bindgen::prelude::*;
+
+/// A triangle mesh as typed arrays: `positions` and `normals` (3 floats a vertex), `indices`
+/// (3 a triangle).
+#[wasm_bindgen]
+pub struct MeshData {
+    pub(crate) buffers: TriangleBuffers,
+}
+
+#[wasm_bindgen]
+impl MeshData {
+    /// Vertex positions, x y z per vertex.
+    #[wasm_bindgen(getter)]
+    pub fn positions(&self) -> js_sys::Float32Array {
+        js_sys::Float32Array::from(self.buffers.positions.as_slice())
+    }
+
+    /// Unit vertex normals.
+    #[wasm_bindgen(getter)]
+    pub fn normals(&self) -> js_sys::Float32Array {
+        js_sys::Float32Array::from(self.buffers.normals.as_slice())
+    }
+
+    /// Triangle vertex indices.
+    #[wasm_bindgen(getter)]
+    pub fn indices(&self) -> js_sys::Uint32Array {
+        js_sys::Uint32Array::from(self.buffers.indices.as_slice())
+    }
+
+    /// Number of vertices.
+    #[wasm_bindgen(getter, js_name = vertexCount)]
+    pub fn vertex_count(&self) -> usize {
+        self.buffers.vertex_count()
+    }
+
+    /// Number of triangles.
+    #[wasm_bindgen(getter, js_name = triangleCount)]
+    pub fn triangle_count(&self) -> usize {
+        self.buffers.triangle_count()
+    }
+}
+
+/// Samples the torus ((R + r cos v) cos u, (R + r cos v) sin u, r sin v) on a `nu` x `nv` grid.
+///
+/// Throws when R or r is not a positive finite number, or the grid is outside 3..=2048.
+#[wasm_bindgen(js_name = torusMesh)]
+pub fn torus_mesh(major: f64, minor: f64, nu: u32, nv: u32) -> Result<MeshData, JsError> {
+    for (name, value) in [("R", major), ("r", minor)] {
+        if !(value.is_finite() && value > 0.0) {
+            return Err(JsError::new(&format!(
+                "torus {name} must be a positive number, got {value}"
+            )));
+        }
+    }
+    for (name, value) in [("nu", nu), ("nv", nv)] {
+        if !(3..=2048).contains(&value) {
+            return Err(JsError::new(&format!(
+                "torus grid {name} must be between 3 and 2048, got {value}"
+            )));
+        }
+    }
+    let buffers = sample_surface(&Torus { major, minor }, nu as usize, nv as usize);
+    Ok(MeshData { buffers })
+}

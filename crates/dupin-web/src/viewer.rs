@@ -1,0 +1,145 @@
+//! A canvas viewer: wgpu surface + `dupin_render::MeshRenderer` + orbit camera.
+
+use crate::mesh_data::MeshData;
+use dupin_render::{MeshRenderer, OrbitCamera, wgpu};
+use wasm_bindgen::prelude::*;
+
+/// Draws meshes into an HTML canvas with WebGPU, or WebGL2 where WebGPU is unavailable.
+#[wasm_bindgen]
+pub struct Viewer {
+    surface: wgpu::Surface<'static>,
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    config: wgpu::SurfaceConfiguration,
+    renderer: MeshRenderer,
+    camera: OrbitCamera,
+    backend: &'static str,
+}
+
+#[wasm_bindgen]
+impl Viewer {
+    /// Creates a viewer on `canvas`. With `force_webgl2`, WebGPU is not tried (for testing the
+    /// fallback and for browsers whose WebGPU misbehaves).
+    pub async fn create(
+        canvas: web_sys::HtmlCanvasElement,
+        force_webgl2: bool,
+    ) -> Result<Viewer, JsError> {
+        let (width, height) = (canvas.width().max(1), canvas.height().max(1));
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        desc.backends = if force_webgl2 {
+            wgpu::Backends::GL
+        } else {
+            wgpu::Backends::BROWSER_WEBGPU | wgpu::Backends::GL
+        };
+        let instance = wgpu::util::new_instance_with_webgpu_detection(desc).await;
+        let surface = instance
+            .create_surface(wgpu::SurfaceTarget::Canvas(canvas))
+            .map_err(|e| JsError::new(&format!("cannot draw into the canvas: {e}")))?;
+        let adapter = instance
+            .request_adapter(&wgpu::RequestAdapterOptions {
+                compatible_surface: Some(&surface),
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| {
+                JsError::new(&format!("no WebGPU or WebGL2 adapter in this browser: {e}"))
+            })?;
+        let backend = match adapter.get_info().backend {
+            wgpu::Backend::BrowserWebGpu => "WebGPU",
+            wgpu::Backend::Gl => "WebGL2",
+            _ => "other",
+        };
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("dupin"),
+                required_limits: wgpu::Limits::downlevel_webgl2_defaults()
+                    .using_resolution(adapter.limits()),
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| JsError::new(&format!("cannot open the graphics device: {e}")))?;
+        let config = surface
+            .get_default_config(&adapter, width, height)
+            .ok_or_else(|| JsError::new("the canvas is not supported by this adapter"))?;
+        surface.configure(&device, &config);
+        let renderer = MeshRenderer::new(&device, config.format);
+        Ok(Viewer {
+            surface,
+            device,
+            queue,
+            config,
+            renderer,
+            camera: OrbitCamera::framing(glam::Vec3::ZERO, 1.0),
+            backend,
+        })
+    }
+
+    /// `"WebGPU"` or `"WebGL2"`.
+    #[wasm_bindgen(getter)]
+    pub fn backend(&self) -> String {
+        self.backend.to_string()
+    }
+
+    /// Shows `mesh`; with `reframe`, the camera is reset to frame it.
+    #[wasm_bindgen(js_name = setMesh)]
+    pub fn set_mesh(&mut self, mesh: &MeshData, reframe: bool) -> Result<(), JsError> {
+        self.renderer
+            .set_mesh(&self.device, &mesh.buffers, None)
+            .map_err(|e| JsError::new(&e.to_string()))?;
+        if reframe {
+            self.camera = OrbitCamera::framing_points(&mesh.buffers.positions);
+        }
+        Ok(())
+    }
+
+    /// Rotates the view by a drag of (`dx`, `dy`) radians.
+    pub fn orbit(&mut self, dx: f32, dy: f32) {
+        self.camera.orbit(dx, dy);
+    }
+
+    /// Moves the camera closer (`factor` < 1) or farther (`factor` > 1).
+    pub fn zoom(&mut self, factor: f32) {
+        self.camera.zoom(factor);
+    }
+
+    /// Adapts to a new canvas size in device pixels.
+    pub fn resize(&mut self, width: u32, height: u32) {
+        let (width, height) = (width.clamp(1, 8192), height.clamp(1, 8192));
+        if (width, height) != (self.config.width, self.config.height) {
+            self.config.width = width;
+            self.config.height = height;
+            self.surface.configure(&self.device, &self.config);
+        }
+    }
+
+    /// Draws one frame.
+    pub fn render(&mut self) -> Result<(), JsError> {
+        let frame = match self.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(t)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                self.surface.configure(&self.device, &self.config);
+                return Ok(());
+            }
+            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
+                return Ok(());
+            }
+            wgpu::CurrentSurfaceTexture::Validation => {
+                return Err(JsError::new(
+                    "the canvas surface reported a validation error",
+                ));
+            }
+        };
+        let view = frame.texture.create_view(&Default::default());
+        self.renderer.render(
+            &self.device,
+            &self.queue,
+            &view,
+            self.config.width,
+            self.config.height,
+            &self.camera,
+        );
+        self.queue.present(frame);
+        Ok(())
+    }
+}

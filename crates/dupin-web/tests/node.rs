@@ -1,0 +1,37 @@
+//! wasm-bindgen tests of the JS-facing API, run in Node (`wasm-pack test --node -- --test node`).
+#![cfg(target_arch = "wasm32")]
+
+use dupin_web::torus_mesh;
+use wasm_bindgen_test::*;
+
+#[wasm_bindgen_test]
+fn torus_mesh_has_the_promised_shape() {
+    let m = torus_mesh(2.0, 0.5, 40, 20).unwrap();
+    assert_eq!(m.vertex_count(), 800);
+    assert_eq!(m.triangle_count(), 1600);
+    let p = m.positions().to_vec();
+    let n = m.normals().to_vec();
+    let idx = m.indices().to_vec();
+    assert_eq!(p.len(), 2400);
+    assert_eq!(idx.len(), 4800);
+    assert!(idx.iter().all(|&i| (i as usize) < 800));
+    for k in 0..800 {
+        let (x, y, z) = (p[3 * k] as f64, p[3 * k + 1] as f64, p[3 * k + 2] as f64);
+        let rho = (x * x + y * y).sqrt() - 2.0;
+        assert!(
+            ((rho * rho + z * z).sqrt() - 0.5).abs() < 1e-5,
+            "vertex {k} is off the torus"
+        );
+        let len = (n[3 * k] as f64)
+            .hypot(n[3 * k + 1] as f64)
+            .hypot(n[3 * k + 2] as f64);
+        assert!((len - 1.0).abs() < 1e-5);
+    }
+}
+
+#[wasm_bindgen_test]
+fn bad_torus_parameters_are_errors() {
+    assert!(torus_mesh(-1.0, 0.5, 40, 20).is_err());
+    assert!(torus_mesh(2.0, f64::NAN, 40, 20).is_err());
+    assert!(torus_mesh(2.0, 0.5, 1, 20).is_err());
+}
