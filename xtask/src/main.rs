@@ -1,1 +1,67 @@
-fn main() {}
+//! `cargo xtask`: Dupin's build, serve and test automation (the wgpu/eframe convention).
+//!
+//! - `cargo xtask setup [--browser]`: install what is missing (wasm32 target, the wasm-bindgen-cli
+//!   pinned by Cargo.lock, wasm-pack; with `--browser` also Chromium, chromedriver, lavapipe and
+//!   the end-to-end test's npm packages).
+//! - `cargo xtask build-web`: build the wasm package into the page (settings: `wasm-pack.toml`).
+//! - `cargo xtask serve [--port 8080]`: set up, build, and serve `web/` at http://127.0.0.1:8080/.
+//! - `cargo xtask test`: everything CI runs (`.ci/run` is exactly this).
+
+mod config;
+mod serve;
+mod setup;
+mod test;
+mod util;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "cargo xtask", about = "Dupin build, serve and test automation")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Install missing tools (wasm32 target, wasm-bindgen-cli, wasm-pack; --browser: Chromium,
+    /// chromedriver, lavapipe, npm packages).
+    Setup {
+        /// Also install the browser-test tools.
+        #[arg(long)]
+        browser: bool,
+    },
+    /// Build the wasm package of the page with wasm-pack (settings from wasm-pack.toml).
+    BuildWeb,
+    /// Build and serve the configurator page.
+    Serve {
+        /// Port on 127.0.0.1.
+        #[arg(long, default_value_t = 8080)]
+        port: u16,
+    },
+    /// Run every check CI runs.
+    Test,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Setup { browser } => setup::ensure(browser).map(|installed| {
+            setup::print_installed(&installed);
+        }),
+        Command::BuildWeb => setup::ensure(false).and_then(|installed| {
+            setup::print_installed(&installed);
+            config::WebBuild::load()?.build()
+        }),
+        Command::Serve { port } => serve::run(port),
+        Command::Test => test::run(),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("xtask: error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -11,7 +11,7 @@ mod mesh_renderer;
 mod offscreen;
 
 pub use camera::OrbitCamera;
-pub use mesh_renderer::{BACKGROUND, MeshRenderer, RenderError};
+pub use mesh_renderer::{BACKGROUND, MeshRenderer, PendingSnapshot, RenderError};
 #[cfg(not(target_arch = "wasm32"))]
 pub use offscreen::{OffscreenImage, render_offscreen};
 pub use wgpu;

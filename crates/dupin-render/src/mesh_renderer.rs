@@ -3,7 +3,6 @@
 use crate::camera::OrbitCamera;
 use dupin_core::TriangleBuffers;
 use thiserror::Error;
-use wgpu::util::DeviceExt;
 
 /// Background colour of every view (linear RGB), also used by tests to count covered pixels.
 pub const BACKGROUND: wgpu::Color = wgpu::Color {
@@ -187,6 +186,7 @@ impl MeshRenderer {
     pub fn set_mesh(
         &mut self,
         device: &wgpu::Device,
+        queue: &wgpu::Queue,
         mesh: &TriangleBuffers,
         colors: Option<&[f32]>,
     ) -> Result<(), RenderError> {
@@ -224,12 +224,18 @@ impl MeshRenderer {
             })
             .collect();
         self.vertex_colors = colors.is_some();
-        self.mesh = Some(upload(device, &vertices, &mesh.indices, "mesh"));
+        self.mesh = Some(upload(device, queue, &vertices, &mesh.indices, "mesh"));
         Ok(())
     }
 
     /// Uploads line segments (pairs of `[x, y, z]` endpoints, 6 floats a segment), drawn in `color`.
-    pub fn set_lines(&mut self, device: &wgpu::Device, segments: &[f32], color: [f32; 3]) {
+    pub fn set_lines(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        segments: &[f32],
+        color: [f32; 3],
+    ) {
         let vertices: Vec<Vertex> = segments
             .chunks_exact(3)
             .map(|p| Vertex {
@@ -239,12 +245,96 @@ impl MeshRenderer {
             })
             .collect();
         let indices: Vec<u32> = (0..vertices.len() as u32 & !1).collect();
-        self.lines = (!indices.is_empty()).then(|| upload(device, &vertices, &indices, "lines"));
+        self.lines =
+            (!indices.is_empty()).then(|| upload(device, queue, &vertices, &indices, "lines"));
     }
 
     /// Removes the line segments.
     pub fn clear_lines(&mut self) {
         self.lines = None;
+    }
+
+    /// Renders the current view into an offscreen texture of this renderer's format and starts
+    /// copying it back. The same pipelines draw it, so it is exactly what the canvas shows, at
+    /// any resolution (a 2x screenshot, or a test's pixel check where the browser composites no
+    /// WebGPU canvas into its own screenshots).
+    pub fn begin_snapshot(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        width: u32,
+        height: u32,
+        camera: &OrbitCamera,
+    ) -> PendingSnapshot {
+        let (width, height) = (width.clamp(1, 8192), height.clamp(1, 8192));
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("dupin snapshot"),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: self.format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        self.render(device, queue, &view, width, height, camera);
+        // Rows of a texture-to-buffer copy are padded to 256 bytes.
+        let padded_row = (width * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+        let rows_per_band = (READBACK_CHUNK / padded_row).max(1);
+        let mut encoder = device.create_command_encoder(&Default::default());
+        let mut bands = Vec::new();
+        for first_row in (0..height).step_by(rows_per_band as usize) {
+            let rows = rows_per_band.min(height - first_row);
+            let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("dupin readback"),
+                size: (padded_row * rows) as u64,
+                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                mapped_at_creation: false,
+            });
+            encoder.copy_texture_to_buffer(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d {
+                        x: 0,
+                        y: first_row,
+                        z: 0,
+                    },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                wgpu::TexelCopyBufferInfo {
+                    buffer: &buffer,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(padded_row),
+                        rows_per_image: Some(rows),
+                    },
+                },
+                wgpu::Extent3d {
+                    width,
+                    height: rows,
+                    depth_or_array_layers: 1,
+                },
+            );
+            bands.push((buffer, first_row));
+        }
+        queue.submit([encoder.finish()]);
+        PendingSnapshot {
+            bands,
+            width,
+            height,
+            padded_row,
+            rows_per_band,
+            bgra: matches!(
+                self.format,
+                wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
+            ),
+        }
     }
 
     /// Draws the current mesh and lines seen by `camera` into `target` (of this renderer's
@@ -343,6 +433,94 @@ impl MeshRenderer {
     }
 }
 
+/// Largest readback buffer: SwiftShader's WebGPU (headless Chromium) fails to map buffers of a
+/// few hundred kilobytes, so a frame comes back in bands of rows.
+const READBACK_CHUNK: u32 = 64 * 1024;
+
+/// A rendered frame on its way back from the GPU (see [`MeshRenderer::begin_snapshot`]).
+pub struct PendingSnapshot {
+    /// Readback buffers with the first row each holds, top to bottom.
+    bands: Vec<(wgpu::Buffer, u32)>,
+    width: u32,
+    height: u32,
+    padded_row: u32,
+    rows_per_band: u32,
+    bgra: bool,
+}
+
+type Collected = std::sync::Arc<std::sync::Mutex<(Vec<u8>, usize, Option<RenderError>)>>;
+
+impl PendingSnapshot {
+    /// Width of the image in pixels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Height of the image in pixels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// Maps the pixels; `done` receives `width * height * 4` RGBA bytes, rows top to bottom,
+    /// once the GPU is finished (natively: after `device.poll`; in a browser: on its own).
+    pub fn read(
+        self,
+        done: impl FnOnce(Result<Vec<u8>, RenderError>) + wgpu::WasmNotSend + 'static,
+    ) {
+        let row = (self.width * 4) as usize;
+        let total = self.bands.len();
+        let state: Collected = std::sync::Arc::new(std::sync::Mutex::new((
+            vec![0; row * self.height as usize],
+            0,
+            None,
+        )));
+        let done = std::sync::Arc::new(std::sync::Mutex::new(Some(done)));
+        for (buffer, first_row) in self.bands {
+            let rows = self.rows_per_band.min(self.height - first_row) as usize;
+            let (state, done, mapped_buffer) = (state.clone(), done.clone(), buffer.clone());
+            let (padded, bgra) = (self.padded_row as usize, self.bgra);
+            buffer.map_async(wgpu::MapMode::Read, .., move |mapped| {
+                let mut guard = state.lock().unwrap_or_else(|p| p.into_inner());
+                let (pixels, finished, error) = &mut *guard;
+                match mapped
+                    .map_err(|e| RenderError::Readback(e.to_string()))
+                    .and_then(|()| {
+                        mapped_buffer
+                            .get_mapped_range(..)
+                            .map_err(|e| RenderError::Readback(e.to_string()))
+                    }) {
+                    Ok(data) => {
+                        for y in 0..rows {
+                            let dst = (first_row as usize + y) * row;
+                            pixels[dst..dst + row]
+                                .copy_from_slice(&data[y * padded..y * padded + row]);
+                        }
+                    }
+                    Err(e) => *error = Some(e),
+                }
+                mapped_buffer.unmap();
+                *finished += 1;
+                if *finished == total {
+                    let result = match error.take() {
+                        Some(e) => Err(e),
+                        None => {
+                            let mut out = std::mem::take(pixels);
+                            if bgra {
+                                out.chunks_exact_mut(4).for_each(|p| p.swap(0, 2));
+                            }
+                            Ok(out)
+                        }
+                    };
+                    drop(guard);
+                    if let Some(done) = done.lock().unwrap_or_else(|p| p.into_inner()).take() {
+                        done(result);
+                    }
+                }
+            });
+        }
+    }
+}
+
 /// The clear colour in the target's encoding, so the background looks the same on sRGB and
 /// linear targets.
 fn background_for(format: wgpu::TextureFormat) -> wgpu::Color {
@@ -359,18 +537,30 @@ fn background_for(format: wgpu::TextureFormat) -> wgpu::Color {
     }
 }
 
-fn upload(device: &wgpu::Device, vertices: &[Vertex], indices: &[u32], label: &str) -> GpuMesh {
+fn upload(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    vertices: &[Vertex],
+    indices: &[u32],
+    label: &str,
+) -> GpuMesh {
+    // Plain buffers filled through the queue: some WebGPU implementations (SwiftShader) refuse
+    // `mappedAtCreation` for buffers of a few hundred kilobytes.
+    let make = |bytes: &[u8], usage: wgpu::BufferUsages| {
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: (bytes.len() as u64)
+                .max(4)
+                .next_multiple_of(wgpu::COPY_BUFFER_ALIGNMENT),
+            usage: usage | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        queue.write_buffer(&buffer, 0, bytes);
+        buffer
+    };
     GpuMesh {
-        vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents: bytemuck::cast_slice(vertices),
-            usage: wgpu::BufferUsages::VERTEX,
-        }),
-        indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents: bytemuck::cast_slice(indices),
-            usage: wgpu::BufferUsages::INDEX,
-        }),
+        vertices: make(bytemuck::cast_slice(vertices), wgpu::BufferUsages::VERTEX),
+        indices: make(bytemuck::cast_slice(indices), wgpu::BufferUsages::INDEX),
         count: indices.len() as u32,
     }
 }

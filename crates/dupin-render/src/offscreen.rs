@@ -76,85 +76,26 @@ async fn render_async(
         })
         .await
         .map_err(|e| RenderError::Device(e.to_string()))?;
-    let format = wgpu::TextureFormat::Rgba8UnormSrgb;
-    let texture = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("dupin offscreen target"),
-        size: wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    });
-    let view = texture.create_view(&Default::default());
-    let mut renderer = MeshRenderer::new(&device, format);
-    renderer.set_mesh(&device, mesh, None)?;
+    let mut renderer = MeshRenderer::new(&device, wgpu::TextureFormat::Rgba8UnormSrgb);
+    renderer.set_mesh(&device, &queue, mesh, None)?;
     if let Some(l) = lines {
-        renderer.set_lines(&device, l, [0.05, 0.05, 0.06]);
+        renderer.set_lines(&device, &queue, l, [0.05, 0.05, 0.06]);
     }
-    renderer.render(&device, &queue, &view, width, height, camera);
-
-    // Rows of a texture-to-buffer copy are padded to 256 bytes.
-    let row = width * 4;
-    let padded =
-        row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("dupin readback"),
-        size: (padded * height) as u64,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    let mut encoder = device.create_command_encoder(&Default::default());
-    encoder.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo {
-            texture: &texture,
-            mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
-            aspect: wgpu::TextureAspect::All,
-        },
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(padded),
-                rows_per_image: Some(height),
-            },
-        },
-        wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        },
-    );
-    queue.submit([encoder.finish()]);
     let (tx, rx) = std::sync::mpsc::channel();
-    buffer.map_async(wgpu::MapMode::Read, .., move |r| {
-        let _ = tx.send(r);
-    });
+    renderer
+        .begin_snapshot(&device, &queue, width, height, camera)
+        .read(move |r| {
+            let _ = tx.send(r);
+        });
     device
         .poll(wgpu::PollType::Wait {
             submission_index: None,
             timeout: None,
         })
         .map_err(|e| RenderError::Readback(e.to_string()))?;
-    rx.recv()
-        .map_err(|e| RenderError::Readback(e.to_string()))?
-        .map_err(|e| RenderError::Readback(e.to_string()))?;
-    let data = buffer
-        .get_mapped_range(..)
-        .map_err(|e| RenderError::Readback(e.to_string()))?;
-    let mut rgba = Vec::with_capacity((row * height) as usize);
-    for y in 0..height as usize {
-        let start = y * padded as usize;
-        rgba.extend_from_slice(&data[start..start + row as usize]);
-    }
-    drop(data);
-    buffer.unmap();
+    let rgba = rx
+        .recv()
+        .map_err(|e| RenderError::Readback(e.to_string()))??;
     Ok(OffscreenImage {
         width,
         height,

@@ -1,6 +1,6 @@
 //! Triangle buffers handed to JavaScript as typed arrays.
 
-use dupin_core::{Torus, TriangleBuffers, sample_surface};
+use dupin_core::{PolyMesh, Torus, TriangleBuffers, Vec3, sample_surface, write_obj};
 use wasm_bindgen::prelude::*;
 
 /// A triangle mesh as typed arrays: `positions` and `normals` (3 floats a vertex), `indices`
@@ -40,6 +40,20 @@ impl MeshData {
     #[wasm_bindgen(getter, js_name = triangleCount)]
     pub fn triangle_count(&self) -> usize {
         self.buffers.triangle_count()
+    }
+
+    /// The mesh as OBJ text (the outside contract's format).
+    #[wasm_bindgen(js_name = toObj)]
+    pub fn to_obj(&self) -> Result<String, JsError> {
+        let positions = self
+            .buffers
+            .positions
+            .chunks_exact(3)
+            .map(|p| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
+            .collect();
+        let mesh = PolyMesh::new(positions, self.buffers.indices.chunks_exact(3))
+            .map_err(|e| JsError::new(&e.to_string()))?;
+        Ok(write_obj(&mesh))
     }
 }
 

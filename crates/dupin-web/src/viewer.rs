@@ -84,7 +84,7 @@ impl Viewer {
     #[wasm_bindgen(js_name = setMesh)]
     pub fn set_mesh(&mut self, mesh: &MeshData, reframe: bool) -> Result<(), JsError> {
         self.renderer
-            .set_mesh(&self.device, &mesh.buffers, None)
+            .set_mesh(&self.device, &self.queue, &mesh.buffers, None)
             .map_err(|e| JsError::new(&e.to_string()))?;
         if reframe {
             self.camera = OrbitCamera::framing_points(&mesh.buffers.positions);
@@ -110,6 +110,49 @@ impl Viewer {
             self.config.height = height;
             self.surface.configure(&self.device, &self.config);
         }
+    }
+
+    /// Renders the current view at `scale` times the canvas size (e.g. 2 for a 2x PNG) and
+    /// resolves to an `ImageData` of it. Pixels come back from the GPU, so this works where a
+    /// browser screenshot does not show WebGPU canvases (headless Chromium).
+    pub fn snapshot(&mut self, scale: f32) -> Result<js_sys::Promise, JsError> {
+        if !(scale.is_finite() && scale > 0.0 && scale <= 8.0) {
+            return Err(JsError::new(&format!(
+                "snapshot scale must be in (0, 8], got {scale}"
+            )));
+        }
+        let w = (self.config.width as f32 * scale).round() as u32;
+        let h = (self.config.height as f32 * scale).round() as u32;
+        let pending = self
+            .renderer
+            .begin_snapshot(&self.device, &self.queue, w, h, &self.camera);
+        let (w, h) = (pending.width(), pending.height());
+        // Promise::new takes an FnMut it calls exactly once.
+        let mut pending = Some(pending);
+        let promise = js_sys::Promise::new(&mut |resolve, reject| {
+            let Some(pending) = pending.take() else {
+                return;
+            };
+            pending.read(move |result| {
+                let value = result
+                    .map_err(|e| JsValue::from(js_sys::Error::new(&e.to_string())))
+                    .and_then(|rgba| {
+                        web_sys::ImageData::new_with_u8_clamped_array_and_sh(
+                            wasm_bindgen::Clamped(&rgba),
+                            w,
+                            h,
+                        )
+                        .map(JsValue::from)
+                    });
+                let _ = match value {
+                    Ok(v) => resolve.call1(&JsValue::NULL, &v),
+                    Err(e) => reject.call1(&JsValue::NULL, &e),
+                };
+            });
+        });
+        // Natively this would block; in the browser it only nudges wgpu's callbacks along.
+        let _ = self.device.poll(wgpu::PollType::Poll);
+        Ok(promise)
     }
 
     /// Draws one frame.

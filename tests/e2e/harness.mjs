@@ -1,0 +1,104 @@
+// Shared set-up of the browser end-to-end tests: Debian's Chromium through playwright-core, with
+// the flags that give headless WebGPU on SwiftShader (see DEVELOPERS.md), screenshots saved
+// under target/e2e/ and pixel statistics computed in the page (no image library needed).
+import { chromium } from 'playwright-core';
+import { mkdirSync, writeFileSync } from 'node:fs';
+import { dirname, join } from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+export const URL_BASE = process.env.DUPIN_URL ?? 'http://127.0.0.1:8080/';
+export const SHOTS = join(dirname(fileURLToPath(import.meta.url)), '../../target/e2e');
+mkdirSync(SHOTS, { recursive: true });
+
+const FLAGS = [
+  '--headless=new', '--no-sandbox', '--enable-unsafe-webgpu', '--use-webgpu-adapter=swiftshader',
+  '--enable-features=Vulkan', '--disable-background-networking', '--disable-component-update',
+  '--disable-sync', '--no-first-run',
+];
+
+/** Opens the page; with `webgpu: false` the browser offers no `navigator.gpu` at all. */
+export async function openPage({ webgpu = true, hash = '' } = {}) {
+  const browser = await chromium.launch({
+    executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
+    headless: true,
+    args: FLAGS,
+  });
+  const context = await browser.newContext({ viewport: { width: 960, height: 640 }, acceptDownloads: true });
+  if (!webgpu) {
+    await context.addInitScript(() => {
+      Object.defineProperty(Navigator.prototype, 'gpu', { get: () => undefined, configurable: true });
+      delete Navigator.prototype.gpu;
+    });
+  }
+  const page = await context.newPage();
+  const errors = [];
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  page.on('pageerror', (e) => errors.push(String(e)));
+  await page.goto(URL_BASE + hash);
+  await page.waitForFunction(() => document.body.dataset.ready === 'true', null, { timeout: 90_000 });
+  return { browser, page, errors };
+}
+
+export const byId = (page, id) => page.locator(`[data-testid="${id}"]`);
+
+/**
+ * Screenshot of the canvas, saved as target/e2e/NAME.png; returns the PNG bytes. Taken through
+ * the page's own GPU readback (`window.dupin.snapshotDataUrl`), since headless Chromium leaves
+ * WebGPU canvases blank in its page screenshots.
+ */
+export async function shot(page, name) {
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  const url = await page.evaluate(() => window.dupin.snapshotDataUrl(1));
+  const png = Buffer.from(url.slice(url.indexOf(',') + 1), 'base64');
+  writeFileSync(join(SHOTS, `${name}.png`), png);
+  return png;
+}
+
+/**
+ * Pixel statistics of PNG `a` (and its difference from PNG `b`), decoded in the page:
+ * `covered` is the fraction of pixels farther than 8 levels from the background, taken as the
+ * most frequent colour.
+ */
+export async function pixelStats(page, a, b = null) {
+  return page.evaluate(async ([a64, b64]) => {
+    const decode = async (s) => {
+      const img = await createImageBitmap(await (await fetch(`data:image/png;base64,${s}`)).blob());
+      const c = new OffscreenCanvas(img.width, img.height);
+      const g = c.getContext('2d');
+      g.drawImage(img, 0, 0);
+      return g.getImageData(0, 0, img.width, img.height).data;
+    };
+    const p = await decode(a64);
+    const counts = new Map();
+    for (let i = 0; i < p.length; i += 4) {
+      const key = (p[i] << 16) | (p[i + 1] << 8) | p[i + 2];
+      counts.set(key, (counts.get(key) ?? 0) + 1);
+    }
+    const mode = [...counts.entries()].reduce((a, b) => (b[1] > a[1] ? b : a))[0];
+    const bg = [mode >> 16, (mode >> 8) & 255, mode & 255];
+    let covered = 0;
+    for (let i = 0; i < p.length; i += 4) {
+      if (Math.max(Math.abs(p[i] - bg[0]), Math.abs(p[i + 1] - bg[1]), Math.abs(p[i + 2] - bg[2])) > 8) covered++;
+    }
+    let differing = null;
+    if (b64) {
+      const q = await decode(b64);
+      differing = 0;
+      for (let i = 0; i < p.length; i += 4) {
+        if (Math.max(Math.abs(p[i] - q[i]), Math.abs(p[i + 1] - q[i + 1]), Math.abs(p[i + 2] - q[i + 2])) > 16) differing++;
+      }
+      differing /= p.length / 4;
+    }
+    return { covered: covered / (p.length / 4), differing };
+  }, [a.toString('base64'), b ? b.toString('base64') : null]);
+}
+
+/** Drags across the canvas centre by (dx, dy) pixels. */
+export async function drag(page, dx, dy) {
+  const box = await byId(page, 'canvas').boundingBox();
+  const x = box.x + box.width / 2, y = box.y + box.height / 2;
+  await page.mouse.move(x, y);
+  await page.mouse.down();
+  for (let i = 1; i <= 8; i++) await page.mouse.move(x + (dx * i) / 8, y + (dy * i) / 8);
+  await page.mouse.up();
+}

@@ -1,0 +1,97 @@
+// The page in headless Chromium: both backends draw, orbit, keep the contract's test ids, restore
+// from the URL, export OBJ and reject bad input inline.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { byId, drag, openPage, pixelStats, shot } from './harness.mjs';
+
+for (const [backend, webgpu] of [['WebGPU', true], ['WebGL2', false]]) {
+  test(`${backend}: loads cleanly, draws the torus and orbits on drag`, async () => {
+    const { browser, page, errors } = await openPage({ webgpu });
+    try {
+      assert.equal((await byId(page, 'status').textContent()).trim(), backend);
+      const first = await shot(page, `${backend.toLowerCase()}-initial`);
+      const { covered } = await pixelStats(page, first);
+      assert.ok(covered > 0.05, `only ${(covered * 100).toFixed(1)}% of the canvas differs from the background`);
+      await drag(page, 160, 40);
+      const second = await shot(page, `${backend.toLowerCase()}-dragged`);
+      const { differing } = await pixelStats(page, first, second);
+      assert.ok(differing > 0.01, `a drag changed only ${(differing * 100).toFixed(2)}% of pixels`);
+      assert.deepEqual(errors, [], 'console errors');
+    } finally {
+      await browser.close();
+    }
+  });
+}
+
+test('contract test ids and metrics are present', async () => {
+  const { browser, page } = await openPage();
+  try {
+    for (const id of ['canvas', 'scene-select', 'step', 'play', 'reset', 'export-obj', 'status', 'metrics']) {
+      assert.equal(await byId(page, id).count(), 1, `data-testid=${id}`);
+    }
+    const m = byId(page, 'metrics');
+    assert.equal(await m.getAttribute('data-phase'), 'done');
+    assert.equal(await m.getAttribute('data-iteration'), '0');
+    assert.ok(Number(await m.getAttribute('data-faces')) > 0);
+    assert.equal(Number(await m.getAttribute('data-max-planarity')), 0);
+  } finally {
+    await browser.close();
+  }
+});
+
+test('a copied URL restores the configuration', async () => {
+  const { browser, page } = await openPage({ hash: '#scene=torus&R=3&r=1.25' });
+  try {
+    assert.equal(await byId(page, 'param-R').inputValue(), '3');
+    assert.equal(await byId(page, 'param-r').inputValue(), '1.25');
+    const url = page.url();
+    assert.match(url, /R=3/);
+    const faces = await byId(page, 'metrics').getAttribute('data-faces');
+    const again = await page.context().newPage();
+    await again.goto(url);
+    await again.waitForFunction(() => document.body.dataset.ready === 'true');
+    assert.equal(await byId(again, 'param-r').inputValue(), '1.25');
+    assert.equal(await byId(again, 'metrics').getAttribute('data-faces'), faces);
+  } finally {
+    await browser.close();
+  }
+});
+
+test('the exported OBJ parses and has the reported face count', async () => {
+  const { browser, page } = await openPage();
+  try {
+    const [download] = await Promise.all([page.waitForEvent('download'), byId(page, 'export-obj').click()]);
+    const path = await download.path();
+    const text = (await import('node:fs')).readFileSync(path, 'utf8');
+    const lines = text.split('\n').filter(Boolean);
+    const v = lines.filter((l) => l.startsWith('v ')), f = lines.filter((l) => l.startsWith('f '));
+    assert.equal(v.length + f.length, lines.length, 'only v and f statements');
+    for (const l of v) assert.equal(l.split(' ').slice(1).map(Number).filter(Number.isFinite).length, 3);
+    for (const l of f) {
+      const idx = l.split(' ').slice(1).map(Number);
+      assert.ok(idx.every((i) => Number.isInteger(i) && i >= 1 && i <= v.length));
+    }
+    assert.equal(String(f.length), await byId(page, 'metrics').getAttribute('data-faces'));
+  } finally {
+    await browser.close();
+  }
+});
+
+test('bad input shows an inline message and leaves the page usable', async () => {
+  const { browser, page, errors } = await openPage();
+  try {
+    const faces = await byId(page, 'metrics').getAttribute('data-faces');
+    await byId(page, 'param-R').fill('-5');
+    await byId(page, 'param-R').dispatchEvent('change');
+    assert.match(await page.locator('.field-error').first().textContent(), /R must be a number/);
+    assert.equal(await byId(page, 'metrics').getAttribute('data-faces'), faces);
+    await byId(page, 'param-R').fill('4');
+    await byId(page, 'param-R').dispatchEvent('change');
+    assert.equal(await page.locator('.field-error').first().textContent(), '');
+    assert.match(page.url(), /R=4/);
+    assert.equal((await byId(page, 'status').textContent()).trim(), 'WebGPU');
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});

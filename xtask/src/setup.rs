@@ -1,0 +1,106 @@
+//! Installs what the project needs when it is missing, and says what it installed.
+
+use crate::util::{Result, cargo, is_root, output, root, run};
+use std::path::Path;
+use std::process::Command;
+
+/// wasm-pack release the project is tested with.
+const WASM_PACK_VERSION: &str = "0.15.1";
+/// The Vulkan driver file of lavapipe (Mesa's software rasteriser) for native render tests.
+const LAVAPIPE_ICD: &str = "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json";
+const APT_PACKAGES: [&str; 3] = ["chromium", "chromium-driver", "mesa-vulkan-drivers"];
+
+/// Installs the wasm toolchain (and with `browser`, the browser-test tools); returns what it
+/// installed.
+pub fn ensure(browser: bool) -> Result<Vec<String>> {
+    let mut installed = Vec::new();
+    let targets =
+        output(Command::new("rustup").args(["target", "list", "--installed"])).unwrap_or_default();
+    if !targets
+        .lines()
+        .any(|t| t.trim() == "wasm32-unknown-unknown")
+    {
+        run(Command::new("rustup").args(["target", "add", "wasm32-unknown-unknown"]))?;
+        installed.push("rust target wasm32-unknown-unknown".into());
+    }
+
+    let want = wasm_bindgen_version()?;
+    let have = output(Command::new("wasm-bindgen").arg("--version")).unwrap_or_default();
+    if have.split_whitespace().nth(1) != Some(want.as_str()) {
+        // Pinned exactly: the CLI must match the wasm-bindgen crate in Cargo.lock.
+        run(cargo().args([
+            "install",
+            "wasm-bindgen-cli",
+            "--version",
+            &format!("={want}"),
+        ]))?;
+        installed.push(format!("wasm-bindgen-cli {want}"));
+    }
+    if output(Command::new("wasm-pack").arg("--version")).is_none() {
+        run(cargo().args([
+            "install",
+            "wasm-pack",
+            "--version",
+            &format!("={WASM_PACK_VERSION}"),
+        ]))?;
+        installed.push(format!("wasm-pack {WASM_PACK_VERSION}"));
+    }
+
+    if browser {
+        let missing = !Path::new("/usr/bin/chromium").exists()
+            || !Path::new("/usr/bin/chromedriver").exists()
+            || !Path::new(LAVAPIPE_ICD).exists();
+        if missing {
+            if !is_root() {
+                return Err(format!(
+                    "Chromium, chromedriver or lavapipe is missing and we are not root; run \
+                     `sudo apt-get install -y {}` and try again",
+                    APT_PACKAGES.join(" ")
+                ));
+            }
+            run(Command::new("apt-get")
+                .arg("update")
+                .env("DEBIAN_FRONTEND", "noninteractive"))?;
+            run(Command::new("apt-get")
+                .args(["install", "-y", "--no-install-recommends"])
+                .args(APT_PACKAGES)
+                .env("DEBIAN_FRONTEND", "noninteractive"))?;
+            installed.push(format!("apt: {}", APT_PACKAGES.join(", ")));
+        }
+        let e2e = root().join("tests/e2e");
+        if !e2e.join("node_modules/playwright-core").exists() {
+            run(Command::new("npm")
+                .args(["ci", "--no-audit", "--no-fund"])
+                .current_dir(&e2e))?;
+            installed.push("npm: playwright-core (tests/e2e)".into());
+        }
+    }
+    Ok(installed)
+}
+
+/// Prints what [`ensure`] installed.
+pub fn print_installed(installed: &[String]) {
+    if installed.is_empty() {
+        println!("setup: everything needed was already installed");
+    } else {
+        println!("setup: installed {}", installed.join("; "));
+    }
+}
+
+/// The exact wasm-bindgen version in Cargo.lock.
+fn wasm_bindgen_version() -> Result<String> {
+    let lock = root().join("Cargo.lock");
+    let text = std::fs::read_to_string(&lock).map_err(|e| format!("{}: {e}", lock.display()))?;
+    let mut lines = text.lines();
+    while let Some(line) = lines.next() {
+        if line.trim() == "name = \"wasm-bindgen\"" {
+            if let Some(v) = lines
+                .next()
+                .and_then(|l| l.trim().strip_prefix("version = "))
+            {
+                return Ok(v.trim_matches('"').to_string());
+            }
+        }
+    }
+    Err("Cargo.lock has no wasm-bindgen entry".into())
+}

@@ -1,0 +1,93 @@
+//! `cargo xtask test`: every check, in the order a failure is cheapest to find.
+
+use crate::config::WebBuild;
+use crate::serve;
+use crate::setup;
+use crate::util::{self, Result, cargo, root};
+use std::process::Command;
+use std::time::Instant;
+
+/// Runs all checks; stops at the first failure.
+pub fn run() -> Result<()> {
+    let web = WebBuild::load()?;
+    let mut times = Vec::new();
+    let mut step = |name: &str, f: &mut dyn FnMut() -> Result<()>| -> Result<()> {
+        println!("\n==> {name}");
+        let t = Instant::now();
+        let r = f();
+        times.push((name.to_string(), t.elapsed().as_secs_f64()));
+        r.map_err(|e| format!("{name}: {e}"))
+    };
+    step("setup", &mut || {
+        setup::ensure(true).map(|i| setup::print_installed(&i))
+    })?;
+    step("rustfmt", &mut || {
+        util::run(cargo().args(["fmt", "--all", "--check"]))
+    })?;
+    step("clippy (native)", &mut || {
+        util::run(cargo().args([
+            "clippy",
+            "--workspace",
+            "--all-targets",
+            "--",
+            "-D",
+            "warnings",
+        ]))
+    })?;
+    step("clippy (wasm32)", &mut || {
+        util::run(cargo().args([
+            "clippy",
+            "-p",
+            "dupin-core",
+            "-p",
+            "dupin-render",
+            "-p",
+            "dupin-web",
+            "--all-targets",
+            "--target",
+            "wasm32-unknown-unknown",
+            "--",
+            "-D",
+            "warnings",
+        ]))
+    })?;
+    step("native tests", &mut || {
+        util::run(cargo().args(["test", "--workspace"]))
+    })?;
+    step("docs", &mut || {
+        util::run(
+            cargo()
+                .args(["doc", "--workspace", "--no-deps"])
+                .env("RUSTDOCFLAGS", "-D warnings"),
+        )
+    })?;
+    step("core for wasm32", &mut || {
+        util::run(cargo().args([
+            "build",
+            "-p",
+            "dupin-core",
+            "--target",
+            "wasm32-unknown-unknown",
+        ]))
+    })?;
+    step("wasm tests (Node)", &mut || web.test_node())?;
+    step("wasm tests (headless Chromium)", &mut || web.test_chrome())?;
+    step("web build", &mut || web.build())?;
+    step("browser end-to-end", &mut || {
+        let listener = serve::bind(0)?;
+        let port = listener.local_addr().map_err(|e| e.to_string())?.port();
+        let dir = root().join("web");
+        std::thread::spawn(move || serve::serve_forever(listener, dir));
+        util::run(
+            Command::new("node")
+                .args(["--test", "--test-concurrency=1", "tests/e2e/"])
+                .current_dir(root())
+                .env("DUPIN_URL", format!("http://127.0.0.1:{port}/")),
+        )
+    })?;
+    println!("\nxtask test: all checks passed");
+    for (name, secs) in &times {
+        println!("  {secs:8.1} s  {name}");
+    }
+    Ok(())
+}
