@@ -171,6 +171,6 @@ mod tests {
         // Huge but finite coordinates must not overflow into NaN silently.
         let big = Vec2::new(1e300, 1e300);
         let r = dupin_center(&ind, &a, &big, &Vec2::new(-1e300, 1e300));
-        assert!(matches!(r, Err(DupinCenterError::NonFinite)) || r.unwrap().iter().all(|x| x.is_finite()));
+        assert!(r.is_err() || r.unwrap().iter().all(|x| x.is_finite()));
     }
 }

@@ -18,7 +18,7 @@ use std::f64::consts::TAU;
 /// u, v in [0, 2 pi), both periodic; parameter lines are curvature lines (circles). A ring
 /// cyclide needs 0 <= c < mu < a. Each principal curvature is the reciprocal of a focal sphere's
 /// signed radius: spheres centred on the focal ellipse (a cos u, b sin u, 0) with radius
-/// mu - c cos u, and on the focal hyperbola (c / cos v, 0, b tan v) with radius
+/// mu - c cos u, and on the focal hyperbola (c / cos v, 0, -b tan v) with radius
 /// (a - mu cos v) / cos v.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DupinCyclide {
@@ -126,7 +126,7 @@ mod tests {
             // contains its whole curvature line and touches the cyclide along it.
             let m1 = Vec3::new(a * u.cos(), b * u.sin(), 0.0);
             let r1 = mu - c * u.cos();
-            let m2 = Vec3::new(c / v.cos(), 0.0, b * v.tan());
+            let m2 = Vec3::new(c / v.cos(), 0.0, -b * v.tan());
             let r2 = (a - mu * v.cos()) / v.cos();
             assert_close((p - m1).norm(), r1.abs(), 1.0, 1e-12, "ellipse focal sphere");
             assert_close((p - m2).norm(), r2.abs(), 1.0, 1e-9, "hyperbola focal sphere");
