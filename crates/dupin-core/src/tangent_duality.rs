@@ -31,8 +31,9 @@ pub struct TangentDualPoint {
     pub point: Vec3,
     /// Reciprocal 1-norm condition number of the matrix of unit normals, in (0, 1]: 1 for three
     /// orthogonal planes, about |det| for nearly parallel ones. The computed point's error is
-    /// about machine epsilon / rcond times the planes' distance from the origin; small curvature
-    /// or a small triangle makes it O(h^2 K)-small (section 4.1's breakdown).
+    /// about machine epsilon / rcond times the triangle's size (the system is solved relative to
+    /// the first point); small curvature or a small triangle makes rcond O(h^2 K)-small
+    /// (section 4.1's breakdown).
     pub rcond: f64,
 }
 
@@ -57,7 +58,9 @@ pub fn tangent_dual_point(
         }
         let u = n / len;
         m.set_row(i, &u.transpose());
-        rhs[i] = u.dot(p);
+        // Relative to the first point: the error then scales with the triangle, not with the
+        // distance of the planes from the origin.
+        rhs[i] = u.dot(&(p - points[0]));
     }
     let Some(inv) = m.try_inverse() else {
         return Err(TangentDualityError::Parallel { rcond: 0.0 });
@@ -73,7 +76,7 @@ pub fn tangent_dual_point(
             rcond: if rcond.is_finite() { rcond } else { 0.0 },
         });
     }
-    let point = inv * rhs;
+    let point = points[0] + inv * rhs;
     if !point.iter().all(|x| x.is_finite()) {
         return Err(TangentDualityError::Parallel { rcond });
     }
