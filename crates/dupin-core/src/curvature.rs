@@ -171,7 +171,7 @@ impl Curvature {
     /// Curvature from position and derivatives up to second order (shape operator I^-1 II).
     ///
     /// Errors: non-finite input, or a singular parametrisation (|Pu x Pv| below 1e-12 of
-    /// |Pu| |Pv|). Never returns NaN.
+    /// |Pu| |Pv|, or min(|Pu|, |Pv|) below 1e-12 of the max). Never returns NaN.
     pub fn from_derivatives(d: &SurfaceDerivatives) -> Result<Curvature, CurvatureError> {
         let finite = |v: &Vec3| v.iter().all(|c| c.is_finite());
         if !(finite(&d.p)
@@ -186,7 +186,9 @@ impl Curvature {
         let cross = d.pu.cross(&d.pv);
         let (nu, nv) = (d.pu.norm(), d.pv.norm());
         let area = cross.norm();
-        if !(area > 1e-12 * nu * nv) || area == 0.0 {
+        // Singular: Pu, Pv (nearly) parallel, or one of them vanishing against the other (the
+        // pole of a sphere, where |Pu| = r cos v).
+        if !(area > 1e-12 * nu * nv) || area == 0.0 || nu.min(nv) <= 1e-12 * nu.max(nv) {
             return Err(CurvatureError::SingularParametrisation);
         }
         let normal = cross / area;
@@ -324,6 +326,11 @@ mod tests {
         assert_eq!(
             Curvature::from_derivatives(&d),
             Err(CurvatureError::NonFinite)
+        );
+        let s = crate::surface::Sphere { radius: 1.0 };
+        assert_eq!(
+            s.curvature(0.3, std::f64::consts::FRAC_PI_2),
+            Err(CurvatureError::SingularParametrisation)
         );
         let mut d = t.derivatives(0.1, 0.2);
         d.pv = d.pu * 2.0;
