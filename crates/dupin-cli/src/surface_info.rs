@@ -17,7 +17,12 @@ pub struct SurfaceInfoArgs {
     #[arg(long = "set", value_name = "KEY=VALUE", allow_hyphen_values = true)]
     set: Vec<String>,
     /// Parameter point U,V.
-    #[arg(long, value_name = "U,V", allow_hyphen_values = true, required_unless_present = "list")]
+    #[arg(
+        long,
+        value_name = "U,V",
+        allow_hyphen_values = true,
+        required_unless_present = "list"
+    )]
     at: Option<String>,
     /// Print every library surface with its parameters (defaults and ranges) and exit.
     #[arg(long)]
@@ -49,7 +54,12 @@ pub fn run(args: SurfaceInfoArgs) -> Result<(), CliError> {
                     )
                 })
                 .collect();
-            println!("{} {} : {}", spec.name, params.join(" "), spec.parametrisation);
+            println!(
+                "{} {} : {}",
+                spec.name,
+                params.join(" "),
+                spec.parametrisation
+            );
         }
         return Ok(());
     }

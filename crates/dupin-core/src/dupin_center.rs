@@ -50,7 +50,12 @@ pub fn dupin_conic_through(
     if t == PointType::Parabolic || t == PointType::Planar {
         return Err(DupinCenterError::ZeroGaussianCurvature(t));
     }
-    if !(a.iter().chain(b.iter()).chain(c.iter()).all(|x| x.is_finite())) {
+    if !(a
+        .iter()
+        .chain(b.iter())
+        .chain(c.iter())
+        .all(|x| x.is_finite()))
+    {
         return Err(DupinCenterError::NonFinite);
     }
     let p = b - a;
@@ -98,6 +103,49 @@ pub fn dupin_center_3d(
     Ok(f.to_world(&o))
 }
 
+/// How [`approximate_dupin_center`] placed its point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DupinCenterMethod {
+    /// Average of the three per-vertex Dupin centers (section 6, steps 2 and 3).
+    Averaged,
+    /// Parabolic region detected: the centroid (section 6, step 1).
+    Centroid,
+}
+
+/// The approximate Dupin center of a surface triangle used to initialise P-Hex meshes (P-Hex
+/// paper, section 6 "Initialization via Dupin duality"):
+/// 1. if the Gaussian curvatures at the three vertices differ in sign or one has |K| below
+///    `parabolic_threshold` (the paper uses 1e-8), the centroid;
+/// 2. otherwise, for each vertex, the Dupin center of the triangle projected onto that vertex's
+///    tangent plane with that vertex's indicatrix;
+/// 3. the average of the three.
+///
+/// `curv[i]` is the curvature at vertex i (its `point` is the vertex). Errors: non-finite input
+/// or a degenerate projected triangle.
+pub fn approximate_dupin_center(
+    curv: [&Curvature; 3],
+    parabolic_threshold: f64,
+) -> Result<(Vec3, DupinCenterMethod), DupinCenterError> {
+    let p = [curv[0].point, curv[1].point, curv[2].point];
+    if !p.iter().all(|v| v.iter().all(|x| x.is_finite())) {
+        return Err(DupinCenterError::NonFinite);
+    }
+    let k = [curv[0].gaussian, curv[1].gaussian, curv[2].gaussian];
+    if !k.iter().all(|x| x.is_finite()) {
+        return Err(DupinCenterError::NonFinite);
+    }
+    let same_sign =
+        (k[0] > 0.0 && k[1] > 0.0 && k[2] > 0.0) || (k[0] < 0.0 && k[1] < 0.0 && k[2] < 0.0);
+    if !same_sign || k.iter().any(|x| x.abs() < parabolic_threshold) {
+        return Ok(((p[0] + p[1] + p[2]) / 3.0, DupinCenterMethod::Centroid));
+    }
+    let mut sum = Vec3::zeros();
+    for (i, c) in curv.iter().enumerate() {
+        sum += dupin_center_3d(c, &p[i], &p[(i + 1) % 3], &p[(i + 2) % 3])?;
+    }
+    Ok((sum / 3.0, DupinCenterMethod::Averaged))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -128,6 +176,45 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn section_6_approximation_tends_to_the_tangent_dual_point() {
+        use crate::surface::{Surface, Torus};
+        use crate::tangent_duality::tangent_dual_point;
+        let t = Torus {
+            major: 2.0,
+            minor: 0.7,
+        };
+        let mut errs = Vec::new();
+        for k in 0..4 {
+            let h = 0.1 / 2f64.powi(k);
+            let uv = [(0.5, 0.4), (0.5 + h, 0.4), (0.5 + 0.3 * h, 0.4 + h)];
+            let c: Vec<Curvature> = uv
+                .iter()
+                .map(|&(u, v)| t.curvature(u, v).unwrap())
+                .collect();
+            let (o, how) = approximate_dupin_center([&c[0], &c[1], &c[2]], 1e-8).unwrap();
+            assert_eq!(how, DupinCenterMethod::Averaged);
+            let td = tangent_dual_point(
+                [&c[0].point, &c[1].point, &c[2].point],
+                [&c[0].normal, &c[1].normal, &c[2].normal],
+            )
+            .unwrap();
+            errs.push((o - td.point).norm() / h);
+        }
+        // O(h^2) error, so error / h shrinks by about 2 per halving.
+        for w in errs.windows(2) {
+            assert!(w[1] < 0.7 * w[0], "{errs:?}");
+        }
+        // Mixed signs of K: the centroid.
+        let c: Vec<Curvature> = [(0.5, 1.5), (0.5, 1.6), (0.6, 1.6)]
+            .iter()
+            .map(|&(u, v)| t.curvature(u, v).unwrap())
+            .collect();
+        let (o, how) = approximate_dupin_center([&c[0], &c[1], &c[2]], 1e-8).unwrap();
+        assert_eq!(how, DupinCenterMethod::Centroid);
+        assert!((o - (c[0].point + c[1].point + c[2].point) / 3.0).norm() < 1e-15);
     }
 
     #[test]
@@ -162,7 +249,9 @@ mod tests {
         let c = Vec2::new(0.0, 1.0);
         assert_eq!(
             dupin_center(&DupinIndicatrix::new(1.0, 0.0).unwrap(), &a, &b, &c),
-            Err(DupinCenterError::ZeroGaussianCurvature(PointType::Parabolic))
+            Err(DupinCenterError::ZeroGaussianCurvature(
+                PointType::Parabolic
+            ))
         );
         assert_eq!(
             dupin_center(&DupinIndicatrix::new(0.0, 0.0).unwrap(), &a, &b, &c),

@@ -22,7 +22,9 @@ pub enum IndicatrixError {
     #[error("zero direction")]
     ZeroDirection,
     /// At a parabolic point, every direction is conjugate to the zero-curvature direction.
-    #[error("the direction is the zero-curvature direction of a parabolic point: its conjugate is undetermined")]
+    #[error(
+        "the direction is the zero-curvature direction of a parabolic point: its conjugate is undetermined"
+    )]
     Undetermined,
     /// Asymptotic directions exist only where K < 0 (or along the ruling where K = 0).
     #[error("no asymptotic directions: the point is not hyperbolic")]
@@ -206,9 +208,9 @@ impl DupinConic {
     pub fn point_at(&self, t: f64, branch: i8) -> Option<Vec2> {
         let (k1, k2, s) = (self.indicatrix.k1, self.indicatrix.k2, self.level);
         match self.indicatrix.kind {
-            PointType::Elliptic if s / k1 > 0.0 => Some(
-                self.center + Vec2::new((s / k1).sqrt() * t.cos(), (s / k2).sqrt() * t.sin()),
-            ),
+            PointType::Elliptic if s / k1 > 0.0 => {
+                Some(self.center + Vec2::new((s / k1).sqrt() * t.cos(), (s / k2).sqrt() * t.sin()))
+            }
             PointType::Hyperbolic if s != 0.0 => {
                 let b = if branch < 0 { -1.0 } else { 1.0 };
                 Some(if (k1 > 0.0) == (s > 0.0) {
@@ -235,7 +237,9 @@ impl Curvature {
     /// component is ignored), to the left of `t` seen from the normal (section 4.2).
     pub fn conjugate_direction(&self, t: &Vec3) -> Result<Vec3, IndicatrixError> {
         let f = self.frame();
-        let e = self.indicatrix()?.conjugate_direction(&f.vector_to_local(t))?;
+        let e = self
+            .indicatrix()?
+            .conjugate_direction(&f.vector_to_local(t))?;
         Ok(f.vector_to_world(&e))
     }
 
@@ -320,14 +324,21 @@ mod tests {
 
     #[test]
     fn conic_points_lie_on_the_conic_and_branches_split() {
-        for (k1, k2, s) in [(2.0, 0.5, 3.0), (-1.0, -3.0, -0.5), (1.5, -0.7, 2.0), (1.5, -0.7, -2.0)] {
+        for (k1, k2, s) in [
+            (2.0, 0.5, 3.0),
+            (-1.0, -3.0, -0.5),
+            (1.5, -0.7, 2.0),
+            (1.5, -0.7, -2.0),
+        ] {
             let ind = DupinIndicatrix::new(k1, k2).unwrap();
             let c = ind.conic(Vec2::new(0.3, -0.2), s);
             for i in 0..20 {
                 let t = -2.0 + 0.2 * i as f64;
                 for br in [1i8, -1] {
                     let p = c.point_at(t, br).unwrap();
-                    assert!(c.residual(&p).abs() < 1e-12 * (1.0 + s.abs()) * (1.0 + t.cosh().powi(2)));
+                    assert!(
+                        c.residual(&p).abs() < 1e-12 * (1.0 + s.abs()) * (1.0 + t.cosh().powi(2))
+                    );
                     if k1 * k2 < 0.0 {
                         assert_eq!(c.branch(&p), Some(br));
                     }

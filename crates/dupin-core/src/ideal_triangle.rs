@@ -206,7 +206,9 @@ mod tests {
             let mut n = 0;
             while n < 10_000 {
                 let (ind, a, b) = random_case(&mut rng, sign);
-                let Ok(t) = ideal_triangle(&ind, &a, &b) else { continue };
+                let Ok(t) = ideal_triangle(&ind, &a, &b) else {
+                    continue;
+                };
                 // Keep well-shaped bases: skip nearly asymptotic ones whose apex runs far away.
                 if t.step > 20.0 * (b - a).norm() {
                     continue;
@@ -225,7 +227,9 @@ mod tests {
                 assert!(err <= 1e-12, "Dupin center off by {err}");
                 // C is left of AB, on the conjugate line through M.
                 assert!(cross(&(t.b - t.a), &(t.c - t.a)) > 0.0);
-                assert!(ind.bilinear(&(t.b - t.a), &(t.c - t.m)).abs() <= 1e-9 * scale * scale * 5.0);
+                assert!(
+                    ind.bilinear(&(t.b - t.a), &(t.c - t.m)).abs() <= 1e-9 * scale * scale * 5.0
+                );
                 // The Dupin hexagon of the star is affine regular / quasi-regular and simple.
                 let star = TriangleStar::new(t.a, t.b, t.c).unwrap();
                 let h = star.dupin_hexagon(&ind).unwrap();
@@ -239,7 +243,10 @@ mod tests {
                 assert_eq!(is_simple_polygon(&h.vertices), Ok(true));
             }
         }
-        eprintln!("ideal triangles: worst relative Dupin-center error K>0 {:.2e}, K<0 {:.2e}", worst[0], worst[1]);
+        eprintln!(
+            "ideal triangles: worst relative Dupin-center error K>0 {:.2e}, K<0 {:.2e}",
+            worst[0], worst[1]
+        );
     }
 
     #[test]
@@ -249,7 +256,9 @@ mod tests {
             let mut n = 0;
             while n < 2_000 {
                 let (ind, a, b) = random_case(&mut rng, sign);
-                let Ok(t) = ideal_triangle(&ind, &a, &b) else { continue };
+                let Ok(t) = ideal_triangle(&ind, &a, &b) else {
+                    continue;
+                };
                 n += 1;
                 let tt = t.step / 3f64.sqrt();
                 for lam in [0.3, 0.7, 0.95, 1.05, 1.5, 3.0] {
@@ -265,7 +274,10 @@ mod tests {
                 if sign > 0.0 {
                     // DE touches the Dupin ellipse with diameter AB at M + t w.
                     let s = ind.quadratic(&(e / 2.0));
-                    assert!((ind.quadratic(&(t.m + t.direction * tt - t.m)) - s).abs() <= 1e-9 * s.abs());
+                    assert!(
+                        (ind.quadratic(&(t.m + t.direction * tt - t.m)) - s).abs()
+                            <= 1e-9 * s.abs()
+                    );
                 } else {
                     // MD and ME are asymptotic.
                     let q = ind.quadratic(&(t.d - t.m)).abs() + ind.quadratic(&(t.e - t.m)).abs();
@@ -296,12 +308,18 @@ mod tests {
             ideal_triangle(&ind, &a, &Vec2::new(1.0, 1.0)),
             Err(IdealTriangleError::AsymptoticBase)
         );
-        assert_eq!(ideal_triangle(&ind, &a, &a), Err(IdealTriangleError::DegenerateBase));
+        assert_eq!(
+            ideal_triangle(&ind, &a, &a),
+            Err(IdealTriangleError::DegenerateBase)
+        );
         assert_eq!(
             ideal_triangle(&ind, &a, &Vec2::new(f64::NAN, 1.0)),
             Err(IdealTriangleError::NonFinite)
         );
-        for (k1, k2, t) in [(1.0, 0.0, PointType::Parabolic), (0.0, 0.0, PointType::Planar)] {
+        for (k1, k2, t) in [
+            (1.0, 0.0, PointType::Parabolic),
+            (0.0, 0.0, PointType::Planar),
+        ] {
             let ind = DupinIndicatrix::new(k1, k2).unwrap();
             assert_eq!(
                 ideal_triangle(&ind, &a, &Vec2::new(1.0, 0.3)),

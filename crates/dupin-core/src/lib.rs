@@ -29,7 +29,10 @@ mod tangent_duality;
 mod triangle_star;
 
 pub use curvature::{Curvature, CurvatureError, CurvatureTolerance, PointType, TangentFrame};
-pub use dupin_center::{DupinCenterError, dupin_center, dupin_center_3d, dupin_conic_through};
+pub use dupin_center::{
+    DupinCenterError, DupinCenterMethod, approximate_dupin_center, dupin_center, dupin_center_3d,
+    dupin_conic_through,
+};
 pub use dupin_indicatrix::{DupinConic, DupinIndicatrix, IndicatrixError};
 pub use ideal_triangle::{
     IdealTriangle, IdealTriangleError, ideal_apex_3d, ideal_triangle,

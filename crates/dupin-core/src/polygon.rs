@@ -55,7 +55,10 @@ pub fn is_simple_polygon(pts: &[Vec2]) -> Result<bool, PolygonError> {
     if n < 3 {
         return Err(PolygonError::TooFewVertices(n));
     }
-    if let Some(i) = pts.iter().position(|p| !(p.x.is_finite() && p.y.is_finite())) {
+    if let Some(i) = pts
+        .iter()
+        .position(|p| !(p.x.is_finite() && p.y.is_finite()))
+    {
         return Err(PolygonError::NonFinite(i));
     }
     for i in 0..n {
@@ -118,12 +121,27 @@ mod tests {
         let arrow = [v(0.0, 0.0), v(2.0, 1.0), v(0.0, 2.0), v(0.5, 1.0)];
         assert_eq!(is_simple_polygon(&arrow), Ok(true));
         // Touching: a vertex on a non-adjacent edge.
-        let touch = [v(0.0, 0.0), v(2.0, 0.0), v(2.0, 2.0), v(1.0, 0.0), v(0.0, 2.0)];
+        let touch = [
+            v(0.0, 0.0),
+            v(2.0, 0.0),
+            v(2.0, 2.0),
+            v(1.0, 0.0),
+            v(0.0, 2.0),
+        ];
         assert_eq!(is_simple_polygon(&touch), Ok(false));
         // Repeated vertex and folding edge.
-        assert_eq!(is_simple_polygon(&[v(0.0, 0.0), v(0.0, 0.0), v(1.0, 1.0)]), Ok(false));
-        assert_eq!(is_simple_polygon(&[v(0.0, 0.0), v(2.0, 0.0), v(1.0, 0.0), v(1.0, 1.0)]), Ok(false));
-        assert_eq!(is_simple_polygon(&[v(0.0, 0.0)]), Err(PolygonError::TooFewVertices(1)));
+        assert_eq!(
+            is_simple_polygon(&[v(0.0, 0.0), v(0.0, 0.0), v(1.0, 1.0)]),
+            Ok(false)
+        );
+        assert_eq!(
+            is_simple_polygon(&[v(0.0, 0.0), v(2.0, 0.0), v(1.0, 0.0), v(1.0, 1.0)]),
+            Ok(false)
+        );
+        assert_eq!(
+            is_simple_polygon(&[v(0.0, 0.0)]),
+            Err(PolygonError::TooFewVertices(1))
+        );
         assert_eq!(
             is_simple_polygon(&[v(0.0, 0.0), v(1.0, f64::NAN), v(1.0, 1.0)]),
             Err(PolygonError::NonFinite(1))
@@ -134,8 +152,20 @@ mod tests {
     fn exact_near_degenerate_crossing() {
         // A vertex displaced by one ulp across an edge flips the answer.
         let e = f64::EPSILON;
-        let inside = [v(0.0, 0.0), v(1.0, 0.0), v(1.0, 1.0), v(0.5, e), v(0.0, 1.0)];
-        let across = [v(0.0, 0.0), v(1.0, 0.0), v(1.0, 1.0), v(0.5, -e), v(0.0, 1.0)];
+        let inside = [
+            v(0.0, 0.0),
+            v(1.0, 0.0),
+            v(1.0, 1.0),
+            v(0.5, e),
+            v(0.0, 1.0),
+        ];
+        let across = [
+            v(0.0, 0.0),
+            v(1.0, 0.0),
+            v(1.0, 1.0),
+            v(0.5, -e),
+            v(0.0, 1.0),
+        ];
         assert_eq!(is_simple_polygon(&inside), Ok(true));
         assert_eq!(is_simple_polygon(&across), Ok(false));
     }

@@ -125,7 +125,10 @@ mod tests {
             Err(TangentDualityError::ZeroNormal)
         );
         assert_eq!(
-            tangent_dual_point([&o, &o, &Vec3::new(f64::NAN, 0.0, 0.0)], [&z, &Vec3::y(), &Vec3::x()]),
+            tangent_dual_point(
+                [&o, &o, &Vec3::new(f64::NAN, 0.0, 0.0)],
+                [&z, &Vec3::y(), &Vec3::x()]
+            ),
             Err(TangentDualityError::NonFinite)
         );
     }

@@ -62,7 +62,12 @@ pub struct DupinHexagon {
 impl TriangleStar {
     /// The star around `center` with fundamental triangle (center, p, q).
     pub fn new(center: Vec2, p: Vec2, q: Vec2) -> Result<Self, TriangleStarError> {
-        if !center.iter().chain(p.iter()).chain(q.iter()).all(|x| x.is_finite()) {
+        if !center
+            .iter()
+            .chain(p.iter())
+            .chain(q.iter())
+            .all(|x| x.is_finite())
+        {
             return Err(TriangleStarError::NonFinite);
         }
         let (a, b) = (p - center, q - center);
@@ -242,14 +247,18 @@ mod tests {
     #[test]
     fn proposition_4_conditions_agree() {
         let (v, i) = agreement(1.0, 4);
-        eprintln!("Proposition 4 (K > 0): 100000 stars, {v} valid, {i} invalid, all 3 conditions agree");
+        eprintln!(
+            "Proposition 4 (K > 0): 100000 stars, {v} valid, {i} invalid, all 3 conditions agree"
+        );
         assert!(v > 10_000 && i > 10_000);
     }
 
     #[test]
     fn proposition_5_conditions_agree() {
         let (v, i) = agreement(-1.0, 5);
-        eprintln!("Proposition 5 (K < 0): 100000 stars, {v} valid, {i} invalid, all 3 conditions agree");
+        eprintln!(
+            "Proposition 5 (K < 0): 100000 stars, {v} valid, {i} invalid, all 3 conditions agree"
+        );
         assert!(v > 10_000 && i > 10_000);
     }
 
@@ -259,10 +268,16 @@ mod tests {
         for _ in 0..20_000 {
             let k1: f64 = rng.random_range(-4.0..4.0);
             let k2: f64 = rng.random_range(-4.0..4.0);
-            let Ok(ind) = DupinIndicatrix::new(k1, k2) else { continue };
+            let Ok(ind) = DupinIndicatrix::new(k1, k2) else {
+                continue;
+            };
             let mut p = || Vec2::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
-            let Ok(star) = TriangleStar::new(p(), p(), p()) else { continue };
-            let Ok(h) = star.dupin_hexagon(&ind) else { continue };
+            let Ok(star) = TriangleStar::new(p(), p(), p()) else {
+                continue;
+            };
+            let Ok(h) = star.dupin_hexagon(&ind) else {
+                continue;
+            };
             // One conic through all six vertices, centred at the star's center ...
             let scale = h
                 .vertices
@@ -289,7 +304,8 @@ mod tests {
 
     #[test]
     fn wrong_sign_and_degenerate_are_typed_errors() {
-        let star = TriangleStar::new(Vec2::zeros(), Vec2::new(1.0, 0.0), Vec2::new(0.3, 1.0)).unwrap();
+        let star =
+            TriangleStar::new(Vec2::zeros(), Vec2::new(1.0, 0.0), Vec2::new(0.3, 1.0)).unwrap();
         let pos = DupinIndicatrix::new(1.0, 2.0).unwrap();
         let neg = DupinIndicatrix::new(1.0, -2.0).unwrap();
         assert!(matches!(
@@ -303,7 +319,9 @@ mod tests {
         let par = DupinIndicatrix::new(1.0, 0.0).unwrap();
         assert!(matches!(
             star.is_valid(&par),
-            Err(TriangleStarError::DupinCenter(DupinCenterError::ZeroGaussianCurvature(_)))
+            Err(TriangleStarError::DupinCenter(
+                DupinCenterError::ZeroGaussianCurvature(_)
+            ))
         ));
         assert_eq!(
             TriangleStar::new(Vec2::zeros(), Vec2::zeros(), Vec2::new(1.0, 1.0)),

@@ -102,7 +102,13 @@ fn propositions_1_and_2_rates_are_quadratic() {
         ("hyperboloid", &hyp as &dyn Surface, (0.3, 0.4), -1.0),
     ] {
         let (s2, s1) = rates(name, s, uv, sign);
-        assert!((1.8..=2.2).contains(&s2), "{name}: Proposition 2 slope {s2}");
-        assert!((1.8..=2.2).contains(&s1), "{name}: Proposition 1 slope {s1}");
+        assert!(
+            (1.8..=2.2).contains(&s2),
+            "{name}: Proposition 2 slope {s2}"
+        );
+        assert!(
+            (1.8..=2.2).contains(&s1),
+            "{name}: Proposition 1 slope {s1}"
+        );
     }
 }

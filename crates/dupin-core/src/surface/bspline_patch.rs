@@ -134,7 +134,12 @@ impl BSplinePatch {
     }
 
     /// Moves control point (i, j) (editing the net).
-    pub fn set_control_point(&mut self, i: usize, j: usize, p: Vec3) -> Result<(), BSplinePatchError> {
+    pub fn set_control_point(
+        &mut self,
+        i: usize,
+        j: usize,
+        p: Vec3,
+    ) -> Result<(), BSplinePatchError> {
         if i >= self.nu || j >= self.nv {
             return Err(BSplinePatchError::OutOfRange {
                 i,
@@ -164,7 +169,11 @@ impl Surface for BSplinePatch {
     fn derivatives(&self, u: f64, v: f64) -> SurfaceDerivatives {
         let span = |x: f64, n: usize| -> (usize, f64) {
             let last = (n - 4) as f64;
-            let fl = if x.is_finite() { x.floor().clamp(0.0, last) } else { 0.0 };
+            let fl = if x.is_finite() {
+                x.floor().clamp(0.0, last)
+            } else {
+                0.0
+            };
             (fl as usize, x - fl)
         };
         let (i0, tu) = span(u, self.nu);
@@ -241,7 +250,10 @@ mod tests {
         assert_eq!(s.position(0.5, 0.5), before, "outside the point's support");
         assert!(s.position(2.9, 2.9).z > 0.01);
         assert!(s.set_control_point(6, 0, Vec3::zeros()).is_err());
-        assert!(s.set_control_point(0, 0, Vec3::new(f64::NAN, 0.0, 0.0)).is_err());
+        assert!(
+            s.set_control_point(0, 0, Vec3::new(f64::NAN, 0.0, 0.0))
+                .is_err()
+        );
         assert!(BSplinePatch::new(3, 5, vec![Vec3::zeros(); 15]).is_err());
         assert!(BSplinePatch::new(4, 4, vec![Vec3::zeros(); 15]).is_err());
     }

@@ -149,7 +149,10 @@ mod tests {
             let start = Vec2::new(u + rng.random_range(-0.05..0.05), v);
             for st in [Some(start), None] {
                 let cp = s.closest_point(&q, st).unwrap();
-                assert!((cp.point - s.position(u, v)).norm() < 1e-9, "foot at {u},{v} t {t} start {st:?} got {cp:?}");
+                assert!(
+                    (cp.point - s.position(u, v)).norm() < 1e-9,
+                    "foot at {u},{v} t {t} start {st:?} got {cp:?}"
+                );
                 assert!((cp.distance - t.abs()).abs() < 1e-9);
             }
         }

@@ -128,8 +128,20 @@ mod tests {
             let r1 = mu - c * u.cos();
             let m2 = Vec3::new(c / v.cos(), 0.0, -b * v.tan());
             let r2 = (a - mu * v.cos()) / v.cos();
-            assert_close((p - m1).norm(), r1.abs(), 1.0, 1e-12, "ellipse focal sphere");
-            assert_close((p - m2).norm(), r2.abs(), 1.0, 1e-9, "hyperbola focal sphere");
+            assert_close(
+                (p - m1).norm(),
+                r1.abs(),
+                1.0,
+                1e-12,
+                "ellipse focal sphere",
+            );
+            assert_close(
+                (p - m2).norm(),
+                r2.abs(),
+                1.0,
+                1e-9,
+                "hyperbola focal sphere",
+            );
             // Centre of curvature m = p + n / k, so k = 1 / ((m - p) . n).
             let ka = 1.0 / (m1 - p).dot(&n);
             let kb = 1.0 / (m2 - p).dot(&n);

@@ -257,11 +257,19 @@ fn fit_quadric(
     if ring.len() < 5 {
         return Err(CurvatureError::SingularParametrisation);
     }
-    let helper = if n.x.abs() < 0.9 { Vec3::x() } else { Vec3::y() };
+    let helper = if n.x.abs() < 0.9 {
+        Vec3::x()
+    } else {
+        Vec3::y()
+    };
     let t1 = n.cross(&helper).normalize();
     let t2 = n.cross(&t1);
     let o = pos[i];
-    let scale = ring.iter().map(|&j| (pos[j as usize] - o).norm()).sum::<f64>() / ring.len() as f64;
+    let scale = ring
+        .iter()
+        .map(|&j| (pos[j as usize] - o).norm())
+        .sum::<f64>()
+        / ring.len() as f64;
     if !(scale > 0.0) {
         return Err(CurvatureError::SingularParametrisation);
     }
@@ -352,7 +360,9 @@ mod tests {
                 worst_normal = worst_normal.max((est.normal - exact.normal).norm());
             }
         }
-        eprintln!("mesh torus: worst relative curvature error {worst:.3e}, normal error {worst_normal:.3e}");
+        eprintln!(
+            "mesh torus: worst relative curvature error {worst:.3e}, normal error {worst_normal:.3e}"
+        );
         assert!(worst_normal < 1e-2, "normal error {worst_normal}");
         assert!(worst < 0.02, "worst relative error {worst}");
     }

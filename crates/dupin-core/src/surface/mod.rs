@@ -122,11 +122,10 @@ pub struct FundamentalForms {
 impl FundamentalForms {
     /// Computes both forms from derivatives.
     pub fn from_derivatives(d: &SurfaceDerivatives) -> Self {
-        let normal = d
-            .pu
-            .cross(&d.pv)
-            .try_normalize(0.0)
-            .unwrap_or_else(Vec3::zeros);
+        let normal =
+            d.pu.cross(&d.pv)
+                .try_normalize(0.0)
+                .unwrap_or_else(Vec3::zeros);
         FundamentalForms {
             e: d.pu.dot(&d.pu),
             f: d.pu.dot(&d.pv),
@@ -248,7 +247,11 @@ pub(crate) mod test_support {
 
 /// Derivatives of a surface of revolution P = (rho(v) cos u, rho(v) sin u, z(v)) from the profile
 /// and its first two derivatives `rho = (rho, rho', rho'')`, `z = (z, z', z'')`.
-pub(crate) fn revolution_derivatives(u: f64, rho: (f64, f64, f64), z: (f64, f64, f64)) -> SurfaceDerivatives {
+pub(crate) fn revolution_derivatives(
+    u: f64,
+    rho: (f64, f64, f64),
+    z: (f64, f64, f64),
+) -> SurfaceDerivatives {
     let (su, cu) = u.sin_cos();
     let (r, r1, r2) = rho;
     SurfaceDerivatives {

@@ -233,22 +233,38 @@ pub fn surface_catalog() -> &'static [SurfaceSpec] {
 /// Errors: unknown name or key, value out of its documented range, non-integer where an integer
 /// is required, or a violated relation between parameters (torus r < R, cyclide c < mu < a,
 /// vase amplitude < radius).
-pub fn surface_by_name(name: &str, params: &[(&str, f64)]) -> Result<Box<dyn Surface>, RegistryError> {
-    let spec = CATALOG.iter().find(|s| s.name == name).ok_or_else(|| {
-        RegistryError::UnknownSurface {
-            name: name.to_string(),
-            known: CATALOG.iter().map(|s| s.name).collect::<Vec<_>>().join(", "),
-        }
-    })?;
+pub fn surface_by_name(
+    name: &str,
+    params: &[(&str, f64)],
+) -> Result<Box<dyn Surface>, RegistryError> {
+    let spec =
+        CATALOG
+            .iter()
+            .find(|s| s.name == name)
+            .ok_or_else(|| RegistryError::UnknownSurface {
+                name: name.to_string(),
+                known: CATALOG
+                    .iter()
+                    .map(|s| s.name)
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })?;
     let mut values: Vec<f64> = spec.params.iter().map(|p| p.default).collect();
     for &(key, value) in params {
-        let k = spec.params.iter().position(|p| p.key == key).ok_or_else(|| {
-            RegistryError::UnknownParameter {
+        let k = spec
+            .params
+            .iter()
+            .position(|p| p.key == key)
+            .ok_or_else(|| RegistryError::UnknownParameter {
                 surface: name.to_string(),
                 key: key.to_string(),
-                known: spec.params.iter().map(|p| p.key).collect::<Vec<_>>().join(", "),
-            }
-        })?;
+                known: spec
+                    .params
+                    .iter()
+                    .map(|p| p.key)
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })?;
         let p = &spec.params[k];
         if !(value.is_finite() && value >= p.min && value <= p.max)
             || (p.integer && value.fract() != 0.0)
@@ -288,10 +304,11 @@ pub fn surface_by_name(name: &str, params: &[(&str, f64)]) -> Result<Box<dyn Sur
         "cylinder" => Box::new(Cylinder::new(v[0], v[1])?),
         "bspline" => {
             let amp = v[3];
-            let patch = BSplinePatch::from_height_field(v[0] as usize, v[1] as usize, v[2], |x, y| {
-                amp * (1.2 * x).sin() * (0.9 * y).cos() + 0.1 * (x * x + y * y)
-            })
-            .map_err(|e| RegistryError::Constraint(e.to_string()))?;
+            let patch =
+                BSplinePatch::from_height_field(v[0] as usize, v[1] as usize, v[2], |x, y| {
+                    amp * (1.2 * x).sin() * (0.9 * y).cos() + 0.1 * (x * x + y * y)
+                })
+                .map_err(|e| RegistryError::Constraint(e.to_string()))?;
             Box::new(patch)
         }
         _ => unreachable!("every catalog name is constructed above"),
@@ -333,7 +350,12 @@ mod tests {
                 }
             }
             for p in spec.params {
-                assert!(p.min <= p.default && p.default <= p.max, "{}.{}", spec.name, p.key);
+                assert!(
+                    p.min <= p.default && p.default <= p.max,
+                    "{}.{}",
+                    spec.name,
+                    p.key
+                );
             }
         }
     }
@@ -411,7 +433,10 @@ mod tests {
                     }
                 }
             }
-            assert!(pos > 20 && neg > 20, "{name}: {pos} elliptic, {neg} hyperbolic");
+            assert!(
+                pos > 20 && neg > 20,
+                "{name}: {pos} elliptic, {neg} hyperbolic"
+            );
         }
     }
 }

@@ -69,6 +69,23 @@ mod tests {
     }
 
     #[test]
+    fn curvature_matches_closed_forms() {
+        use crate::surface::test_support::check_curvature;
+        let (big, r) = (2.0, 0.7);
+        let t = Torus {
+            major: big,
+            minor: r,
+        };
+        for i in 0..80 {
+            let u = 0.079 * i as f64;
+            let v = 0.013 + 0.0787 * i as f64;
+            // k along the parallels -cos v / (R + r cos v), along the meridians -1/r.
+            let (ku, kv) = (-v.cos() / (big + r * v.cos()), -1.0 / r);
+            check_curvature(&t, u, v, ku.max(kv), ku.min(kv), 1e-9);
+        }
+    }
+
+    #[test]
     fn outer_normal_points_outward() {
         let t = Torus {
             major: 2.0,
