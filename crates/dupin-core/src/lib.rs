@@ -14,6 +14,9 @@
 //! - [`dupin_center`], [`tangent_dual_point`], [`TriangleStar`] (section 4, Propositions 3-5);
 //! - [`ideal_triangle`] (section 5.1); [`is_simple_polygon`] (exact predicates).
 
+// `!(x > t)` is used on purpose throughout: unlike `x <= t` it also rejects NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 mod curvature;
 mod dupin_center;
 mod dupin_indicatrix;

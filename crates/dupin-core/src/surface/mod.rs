@@ -189,6 +189,25 @@ pub trait Surface: Send + Sync {
     }
 }
 
+/// Derivatives of a surface of revolution P = (rho(v) cos u, rho(v) sin u, z(v)) from the profile
+/// and its first two derivatives `rho = (rho, rho', rho'')`, `z = (z, z', z'')`.
+pub(crate) fn revolution_derivatives(
+    u: f64,
+    rho: (f64, f64, f64),
+    z: (f64, f64, f64),
+) -> SurfaceDerivatives {
+    let (su, cu) = u.sin_cos();
+    let (r, r1, r2) = rho;
+    SurfaceDerivatives {
+        p: Vec3::new(r * cu, r * su, z.0),
+        pu: Vec3::new(-r * su, r * cu, 0.0),
+        pv: Vec3::new(r1 * cu, r1 * su, z.1),
+        puu: Vec3::new(-r * cu, -r * su, 0.0),
+        puv: Vec3::new(-r1 * su, r1 * cu, 0.0),
+        pvv: Vec3::new(r2 * cu, r2 * su, z.2),
+    }
+}
+
 #[cfg(test)]
 pub(crate) mod test_support {
     //! Shared checks for the surface library.
@@ -242,24 +261,5 @@ pub(crate) mod test_support {
         let kp = -d1.1 / (rho * s);
         let km = (d2.0 * d1.1 - d1.0 * d2.1) / (s * s * s);
         (kp.max(km), kp.min(km))
-    }
-}
-
-/// Derivatives of a surface of revolution P = (rho(v) cos u, rho(v) sin u, z(v)) from the profile
-/// and its first two derivatives `rho = (rho, rho', rho'')`, `z = (z, z', z'')`.
-pub(crate) fn revolution_derivatives(
-    u: f64,
-    rho: (f64, f64, f64),
-    z: (f64, f64, f64),
-) -> SurfaceDerivatives {
-    let (su, cu) = u.sin_cos();
-    let (r, r1, r2) = rho;
-    SurfaceDerivatives {
-        p: Vec3::new(r * cu, r * su, z.0),
-        pu: Vec3::new(-r * su, r * cu, 0.0),
-        pv: Vec3::new(r1 * cu, r1 * su, z.1),
-        puu: Vec3::new(-r * cu, -r * su, 0.0),
-        puv: Vec3::new(-r1 * su, r1 * cu, 0.0),
-        pvv: Vec3::new(r2 * cu, r2 * su, z.2),
     }
 }
