@@ -14,6 +14,8 @@ use crate::surface::SurfaceDerivatives;
 use thiserror::Error;
 
 /// Why curvature could not be computed.
+///
+/// (P-Hex paper, section 3.)
 #[derive(Debug, Clone, Copy, PartialEq, Error)]
 pub enum CurvatureError {
     /// The derivatives contain NaN or infinity.

@@ -11,6 +11,8 @@ use crate::math::{Vec2, Vec3};
 use thiserror::Error;
 
 /// Why a Dupin center does not exist.
+///
+/// (P-Hex paper, section 4.1.)
 #[derive(Debug, Clone, Copy, PartialEq, Error)]
 pub enum DupinCenterError {
     /// A vertex or curvature is NaN or infinite.
@@ -104,6 +106,8 @@ pub fn dupin_center_3d(
 }
 
 /// How [`approximate_dupin_center`] placed its point.
+///
+/// (P-Hex paper, section 6.)
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum DupinCenterMethod {
     /// Average of the three per-vertex Dupin centers (section 6, steps 2 and 3).

@@ -10,6 +10,8 @@ use crate::math::{Vec2, Vec3};
 use thiserror::Error;
 
 /// Why an indicatrix operation has no answer.
+///
+/// (P-Hex paper, sections 3 and 4.2.)
 #[derive(Debug, Clone, Copy, PartialEq, Error)]
 pub enum IndicatrixError {
     /// A curvature or a direction is NaN or infinite.

@@ -17,6 +17,8 @@ use crate::math::{Vec2, Vec3};
 use thiserror::Error;
 
 /// Why no ideal triangle exists on this base.
+///
+/// (P-Hex paper, section 5.1.)
 #[derive(Debug, Clone, Copy, PartialEq, Error)]
 pub enum IdealTriangleError {
     /// A point or curvature is NaN or infinite.
@@ -151,6 +153,8 @@ pub fn ideal_apex_3d(curv: &Curvature, a: &Vec3, b: &Vec3) -> Result<Vec3, Ideal
 /// Whether a centrally symmetric hexagon (vertices relative to its center) is affine regular:
 /// h_(i+1) = h_i + h_(i+2) for all i (true for the regular hexagon, preserved by linear maps),
 /// to relative tolerance `tol`.
+///
+/// (P-Hex paper, section 4.2, Fig. 12 left.)
 pub fn is_affine_regular_hexagon(h: &[Vec2; 6], center: &Vec2, tol: f64) -> bool {
     let r = h.map(|p| p - center);
     let scale = r.iter().map(|v| v.norm()).fold(0.0, f64::max);

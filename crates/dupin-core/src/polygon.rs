@@ -9,6 +9,8 @@ use robust::{Coord, orient2d};
 use thiserror::Error;
 
 /// Why a polygon could not be tested.
+///
+/// (P-Hex paper, section 4.2.)
 #[derive(Debug, Clone, Copy, PartialEq, Error)]
 pub enum PolygonError {
     /// Fewer than three vertices.
@@ -35,6 +37,8 @@ fn on_segment(a: &Vec2, b: &Vec2, c: &Vec2) -> bool {
 }
 
 /// Whether the closed segments ab and cd share a point (exact).
+///
+/// (P-Hex paper, section 4.2.)
 pub fn segments_intersect(a: &Vec2, b: &Vec2, c: &Vec2, d: &Vec2) -> bool {
     let (o1, o2) = (orient(a, b, c), orient(a, b, d));
     let (o3, o4) = (orient(c, d, a), orient(c, d, b));
@@ -50,6 +54,8 @@ pub fn segments_intersect(a: &Vec2, b: &Vec2, c: &Vec2, d: &Vec2) -> bool {
 /// Whether the closed polygon `pts` (edges p_i p_(i+1), last to first) is simple: no two
 /// non-adjacent edges meet, adjacent edges meet only at their shared vertex, no zero-length
 /// edge. Exact for the given coordinates.
+///
+/// (P-Hex paper, section 4.2: validity of a face or Dupin hexagon.)
 pub fn is_simple_polygon(pts: &[Vec2]) -> Result<bool, PolygonError> {
     let n = pts.len();
     if n < 3 {
@@ -85,6 +91,8 @@ pub fn is_simple_polygon(pts: &[Vec2]) -> Result<bool, PolygonError> {
 
 /// Whether `p` lies strictly inside triangle abc (exact; false on the boundary or for a
 /// degenerate triangle).
+///
+/// (P-Hex paper, Proposition 4, condition 2.)
 pub fn strictly_inside_triangle(p: &Vec2, a: &Vec2, b: &Vec2, c: &Vec2) -> bool {
     let s = orient(a, b, c);
     if s == 0.0 {

@@ -7,6 +7,8 @@ use nalgebra::Matrix3;
 use thiserror::Error;
 
 /// Why three planes have no (reliable) meeting point.
+///
+/// (P-Hex paper, section 4.1.)
 #[derive(Debug, Clone, Copy, PartialEq, Error)]
 pub enum TangentDualityError {
     /// A point or normal is NaN or infinite.
@@ -25,6 +27,8 @@ pub enum TangentDualityError {
 }
 
 /// Meeting point of three planes and how well determined it is.
+///
+/// (P-Hex paper, section 4.1.)
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TangentDualPoint {
     /// The common point.

@@ -16,6 +16,8 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use thiserror::Error;
 
 /// Why a triangle star cannot be built or judged.
+///
+/// (P-Hex paper, sections 4.1 and 4.2.)
 #[derive(Debug, Clone, Copy, PartialEq, Error)]
 pub enum TriangleStarError {
     /// A vertex is NaN or infinite.

@@ -6,6 +6,8 @@ use crate::math::Vec3;
 use thiserror::Error;
 
 /// Why a control net was rejected.
+///
+/// (P-Hex paper, section 7, Fig. 22.)
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum BSplinePatchError {
     /// A bicubic patch needs at least 4 x 4 control points.
@@ -48,6 +50,8 @@ pub enum BSplinePatchError {
 
 /// Uniform bicubic B-spline patch. Control point (i, j), i < nu, j < nv, is stored at
 /// `i * nv + j`; the domain is u in [0, nu - 3], v in [0, nv - 3] (one unit per knot span).
+///
+/// (P-Hex paper, section 7, Fig. 22.)
 #[derive(Debug, Clone, PartialEq)]
 pub struct BSplinePatch {
     nu: usize,

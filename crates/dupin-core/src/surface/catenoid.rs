@@ -7,6 +7,8 @@ use std::f64::consts::TAU;
 
 /// Catenoid (c cosh(v/c) cos u, c cosh(v/c) sin u, v), u in [0, 2 pi) periodic,
 /// v in [-height/2, height/2]. Principal curvatures +-1 / (c cosh^2(v/c)).
+///
+/// (P-Hex paper, section 7, Fig. 21.)
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Catenoid {
     c: f64,

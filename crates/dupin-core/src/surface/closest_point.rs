@@ -9,6 +9,8 @@ use crate::math::{Vec2, Vec3};
 use thiserror::Error;
 
 /// Result of a closest-point query.
+///
+/// (P-Hex paper, section 6, distance term F_d.)
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ClosestPoint {
     /// Parameters of the foot point (normalised into the domain).
@@ -20,6 +22,8 @@ pub struct ClosestPoint {
 }
 
 /// Why a closest point could not be found.
+///
+/// (P-Hex paper, section 6.)
 #[derive(Debug, Clone, Copy, PartialEq, Error)]
 pub enum ClosestPointError {
     /// The query point or the start parameters contain NaN or infinity.
@@ -40,6 +44,8 @@ const MAX_ITER: usize = 60;
 /// at domain borders; every step decreases f. The result is a local minimum of the distance over
 /// the domain: on the interior, P - p is normal to the surface. Global optimality is only
 /// guaranteed when the start (or grid) lies in the right basin.
+///
+/// (P-Hex paper, section 6, distance term F_d.)
 pub fn closest_point<S: Surface + ?Sized>(
     s: &S,
     p: &Vec3,

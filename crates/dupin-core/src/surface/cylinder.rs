@@ -7,6 +7,8 @@ use std::f64::consts::TAU;
 
 /// Cylinder (r cos u, r sin u, v), u in [0, 2 pi) periodic, v in [0, height].
 /// k1 = 0 (along the rulings), k2 = -1/r (outward normal): every point is parabolic.
+///
+/// (P-Hex paper, section 3, last paragraph.)
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Cylinder {
     radius: f64,

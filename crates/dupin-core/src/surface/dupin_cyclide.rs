@@ -20,6 +20,8 @@ use std::f64::consts::TAU;
 /// signed radius: spheres centred on the focal ellipse (a cos u, b sin u, 0) with radius
 /// mu - c cos u, and on the focal hyperbola (c / cos v, 0, -b tan v) with radius
 /// (a - mu cos v) / cos v.
+///
+/// (P-Hex paper, Figs. 1 and 15.)
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DupinCyclide {
     a: f64,

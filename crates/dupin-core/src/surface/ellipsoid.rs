@@ -7,6 +7,8 @@ use std::f64::consts::{FRAC_PI_2, TAU};
 
 /// Ellipsoid (a cos v cos u, b cos v sin u, c sin v), u in [0, 2 pi) periodic, v in
 /// [-pi/2, pi/2] (poles singular). Outward normal, so both principal curvatures are negative.
+///
+/// (P-Hex paper, section 4.2, K > 0.)
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Ellipsoid {
     a: f64,

@@ -7,6 +7,8 @@ use crate::surface::RegistryError;
 /// Enneper surface s (u - u^3/3 + u v^2, v - v^3/3 + v u^2, u^2 - v^2) over
 /// [-extent, extent]^2. Principal curvatures +-2 / (s (1 + u^2 + v^2)^2).
 /// The surface is embedded for u^2 + v^2 < 3, so `extent` is limited to 1.2.
+///
+/// (P-Hex paper, section 7, Fig. 21.)
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Enneper {
     scale: f64,

@@ -7,6 +7,8 @@ use crate::surface::RegistryError;
 
 /// Graph P(u, v) = (u, v, u^2 / (2a) - v^2 / (2b)) over [-size, size]^2. `a` and `b` are the
 /// radii of curvature at the apex (k1 = 1/a, k2 = -1/b there, normal pointing up).
+///
+/// (P-Hex paper, section 4.2, Proposition 5.)
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HyperbolicParaboloid {
     a: f64,

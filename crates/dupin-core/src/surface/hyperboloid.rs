@@ -7,6 +7,8 @@ use std::f64::consts::TAU;
 
 /// Hyperboloid (a cosh v cos u, a cosh v sin u, c sinh v), u in [0, 2 pi) periodic,
 /// v in [-v_max, v_max]. `a` is the waist radius, `c` the vertical scale; K < 0 everywhere.
+///
+/// (P-Hex paper, section 4.2, Fig. 11.)
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Hyperboloid {
     a: f64,

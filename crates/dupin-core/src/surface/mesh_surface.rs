@@ -17,6 +17,8 @@ use rstar::{AABB, PointDistance, RTree, RTreeObject};
 use thiserror::Error;
 
 /// Why a mesh surface could not be built or queried.
+///
+/// (P-Hex paper, section 6.)
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum MeshSurfaceError {
     /// The OBJ text could not be read.
@@ -44,9 +46,13 @@ pub enum MeshSurfaceError {
 
 /// Curvature estimated at one mesh vertex (same conventions as [`Curvature`]; the normal points
 /// to the side from which faces are counter-clockwise).
+///
+/// (P-Hex paper, sections 3 and 6.)
 pub type VertexCurvature = Curvature;
 
 /// Closest point on a mesh surface.
+///
+/// (P-Hex paper, section 6.)
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MeshClosestPoint {
     /// The closest point.

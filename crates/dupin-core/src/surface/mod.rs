@@ -39,6 +39,8 @@ use crate::curvature::{Curvature, CurvatureError};
 use crate::math::{Vec2, Vec3};
 
 /// The parameter rectangle of a surface and which directions wrap around.
+///
+/// (P-Hex paper, section 3.)
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Domain {
     /// Range of u.
@@ -80,6 +82,8 @@ impl Domain {
 }
 
 /// Position and first and second partial derivatives of P at one parameter point.
+///
+/// (P-Hex paper, section 3.)
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SurfaceDerivatives {
     /// P(u, v).

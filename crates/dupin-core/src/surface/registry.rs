@@ -8,6 +8,8 @@ use super::{
 use thiserror::Error;
 
 /// Why a surface could not be built from a name and parameters.
+///
+/// (P-Hex paper, sections 3 and 7.)
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum RegistryError {
     /// No surface has this name.
@@ -52,6 +54,8 @@ pub enum RegistryError {
 }
 
 /// One parameter of a library surface.
+///
+/// (P-Hex paper, sections 3 and 7.)
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ParamSpec {
     /// The key used in `KEY=VALUE`.
@@ -69,6 +73,8 @@ pub struct ParamSpec {
 }
 
 /// A library surface: name, parametrisation and parameters (see [`surface_catalog`]).
+///
+/// (P-Hex paper, sections 3 and 7.)
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SurfaceSpec {
     /// The name used by `--surface NAME`.
@@ -223,6 +229,8 @@ static CATALOG: &[SurfaceSpec] = &[
 
 /// The surface library: every name with its parametrisation and parameters (what
 /// `dupin surface-info --list` prints).
+///
+/// (P-Hex paper, sections 3 and 7.)
 pub fn surface_catalog() -> &'static [SurfaceSpec] {
     CATALOG
 }
@@ -233,6 +241,8 @@ pub fn surface_catalog() -> &'static [SurfaceSpec] {
 /// Errors: unknown name or key, value out of its documented range, non-integer where an integer
 /// is required, or a violated relation between parameters (torus r < R, cyclide c < mu < a,
 /// vase amplitude < radius).
+///
+/// (P-Hex paper, sections 3 and 7.)
 pub fn surface_by_name(
     name: &str,
     params: &[(&str, f64)],
@@ -316,6 +326,8 @@ pub fn surface_by_name(
 }
 
 /// Parses one `KEY=VALUE` assignment (as given to `--set`).
+///
+/// (P-Hex paper, sections 3 and 7.)
 pub fn parse_assignment(s: &str) -> Result<(String, f64), RegistryError> {
     let (k, v) = s
         .split_once('=')

@@ -7,6 +7,8 @@ use std::f64::consts::{FRAC_PI_2, TAU};
 ///
 /// Umbilic everywhere: k1 = k2 = -1/r for the outward normal Pu x Pv. The poles v = +-pi/2 are
 /// singular points of the parametrisation.
+///
+/// (P-Hex paper, section 7, Fig. 20.)
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sphere {
     /// Radius r > 0.

@@ -8,6 +8,8 @@ use std::f64::consts::TAU;
 ///
 /// `major` is R (distance from the axis to the tube centre), `minor` is r (tube radius).
 /// K > 0 on the outer half (cos v > 0), K < 0 on the inner half, parabolic circles at v = +-pi/2.
+///
+/// (P-Hex paper, section 5.3, Figs. 3, 17 right and 19.)
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Torus {
     /// R, the distance from the axis to the centre of the tube.
