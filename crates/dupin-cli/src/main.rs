@@ -6,6 +6,7 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 mod common;
+mod surface_info;
 
 /// Planar-panel geometry for architecture.
 #[derive(Parser)]
@@ -16,10 +17,15 @@ struct Cli {
 }
 
 #[derive(Subcommand)]
-enum Command {}
+enum Command {
+    /// Position, normal and curvature of a library surface at (U, V), as JSON.
+    SurfaceInfo(surface_info::SurfaceInfoArgs),
+}
 
 fn run(cli: Cli) -> Result<(), common::CliError> {
-    match cli.command {}
+    match cli.command {
+        Command::SurfaceInfo(args) => surface_info::run(args),
+    }
 }
 
 fn main() -> ExitCode {

@@ -6,17 +6,53 @@
 //!
 //! The modules are private; this page lists the public API (spade's style: a small, flat
 //! surface chosen by `pub use`). See `ARCHITECTURE.md` for layering rules.
+//!
+//! ## Surfaces, curvature and Dupin duality (P-Hex paper, sections 3 to 5.1)
+//! - [`Surface`] and the library ([`surface_by_name`], [`surface_catalog`]), [`MeshSurface`];
+//! - [`Curvature`], [`PointType`], [`CurvatureTolerance`] (section 3);
+//! - [`DupinIndicatrix`], [`DupinConic`], conjugate and asymptotic directions (sections 3, 4.2);
+//! - [`dupin_center`], [`tangent_dual_point`], [`TriangleStar`] (section 4, Propositions 3-5);
+//! - [`ideal_triangle`] (section 5.1); [`is_simple_polygon`] (exact predicates).
 
+// `!(x > t)` is used on purpose throughout: unlike `x <= t` it also rejects NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+mod curvature;
+mod dupin_center;
+mod dupin_indicatrix;
+mod ideal_triangle;
 mod math;
 mod mesh;
 mod obj;
 mod planarity;
+mod polygon;
 mod render_buffers;
 mod surface;
+mod tangent_duality;
+mod triangle_star;
 
+pub use curvature::{Curvature, CurvatureError, CurvatureTolerance, PointType, TangentFrame};
+pub use dupin_center::{
+    DupinCenterError, DupinCenterMethod, approximate_dupin_center, dupin_center, dupin_center_3d,
+    dupin_conic_through,
+};
+pub use dupin_indicatrix::{DupinConic, DupinIndicatrix, IndicatrixError};
+pub use ideal_triangle::{
+    IdealTriangle, IdealTriangleError, ideal_apex_3d, ideal_triangle,
+    is_affine_quasi_regular_hexagon, is_affine_regular_hexagon,
+};
 pub use math::{Vec2, Vec3};
 pub use mesh::{MeshError, PolyMesh};
 pub use obj::{ObjError, parse_obj, write_obj};
 pub use planarity::{face_planarity, max_planarity};
+pub use polygon::{PolygonError, is_simple_polygon, segments_intersect, strictly_inside_triangle};
 pub use render_buffers::{TriangleBuffers, sample_surface};
-pub use surface::{Domain, Surface, SurfaceDerivatives, Torus};
+pub use surface::{
+    BSplinePatch, BSplinePatchError, Catenoid, ClosestPoint, ClosestPointError, Cylinder, Domain,
+    DupinCyclide, Ellipsoid, Enneper, FundamentalForms, HyperbolicParaboloid, Hyperboloid,
+    MeshClosestPoint, MeshSurface, MeshSurfaceError, ParamSpec, RegistryError, Sphere, Surface,
+    SurfaceDerivatives, SurfaceSpec, Torus, Vase, VertexCurvature, parse_assignment,
+    surface_by_name, surface_catalog,
+};
+pub use tangent_duality::{TangentDualPoint, TangentDualityError, tangent_dual_point};
+pub use triangle_star::{DupinHexagon, TriangleStar, TriangleStarError};
