@@ -1,0 +1,12 @@
+import { chromium } from 'playwright-core';
+const BASE = process.env.BASE ?? '--headless=new --no-sandbox --enable-unsafe-webgpu --use-webgpu-adapter=swiftshader --enable-features=Vulkan --disable-background-networking --disable-component-update --disable-sync --no-first-run';
+const FLAGS = (BASE + ' ' + (process.env.EXTRA||'')).trim().split(/\s+/);
+const env = {...process.env}; 
+const b = await chromium.launch({ executablePath: '/usr/bin/chromium', headless: true, args: FLAGS, env, ignoreDefaultArgs: process.env.NODEF ? true : undefined });
+const p = await b.newPage();
+p.on('console', m => console.log('CONSOLE', m.text()));
+await p.goto('http://127.0.0.1:8765/gpu2.html'); await p.waitForTimeout(3000);
+const buf = await p.screenshot();
+const px = await p.evaluate(async (s) => { const img = await createImageBitmap(await (await fetch('data:image/png;base64,'+s)).blob()); const c = new OffscreenCanvas(img.width, img.height); const g = c.getContext('2d'); g.drawImage(img,0,0); return Array.from(g.getImageData(50,50,1,1).data); }, buf.toString('base64'));
+console.log('PIXEL', JSON.stringify(process.env.EXTRA), px, await p.evaluate(() => window.mapok), JSON.stringify(await p.evaluate(() => window.info)));
+await b.close();
