@@ -10,10 +10,13 @@ export const URL_BASE = process.env.DUPIN_URL ?? 'http://127.0.0.1:8080/';
 export const SHOTS = join(dirname(fileURLToPath(import.meta.url)), '../../target/e2e');
 mkdirSync(SHOTS, { recursive: true });
 
+// DEVELOPERS.md's flags plus `--use-angle=swiftshader --use-vulkan=swiftshader`: without them
+// headless Chromium composites in software, cannot allocate the WebGPU swap-chain image, and
+// loses the whole WebGPU device on the first canvas frame (blank canvas, failing mapAsync).
 const FLAGS = [
   '--headless=new', '--no-sandbox', '--enable-unsafe-webgpu', '--use-webgpu-adapter=swiftshader',
-  '--enable-features=Vulkan', '--disable-background-networking', '--disable-component-update',
-  '--disable-sync', '--no-first-run',
+  '--enable-features=Vulkan', '--use-angle=swiftshader', '--use-vulkan=swiftshader',
+  '--disable-background-networking', '--disable-component-update', '--disable-sync', '--no-first-run',
 ];
 
 /** Opens the page; with `webgpu: false` the browser offers no `navigator.gpu` at all. */

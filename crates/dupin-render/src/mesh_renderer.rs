@@ -196,7 +196,7 @@ impl MeshRenderer {
                 "positions and normals need 3 floats per vertex".into(),
             ));
         }
-        if mesh.indices.len() % 3 != 0 || mesh.indices.iter().any(|&i| i as usize >= n) {
+        if !mesh.indices.len().is_multiple_of(3) || mesh.indices.iter().any(|&i| i as usize >= n) {
             return Err(RenderError::InvalidBuffers(
                 "indices must come in triples and name existing vertices".into(),
             ));

@@ -1,3 +1,4 @@
+#![cfg(not(target_arch = "wasm32"))]
 //! Native offscreen render test: the torus of the web slice, drawn through `dupin-render` on
 //! whatever Vulkan/GL adapter exists (lavapipe in CI), compared with a stored reference image.
 //!
