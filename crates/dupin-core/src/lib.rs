@@ -7,6 +7,7 @@
 //! The modules are private; this page lists the public API (spade's style: a small, flat
 //! surface chosen by `pub use`). See `ARCHITECTURE.md` for layering rules.
 
+mod hex_delaunay;
 mod math;
 mod mesh;
 mod obj;
@@ -14,6 +15,11 @@ mod planarity;
 mod render_buffers;
 mod surface;
 
+pub use hex_delaunay::{
+    Circle, HexCell, HexDelaunayError, HexDelaunayMode, HexDelaunayStepper, HexTriangulation,
+    MAX_COORDINATE, MAX_LEVEL, MIN_EXTENT, TriangulationQuality, hex_delaunay,
+    min_enclosing_circle, triangulation_quality,
+};
 pub use math::{Vec2, Vec3};
 pub use mesh::{MeshError, PolyMesh};
 pub use obj::{ObjError, parse_obj, write_obj};

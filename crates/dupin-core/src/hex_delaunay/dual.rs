@@ -1,0 +1,99 @@
+//! Dual mesh extraction (section 4.2).
+//!
+//! Every full hexagon's centre is joined to its full neighbours' centres, and across a
+//! semi-hexagon to the centre of the semi-hexagon's opposite full hexagon; occupied centres are
+//! then moved to their input point. On the lattice this dual is a recursive refinement of Ω's six
+//! level-1 equilateral triangles: a level-`k` lattice triangle whose three corner hexagons are
+//! split becomes its four level-`k+1` children; with exactly two split corners `a`, `b` it
+//! becomes two 30-60-90 triangles meeting at the joined hexagon `a+b` (the paper's "half angle
+//! at the centre of the un-subdivided hexagon"); otherwise it is a leaf. The balancing rule
+//! guarantees nothing finer hides inside a leaf. Cost: O(1) expected per output triangle.
+
+use super::hierarchy::Hierarchy;
+use super::lattice::{Axial, DIRS, add, normalize};
+use crate::math::Vec2;
+use rustc_hash::FxHashMap;
+
+type Key = (u32, Axial);
+
+/// Triangles with vertices named by normalised lattice keys, before positions are assigned.
+pub struct DualBuilder<'h> {
+    h: &'h Hierarchy,
+    /// Vertex index of each lattice key.
+    pub index: FxHashMap<Key, u32>,
+    /// Lattice key of each vertex.
+    pub keys: Vec<Key>,
+    /// Triangles, counter-clockwise.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl<'h> DualBuilder<'h> {
+    /// Extracts the dual triangulation of the hierarchy's current hexagon mesh.
+    pub fn build(h: &'h Hierarchy) -> Self {
+        let mut b = DualBuilder {
+            h,
+            index: FxHashMap::default(),
+            keys: Vec::new(),
+            triangles: Vec::new(),
+        };
+        for i in 0..6 {
+            b.emit(1, (0, 0), DIRS[i], DIRS[(i + 1) % 6]);
+        }
+        b
+    }
+
+    fn vertex(&mut self, level: u32, v: Axial) -> u32 {
+        let key = normalize(level, v);
+        let n = self.keys.len() as u32;
+        *self.index.entry(key).or_insert_with(|| {
+            self.keys.push(key);
+            n
+        })
+    }
+
+    fn emit(&mut self, k: u32, a: Axial, b: Axial, c: Axial) {
+        let (sa, sb, sc) = (
+            self.h.is_split(k, a),
+            self.h.is_split(k, b),
+            self.h.is_split(k, c),
+        );
+        match (sa, sb, sc) {
+            (true, true, true) => {
+                let (ab, bc, ca) = (add(a, b), add(b, c), add(c, a));
+                let (a2, b2, c2) = ((2 * a.0, 2 * a.1), (2 * b.0, 2 * b.1), (2 * c.0, 2 * c.1));
+                self.emit(k + 1, a2, ab, ca);
+                self.emit(k + 1, ab, b2, bc);
+                self.emit(k + 1, ca, bc, c2);
+                self.emit(k + 1, ab, bc, ca);
+            }
+            (true, true, false) => self.bisect(k, a, b, c),
+            (false, true, true) => self.bisect(k, b, c, a),
+            (true, false, true) => self.bisect(k, c, a, b),
+            _ => {
+                let t = [self.vertex(k, a), self.vertex(k, b), self.vertex(k, c)];
+                self.triangles.push(t);
+            }
+        }
+    }
+
+    /// `a`, `b` split, `c` not (counter-clockwise a, b, c): two right triangles at `a + b`.
+    fn bisect(&mut self, k: u32, a: Axial, b: Axial, c: Axial) {
+        let m = self.vertex(k + 1, add(a, b));
+        let (va, vb, vc) = (self.vertex(k, a), self.vertex(k, b), self.vertex(k, c));
+        self.triangles.push([va, m, vc]);
+        self.triangles.push([m, vb, vc]);
+    }
+
+    /// Vertex positions: lattice positions, with `moved` overriding some keys.
+    pub fn positions(&self, moved: &FxHashMap<Key, Vec2>) -> Vec<Vec2> {
+        self.keys
+            .iter()
+            .map(|&(l, v)| {
+                moved
+                    .get(&(l, v))
+                    .copied()
+                    .unwrap_or_else(|| self.h.frame.position(l, v))
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,170 @@
+//! Simple refinement (section 4.1): rules 1 to 5 driven by a work queue of affected points.
+//!
+//! Each point knows its leaf cell; a hash map lists the points of every occupied cell. A point
+//! is (re)checked when it moved to a new cell or when a hexagon next to its cell was split; a
+//! check applies the first rule that fires:
+//!
+//! 1. its cell holds several points → split the cell;
+//! 2. its cell is a semi-hexagon → split the full hexagon on the semi-hexagon's long edge;
+//! 3. a neighbouring full hexagon is occupied → split the cell;
+//! 4. a neighbour is of lower level (a semi-hexagon covers the neighbour position) → split the
+//!    full hexagon on that semi-hexagon's long edge;
+//! 5. a neighbour is of higher level (split) → split the cell.
+//!
+//! Added for the bounded domain: a point in a boundary (virtual) hexagon splits it, since a
+//! boundary centre must stay on Ω's boundary for the triangles to tile Ω. The balancing rule
+//! runs inside every split. The queue empties when every occupied cell is a full hexagon holding
+//! one point inside a ring of six unsplit, unoccupied full hexagons of its level — the paper's
+//! final state. Each split costs O(1) expected hash operations plus the re-location of the
+//! points it displaces (O(depth) each), so the whole refinement is O(T + n·depth²) for T output
+//! triangles, n points.
+
+use super::error::HexDelaunayError;
+use super::hierarchy::{Cell, Hierarchy};
+use super::lattice::{Axial, DIRS, add};
+use crate::math::Vec2;
+use rustc_hash::FxHashMap;
+use std::collections::VecDeque;
+
+/// The refinement state: hierarchy, point cells and the work queue.
+#[derive(Debug, Clone)]
+pub struct Refinement {
+    /// The hexagon hierarchy.
+    pub hierarchy: Hierarchy,
+    /// Distinct input points.
+    pub points: Vec<Vec2>,
+    /// Leaf cell of every point.
+    pub cell_of: Vec<Cell>,
+    occupants: FxHashMap<Cell, Vec<u32>>,
+    queue: VecDeque<u32>,
+    queued: Vec<bool>,
+    scratch: Vec<(u32, Axial)>,
+}
+
+enum Action {
+    Split(u32, Axial),
+    Present(u32, Axial),
+}
+
+impl Refinement {
+    /// Locates every point in the (root-split) hierarchy and queues them all.
+    pub fn new(hierarchy: Hierarchy, points: Vec<Vec2>) -> Self {
+        let mut occupants: FxHashMap<Cell, Vec<u32>> = FxHashMap::default();
+        let cell_of: Vec<Cell> = points.iter().map(|p| hierarchy.locate(*p)).collect();
+        for (i, c) in cell_of.iter().enumerate() {
+            occupants.entry(*c).or_default().push(i as u32);
+        }
+        let n = points.len();
+        Refinement {
+            hierarchy,
+            points,
+            cell_of,
+            occupants,
+            queue: (0..n as u32).collect(),
+            queued: vec![true; n],
+            scratch: Vec::new(),
+        }
+    }
+
+    /// Whether the work queue is empty (refinement finished).
+    pub fn is_done(&self) -> bool {
+        self.queue.is_empty()
+    }
+
+    fn push(&mut self, i: u32) {
+        if !self.queued[i as usize] {
+            self.queued[i as usize] = true;
+            self.queue.push_back(i);
+        }
+    }
+
+    fn occupied(&self, c: &Cell) -> usize {
+        self.occupants.get(c).map_or(0, Vec::len)
+    }
+
+    fn check(&self, i: u32) -> Option<Action> {
+        let h = &self.hierarchy;
+        match self.cell_of[i as usize] {
+            Cell::Semi(k, m) => Some(Action::Present(k, m)),
+            Cell::Full(k, x) => {
+                if self.occupied(&Cell::Full(k, x)) >= 2 || h.on_boundary(k, x) {
+                    return Some(Action::Split(k, x));
+                }
+                for d in DIRS {
+                    let y = add(x, d);
+                    if !h.is_present(k, y) {
+                        return Some(Action::Present(k, y));
+                    }
+                }
+                for d in DIRS {
+                    let y = add(x, d);
+                    if h.is_split(k, y) || self.occupied(&Cell::Full(k, y)) > 0 {
+                        return Some(Action::Split(k, x));
+                    }
+                }
+                None
+            }
+        }
+    }
+
+    /// Processes the queue until at least one hexagon is split (one observable subdivision step,
+    /// including the balancing splits it forces) or the queue is empty. Returns the splits made,
+    /// in order; empty means refinement is finished.
+    pub fn step(&mut self) -> Result<Vec<(u32, Axial)>, HexDelaunayError> {
+        while let Some(i) = self.queue.pop_front() {
+            self.queued[i as usize] = false;
+            let Some(action) = self.check(i) else {
+                continue;
+            };
+            let mut out = std::mem::take(&mut self.scratch);
+            out.clear();
+            match action {
+                Action::Split(k, x) => self.hierarchy.ensure_split(k, x, &mut out)?,
+                Action::Present(k, y) => self.hierarchy.ensure_present(k, y, &mut out)?,
+            }
+            for &(k, x) in &out {
+                self.after_split(k, x);
+            }
+            self.push(i);
+            let made = out.clone();
+            self.scratch = out;
+            if !made.is_empty() {
+                return Ok(made);
+            }
+        }
+        Ok(Vec::new())
+    }
+
+    /// Runs the refinement to the end.
+    pub fn run(&mut self) -> Result<(), HexDelaunayError> {
+        while !self.step()?.is_empty() {}
+        Ok(())
+    }
+
+    /// Re-locates the points displaced by splitting `x` at level `k` and queues the points whose
+    /// rules may now fire.
+    fn after_split(&mut self, k: u32, x: Axial) {
+        let mut moved = self.occupants.remove(&Cell::Full(k, x)).unwrap_or_default();
+        for d in DIRS {
+            // Semi-hexagons of split neighbours towards x are now joined into full hexagons.
+            if let Some(v) = self.occupants.remove(&Cell::Semi(k + 1, add(x, add(x, d)))) {
+                moved.extend(v);
+            }
+        }
+        for i in moved {
+            let c = self.hierarchy.locate(self.points[i as usize]);
+            self.cell_of[i as usize] = c;
+            self.occupants.entry(c).or_default().push(i);
+            self.push(i);
+        }
+        for d in DIRS {
+            let y = add(x, d);
+            if let Some(v) = self.occupants.get(&Cell::Full(k, y)) {
+                let v = v.clone();
+                for i in v {
+                    self.push(i);
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,311 @@
+//! The stepper: the refinement one observable subdivision step at a time, for the page's 2D
+//! view, plus the input checks and bounding-hexagon set-up shared with the one-shot function.
+
+use super::dual::DualBuilder;
+use super::error::HexDelaunayError;
+use super::hierarchy::{Cell, Hierarchy};
+use super::lattice::{Axial, DIRS, Frame, add, normalize, parents_of_midpoint};
+use super::min_enclosing_circle::min_enclosing_circle;
+use super::simple_refinement::Refinement;
+use super::{HexDelaunayMode, HexTriangulation, MAX_COORDINATE, MAX_LEVEL, MIN_EXTENT};
+use crate::math::Vec2;
+use robust::{Coord, orient2d};
+use rustc_hash::FxHashMap;
+
+/// A leaf cell of the current hexagon mesh, for drawing.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HexCell {
+    /// Corners, counter-clockwise (6 for a full hexagon, 4 for a semi-hexagon).
+    pub corners: Vec<Vec2>,
+    /// The paper's level: even for full hexagons, odd for semi-hexagons.
+    pub paper_level: u32,
+    /// Whether an input point lies in the cell.
+    pub occupied: bool,
+}
+
+/// Hexagonal Delaunay triangulation run step by step: each [`step`](Self::step) performs one
+/// refinement-rule subdivision (with the balancing splits it forces).
+#[derive(Debug, Clone)]
+pub struct HexDelaunayStepper {
+    refinement: Refinement,
+    input_map: Vec<u32>,
+    last: Vec<(u32, Axial)>,
+    steps: usize,
+}
+
+impl HexDelaunayStepper {
+    /// Checks the input, builds the bounding hexagon and locates the points.
+    pub fn new(
+        points: &[Vec2],
+        segments: &[[usize; 2]],
+        mode: HexDelaunayMode,
+    ) -> Result<Self, HexDelaunayError> {
+        let (unique, input_map) = check_points(points)?;
+        check_segments(points, segments)?;
+        if !segments.is_empty() {
+            return Err(HexDelaunayError::Unsupported(
+                "PSLG segments (section 7); triangulate the points alone",
+            ));
+        }
+        if mode == HexDelaunayMode::Extended {
+            return Err(HexDelaunayError::Unsupported(
+                "extended refinement (section 5, 43.9..90 degrees); use the simple mode",
+            ));
+        }
+        let circle = min_enclosing_circle(&unique).ok_or(HexDelaunayError::Empty)?;
+        let rho = if circle.radius > 0.0 {
+            if circle.radius < MIN_EXTENT {
+                return Err(HexDelaunayError::TooSmall {
+                    extent: circle.radius,
+                    limit: MIN_EXTENT,
+                });
+            }
+            circle.radius
+        } else {
+            circle.center.x.abs().max(circle.center.y.abs()).max(1.0)
+        };
+        // Ω has inradius 1.5 rho = 3R/4.
+        let root_radius = 2.0 * rho;
+        let frame = Frame {
+            origin: circle.center,
+            root_radius,
+        };
+        // Cells finer than 2^-42 of the coordinates' magnitude lose their shape in f64.
+        let scale = circle.center.x.abs().max(circle.center.y.abs()) + root_radius;
+        let by_precision = 42.0 - (scale / root_radius).log2();
+        let max_level = (by_precision.floor().max(0.0) as u32).min(MAX_LEVEL);
+        let hierarchy = Hierarchy::new(frame, max_level);
+        Ok(HexDelaunayStepper {
+            refinement: Refinement::new(hierarchy, unique),
+            input_map,
+            last: Vec::new(),
+            steps: 0,
+        })
+    }
+
+    /// One subdivision step. Returns `Ok(false)` once refinement is finished.
+    pub fn step(&mut self) -> Result<bool, HexDelaunayError> {
+        self.last = self.refinement.step()?;
+        if self.last.is_empty() {
+            Ok(false)
+        } else {
+            self.steps += 1;
+            Ok(true)
+        }
+    }
+
+    /// Runs all remaining steps.
+    pub fn run(&mut self) -> Result<(), HexDelaunayError> {
+        self.refinement.run()
+    }
+
+    /// Whether refinement is finished.
+    pub fn is_done(&self) -> bool {
+        self.refinement.is_done()
+    }
+
+    /// Number of steps taken through [`step`](Self::step).
+    pub fn steps(&self) -> usize {
+        self.steps
+    }
+
+    /// Number of split hexagons so far (root included).
+    pub fn split_count(&self) -> usize {
+        self.refinement.hierarchy.split_count
+    }
+
+    /// The hexagons split by the last step (centre and circumradius), balancing splits first.
+    pub fn last_splits(&self) -> Vec<(Vec2, f64)> {
+        let f = &self.refinement.hierarchy.frame;
+        self.last
+            .iter()
+            .map(|&(k, v)| (f.position(k, v), f.radius(k)))
+            .collect()
+    }
+
+    /// Corners of the bounding hexagon Ω, counter-clockwise.
+    pub fn domain(&self) -> [Vec2; 6] {
+        self.refinement.hierarchy.frame.domain_corners()
+    }
+
+    /// The current leaf cells (full and semi-hexagons) clipped to nothing: boundary cells are
+    /// drawn whole, as the paper's virtual full hexagons.
+    pub fn cells(&self) -> Vec<HexCell> {
+        let h = &self.refinement.hierarchy;
+        let f = &h.frame;
+        let occupied: rustc_hash::FxHashSet<Cell> =
+            self.refinement.cell_of.iter().copied().collect();
+        let mut out = Vec::new();
+        for k in 0..h.depth() {
+            for &x in h.split_at(k) {
+                let c = (2 * x.0, 2 * x.1);
+                if !h.is_split(k + 1, c) {
+                    out.push(HexCell {
+                        corners: f.hexagon(k + 1, c).to_vec(),
+                        paper_level: 2 * (k + 1),
+                        occupied: occupied.contains(&Cell::Full(k + 1, c)),
+                    });
+                }
+                for d in DIRS {
+                    let m = add(c, d);
+                    if !super::lattice::in_domain(k + 1, m) {
+                        continue;
+                    }
+                    if h.is_present(k + 1, m) {
+                        let (a, _) = parents_of_midpoint(m);
+                        let first = a == x || !super::lattice::in_domain(k, a);
+                        if first && !h.is_split(k + 1, m) {
+                            out.push(HexCell {
+                                corners: f.hexagon(k + 1, m).to_vec(),
+                                paper_level: 2 * (k + 1),
+                                occupied: occupied.contains(&Cell::Full(k + 1, m)),
+                            });
+                        }
+                    } else {
+                        let cm = f.position(k + 1, m);
+                        let toward = f.position(k, x) - cm;
+                        let corners = f
+                            .hexagon(k + 1, m)
+                            .into_iter()
+                            .filter(|p| (p - cm).dot(&toward) >= -1e-9 * toward.norm_squared())
+                            .collect();
+                        out.push(HexCell {
+                            corners,
+                            paper_level: 2 * k + 1,
+                            occupied: occupied.contains(&Cell::Semi(k + 1, m)),
+                        });
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// The dual triangulation of the current hexagon mesh, occupied centres moved to their
+    /// points. Input points are exact vertices only once refinement is finished.
+    pub fn triangulation(&self) -> HexTriangulation {
+        let h = &self.refinement.hierarchy;
+        let dual = DualBuilder::build(h);
+        let mut moved: FxHashMap<(u32, Axial), Vec2> = FxHashMap::default();
+        let mut point_key = Vec::with_capacity(self.refinement.points.len());
+        for (i, c) in self.refinement.cell_of.iter().enumerate() {
+            let key = match *c {
+                Cell::Full(k, x) => Some(normalize(k, x)),
+                Cell::Semi(..) => None,
+            };
+            if let Some(key) = key {
+                moved.insert(key, self.refinement.points[i]);
+            }
+            point_key.push(key);
+        }
+        let vertices = dual.positions(&moved);
+        let unique_vertex: Vec<u32> = point_key
+            .iter()
+            .map(|k| k.and_then(|k| dual.index.get(&k).copied()).unwrap_or(u32::MAX))
+            .collect();
+        HexTriangulation {
+            vertices,
+            triangles: dual.triangles.clone(),
+            input_vertex: self
+                .input_map
+                .iter()
+                .map(|&u| unique_vertex[u as usize])
+                .collect(),
+            domain: h.frame.domain_corners(),
+            depth: h.depth(),
+        }
+    }
+}
+
+/// Checks coordinates and removes exact duplicates. Returns the distinct points and, for each
+/// input point, the index of its distinct point.
+fn check_points(points: &[Vec2]) -> Result<(Vec<Vec2>, Vec<u32>), HexDelaunayError> {
+    if points.is_empty() {
+        return Err(HexDelaunayError::Empty);
+    }
+    for (index, p) in points.iter().enumerate() {
+        if !p.x.is_finite() || !p.y.is_finite() {
+            return Err(HexDelaunayError::NonFinite { index });
+        }
+        let m = p.x.abs().max(p.y.abs());
+        if m > MAX_COORDINATE {
+            return Err(HexDelaunayError::TooLarge {
+                index,
+                value: m,
+                limit: MAX_COORDINATE,
+            });
+        }
+    }
+    let mut order: Vec<u32> = (0..points.len() as u32).collect();
+    let key = |i: u32| {
+        let p = points[i as usize];
+        // +0.0 and -0.0 are the same point.
+        ((p.x + 0.0).to_bits(), (p.y + 0.0).to_bits())
+    };
+    order.sort_unstable_by_key(|&i| key(i));
+    let mut map = vec![0u32; points.len()];
+    let mut unique = Vec::new();
+    let mut prev = None;
+    for i in order {
+        let k = key(i);
+        if prev != Some(k) {
+            unique.push(points[i as usize] + Vec2::new(0.0, 0.0));
+            prev = Some(k);
+        }
+        map[i as usize] = unique.len() as u32 - 1;
+    }
+    Ok((unique, map))
+}
+
+/// Checks segment indices, lengths and crossings (exact orientation predicates).
+fn check_segments(points: &[Vec2], segments: &[[usize; 2]]) -> Result<(), HexDelaunayError> {
+    for (segment, s) in segments.iter().enumerate() {
+        for &index in s {
+            if index >= points.len() {
+                return Err(HexDelaunayError::SegmentIndex {
+                    segment,
+                    index,
+                    points: points.len(),
+                });
+            }
+        }
+        if points[s[0]] == points[s[1]] {
+            return Err(HexDelaunayError::DegenerateSegment { segment });
+        }
+    }
+    let c = |i: usize| Coord {
+        x: points[i].x,
+        y: points[i].y,
+    };
+    for i in 0..segments.len() {
+        for j in i + 1..segments.len() {
+            let [a, b] = segments[i];
+            let [p, q] = segments[j];
+            let shared = [a, b]
+                .iter()
+                .any(|&u| [p, q].iter().any(|&v| points[u] == points[v]));
+            let o1 = orient2d(c(a), c(b), c(p));
+            let o2 = orient2d(c(a), c(b), c(q));
+            let o3 = orient2d(c(p), c(q), c(a));
+            let o4 = orient2d(c(p), c(q), c(b));
+            let crosses = if o1 == 0.0 && o2 == 0.0 {
+                // Collinear: they may meet only at a shared endpoint.
+                let d = points[b] - points[a];
+                let t = |v: usize| (points[v] - points[a]).dot(&d) / d.norm_squared();
+                let (lo, hi) = (t(p).min(t(q)).max(0.0), t(p).max(t(q)).min(1.0));
+                hi > lo || (hi == lo && !shared)
+            } else if shared {
+                false
+            } else {
+                o1 * o2 <= 0.0 && o3 * o4 <= 0.0
+            };
+            if crosses {
+                return Err(HexDelaunayError::SegmentsCross {
+                    first: i,
+                    second: j,
+                });
+            }
+        }
+    }
+    Ok(())
+}
