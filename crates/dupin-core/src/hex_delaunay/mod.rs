@@ -69,9 +69,9 @@ impl HexTriangulation {
     pub fn domain_area(&self) -> f64 {
         let c = self.domain;
         let mut a = 0.0;
-        for i in 0..6 {
-            let (p, q) = (c[i], c[(i + 1) % 6]);
-            a += p.x * q.y - p.y * q.x;
+        for i in 1..5 {
+            // Fan from corner 0: differences keep the precision of offset hexagons.
+            a += (c[i] - c[0]).perp(&(c[i + 1] - c[0]));
         }
         0.5 * a
     }

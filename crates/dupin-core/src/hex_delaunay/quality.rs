@@ -24,10 +24,13 @@ pub struct TriangulationQuality {
     /// Edges used by exactly one triangle.
     pub boundary_edges: usize,
     /// Interior edges where the exact incircle test finds the opposite vertex strictly inside the
-    /// circumcircle and the two opposite angles sum to more than 180° + 1e-7°.
+    /// circumcircle and the two opposite angles sum to more than 180° plus a rounding tolerance
+    /// (1e-7° plus 64 ulp of the largest coordinate over the shortest edge of the pair, in
+    /// radians).
     pub delaunay_violations: usize,
-    /// Interior edges whose four points are cocircular up to rounding (exact incircle non-zero
-    /// only because lattice positions are rounded; opposite angles sum to 180° within 1e-7°).
+    /// Interior edges whose four points are cocircular up to rounding (the exact incircle test is
+    /// positive only because lattice positions, multiples of √3, are rounded to f64; the
+    /// opposite angles sum to 180° within the tolerance above).
     pub delaunay_ties: usize,
 }
 
@@ -100,8 +103,19 @@ pub fn triangulation_quality(vertices: &[Vec2], triangles: &[[u32; 3]]) -> Trian
                 // Triangle (a, b, o) is counter-clockwise; o2 lies across edge (a, b).
                 if incircle(c(a), c(b), c(o), c(o2)) > 0.0 {
                     let (pa, pb) = (vertices[a as usize], vertices[b as usize]);
-                    let s = angle(vertices[o as usize], pa, pb) + angle(vertices[o2 as usize], pa, pb);
-                    if s > 180.0 + 1e-7 {
+                    let (po, po2) = (vertices[o as usize], vertices[o2 as usize]);
+                    let s = angle(po, pa, pb) + angle(po2, pa, pb);
+                    // Rounding of the coordinates moves each angle by about ulp / edge length.
+                    let mag = [pa, pb, po, po2]
+                        .iter()
+                        .map(|p| p.x.abs().max(p.y.abs()))
+                        .fold(0.0, f64::max);
+                    let short = [(pa - pb).norm(), (po - pa).norm(), (po - pb).norm()]
+                        .into_iter()
+                        .chain([(po2 - pa).norm(), (po2 - pb).norm()])
+                        .fold(f64::INFINITY, f64::min);
+                    let tol = 1e-7 + (64.0 * f64::EPSILON * mag / short).to_degrees();
+                    if s > 180.0 + tol {
                         q.delaunay_violations += 1;
                     } else {
                         q.delaunay_ties += 1;

@@ -9,7 +9,12 @@
 //! 3. a neighbouring full hexagon is occupied → split the cell;
 //! 4. a neighbour is of lower level (a semi-hexagon covers the neighbour position) → split the
 //!    full hexagon on that semi-hexagon's long edge;
-//! 5. a neighbour is of higher level (split) → split the cell.
+//! 5. a neighbour is of higher level (split) → split the cell;
+//!
+//! 3b. (ours) another occupied hexagon of the same level lies two steps away, sharing a ring
+//!    hexagon → split the cell. Without it two relocated centres can face each other across one
+//!    ring edge with opposite angles up to 120° each, and the dual is not Delaunay (the paper
+//!    claims Delaunay only for the extended refinement, through its 90° bound).
 //!
 //! Added for the bounded domain: a point in a boundary (virtual) hexagon splits it, since a
 //! boundary centre must stay on Ω's boundary for the triangles to tile Ω. The balancing rule
@@ -100,6 +105,17 @@ impl Refinement {
                     let y = add(x, d);
                     if h.is_split(k, y) || self.occupied(&Cell::Full(k, y)) > 0 {
                         return Some(Action::Split(k, x));
+                    }
+                }
+                // Rule 3b (ours): no other occupied hexagon of this level shares a ring
+                // hexagon, else two relocated centres face each other across one ring edge and
+                // the two opposite angles (up to 120° each) break the Delaunay property.
+                for (j, d) in DIRS.iter().enumerate() {
+                    let e = DIRS[(j + 1) % 6];
+                    for z in [add(x, add(*d, *d)), add(x, add(*d, e))] {
+                        if self.occupied(&Cell::Full(k, z)) > 0 && !h.is_split(k, z) {
+                            return Some(Action::Split(k, x));
+                        }
                     }
                 }
                 None

@@ -53,7 +53,7 @@ impl HexDelaunayStepper {
             ));
         }
         let circle = min_enclosing_circle(&unique).ok_or(HexDelaunayError::Empty)?;
-        let rho = if circle.radius > 0.0 {
+        let rho = if unique.len() > 1 {
             if circle.radius < MIN_EXTENT {
                 return Err(HexDelaunayError::TooSmall {
                     extent: circle.radius,
@@ -146,8 +146,8 @@ impl HexDelaunayStepper {
                         occupied: occupied.contains(&Cell::Full(k + 1, c)),
                     });
                 }
-                for d in DIRS {
-                    let m = add(c, d);
+                for (j, d) in DIRS.iter().enumerate() {
+                    let m = add(c, *d);
                     if !super::lattice::in_domain(k + 1, m) {
                         continue;
                     }
@@ -162,13 +162,10 @@ impl HexDelaunayStepper {
                             });
                         }
                     } else {
-                        let cm = f.position(k + 1, m);
-                        let toward = f.position(k, x) - cm;
-                        let corners = f
-                            .hexagon(k + 1, m)
-                            .into_iter()
-                            .filter(|p| (p - cm).dot(&toward) >= -1e-9 * toward.norm_squared())
-                            .collect();
+                        // The half towards x: corners j+2..=j+5 (corner i at 60i degrees,
+                        // direction d_j at 30 + 60j degrees points away from x).
+                        let hex = f.hexagon(k + 1, m);
+                        let corners = (2..6).map(|i| hex[(j + i) % 6]).collect();
                         out.push(HexCell {
                             corners,
                             paper_level: 2 * k + 1,
