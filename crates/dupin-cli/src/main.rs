@@ -6,6 +6,7 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 mod common;
+mod hexdelaunay;
 
 /// Planar-panel geometry for architecture.
 #[derive(Parser)]
@@ -16,10 +17,15 @@ struct Cli {
 }
 
 #[derive(Subcommand)]
-enum Command {}
+enum Command {
+    /// Hexagonal Delaunay triangulation of a point set (angles in [30, 120] degrees).
+    Hexdelaunay(hexdelaunay::HexDelaunayArgs),
+}
 
 fn run(cli: Cli) -> Result<(), common::CliError> {
-    match cli.command {}
+    match cli.command {
+        Command::Hexdelaunay(args) => hexdelaunay::run(args),
+    }
 }
 
 fn main() -> ExitCode {

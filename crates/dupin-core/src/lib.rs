@@ -12,6 +12,7 @@ mod math;
 mod mesh;
 mod obj;
 mod planarity;
+mod point_set;
 mod render_buffers;
 mod surface;
 
@@ -24,5 +25,6 @@ pub use math::{Vec2, Vec3};
 pub use mesh::{MeshError, PolyMesh};
 pub use obj::{ObjError, parse_obj, write_obj};
 pub use planarity::{face_planarity, max_planarity};
+pub use point_set::{PointSetError, parse_points, parse_segments};
 pub use render_buffers::{TriangleBuffers, sample_surface};
 pub use surface::{Domain, Surface, SurfaceDerivatives, Torus};
