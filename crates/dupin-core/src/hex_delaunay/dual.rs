@@ -14,27 +14,42 @@ use super::lattice::{Axial, DIRS, add, normalize};
 use crate::math::Vec2;
 use rustc_hash::FxHashMap;
 
-type Key = (u32, Axial);
+/// A normalised lattice position packed into 16 bytes: `(a << 6 | level, b)`.
+pub type Key = (i64, i64);
 
-/// Triangles with vertices named by normalised lattice keys, before positions are assigned.
+/// Packs a normalised `(level, v)` (level < 64, |a| < 2^56).
+#[inline]
+pub fn pack(level: u32, v: Axial) -> Key {
+    let (l, v) = normalize(level, v);
+    ((v.0 << 6) | l as i64, v.1)
+}
+
+/// The dual triangles and vertex positions of a hexagon mesh.
 pub struct DualBuilder<'h> {
     h: &'h Hierarchy,
+    moved: &'h FxHashMap<Key, Vec2>,
     /// Vertex index of each lattice key.
     pub index: FxHashMap<Key, u32>,
-    /// Lattice key of each vertex.
-    pub keys: Vec<Key>,
+    /// Vertex positions: lattice positions, or the input point of an occupied hexagon.
+    pub positions: Vec<Vec2>,
     /// Triangles, counter-clockwise.
     pub triangles: Vec<[u32; 3]>,
 }
 
 impl<'h> DualBuilder<'h> {
-    /// Extracts the dual triangulation of the hierarchy's current hexagon mesh.
-    pub fn build(h: &'h Hierarchy) -> Self {
+    /// Extracts the dual triangulation of the hierarchy's current hexagon mesh; `moved` gives
+    /// the new positions of occupied centres. Storage is reserved exactly up front (one vertex
+    /// per leaf full hexagon, at most two triangles per vertex), so nothing is reallocated.
+    pub fn build(h: &'h Hierarchy, moved: &'h FxHashMap<Key, Vec2>) -> Self {
+        let leaves = h.leaf_count();
+        let mut index = FxHashMap::default();
+        index.reserve(leaves);
         let mut b = DualBuilder {
             h,
-            index: FxHashMap::default(),
-            keys: Vec::new(),
-            triangles: Vec::new(),
+            moved,
+            index,
+            positions: Vec::with_capacity(leaves),
+            triangles: Vec::with_capacity(2 * leaves),
         };
         for i in 0..6 {
             b.emit(1, (0, 0), DIRS[i], DIRS[(i + 1) % 6]);
@@ -43,10 +58,16 @@ impl<'h> DualBuilder<'h> {
     }
 
     fn vertex(&mut self, level: u32, v: Axial) -> u32 {
-        let key = normalize(level, v);
-        let n = self.keys.len() as u32;
+        let key = pack(level, v);
+        let n = self.positions.len() as u32;
+        let (h, moved, positions) = (self.h, self.moved, &mut self.positions);
         *self.index.entry(key).or_insert_with(|| {
-            self.keys.push(key);
+            positions.push(
+                moved
+                    .get(&key)
+                    .copied()
+                    .unwrap_or_else(|| h.frame.position(level, v)),
+            );
             n
         })
     }
@@ -82,18 +103,5 @@ impl<'h> DualBuilder<'h> {
         let (va, vb, vc) = (self.vertex(k, a), self.vertex(k, b), self.vertex(k, c));
         self.triangles.push([va, m, vc]);
         self.triangles.push([m, vb, vc]);
-    }
-
-    /// Vertex positions: lattice positions, with `moved` overriding some keys.
-    pub fn positions(&self, moved: &FxHashMap<Key, Vec2>) -> Vec<Vec2> {
-        self.keys
-            .iter()
-            .map(|&(l, v)| {
-                moved
-                    .get(&(l, v))
-                    .copied()
-                    .unwrap_or_else(|| self.h.frame.position(l, v))
-            })
-            .collect()
     }
 }

@@ -147,8 +147,12 @@ impl Hierarchy {
     /// each level, the nearest of the seven children of the current split hexagon, so a point on
     /// a shared edge is still assigned consistently to one cell (section 6.3's "first tested").
     pub fn locate(&self, p: Vec2) -> Cell {
-        let mut level = 0u32;
-        let mut a: Axial = (0, 0);
+        self.locate_from(p, 0, (0, 0))
+    }
+
+    /// [`locate`](Self::locate) starting below the split hexagon `a` at `level`, which must
+    /// contain `p`.
+    pub fn locate_from(&self, p: Vec2, mut level: u32, mut a: Axial) -> Cell {
         loop {
             let next = level + 1;
             let mut best = (a.0 * 2, a.1 * 2);
@@ -180,6 +184,27 @@ impl Hierarchy {
     #[inline]
     pub fn on_boundary(&self, level: u32, v: Axial) -> bool {
         on_boundary(level, v)
+    }
+
+    /// Number of leaf full hexagons (the dual mesh's vertices): every split hexagon's central
+    /// child continues its position, so this counts the root plus, per split hexagon, its joined
+    /// children (each counted from the parent that `parents_of_midpoint` names first, or from
+    /// the inner parent for a boundary join).
+    pub fn leaf_count(&self) -> usize {
+        let mut n = 1;
+        for (k, set) in self.split.iter().enumerate() {
+            let k = k as u32;
+            for &x in set {
+                for d in DIRS {
+                    let y = add(x, d);
+                    let boundary_join = !in_domain(k, y) && in_domain(k + 1, add(x, y));
+                    if boundary_join || (self.is_split(k, y) && x < y) {
+                        n += 1;
+                    }
+                }
+            }
+        }
+        n
     }
 
     /// Iterates over the split hexagons of `level`.

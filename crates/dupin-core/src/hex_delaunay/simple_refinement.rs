@@ -157,21 +157,28 @@ impl Refinement {
         Ok(())
     }
 
+    fn relocate(&mut self, i: u32, c: Cell) {
+        self.cell_of[i as usize] = c;
+        self.occupants.entry(c).or_default().push(i);
+        self.push(i);
+    }
+
     /// Re-locates the points displaced by splitting `x` at level `k` and queues the points whose
     /// rules may now fire.
     fn after_split(&mut self, k: u32, x: Axial) {
-        let mut moved = self.occupants.remove(&Cell::Full(k, x)).unwrap_or_default();
+        let moved = self.occupants.remove(&Cell::Full(k, x)).unwrap_or_default();
+        for i in moved {
+            let c = self.hierarchy.locate_from(self.points[i as usize], k, x);
+            self.relocate(i, c);
+        }
         for d in DIRS {
             // Semi-hexagons of split neighbours towards x are now joined into full hexagons.
-            if let Some(v) = self.occupants.remove(&Cell::Semi(k + 1, add(x, add(x, d)))) {
-                moved.extend(v);
+            let m = add(x, add(x, d));
+            if let Some(v) = self.occupants.remove(&Cell::Semi(k + 1, m)) {
+                for i in v {
+                    self.relocate(i, Cell::Full(k + 1, m));
+                }
             }
-        }
-        for i in moved {
-            let c = self.hierarchy.locate(self.points[i as usize]);
-            self.cell_of[i as usize] = c;
-            self.occupants.entry(c).or_default().push(i);
-            self.push(i);
         }
         for d in DIRS {
             let y = add(x, d);

@@ -1,10 +1,10 @@
 //! The stepper: the refinement one observable subdivision step at a time, for the page's 2D
 //! view, plus the input checks and bounding-hexagon set-up shared with the one-shot function.
 
-use super::dual::DualBuilder;
+use super::dual::{DualBuilder, Key, pack};
 use super::error::HexDelaunayError;
 use super::hierarchy::{Cell, Hierarchy};
-use super::lattice::{Axial, DIRS, Frame, add, normalize, parents_of_midpoint};
+use super::lattice::{Axial, DIRS, Frame, add, parents_of_midpoint};
 use super::min_enclosing_circle::min_enclosing_circle;
 use super::simple_refinement::Refinement;
 use super::{HexDelaunayMode, HexTriangulation, MAX_COORDINATE, MAX_LEVEL, MIN_EXTENT};
@@ -182,12 +182,11 @@ impl HexDelaunayStepper {
     /// points. Input points are exact vertices only once refinement is finished.
     pub fn triangulation(&self) -> HexTriangulation {
         let h = &self.refinement.hierarchy;
-        let dual = DualBuilder::build(h);
-        let mut moved: FxHashMap<(u32, Axial), Vec2> = FxHashMap::default();
+        let mut moved: FxHashMap<Key, Vec2> = FxHashMap::default();
         let mut point_key = Vec::with_capacity(self.refinement.points.len());
         for (i, c) in self.refinement.cell_of.iter().enumerate() {
             let key = match *c {
-                Cell::Full(k, x) => Some(normalize(k, x)),
+                Cell::Full(k, x) => Some(pack(k, x)),
                 Cell::Semi(..) => None,
             };
             if let Some(key) = key {
@@ -195,14 +194,15 @@ impl HexDelaunayStepper {
             }
             point_key.push(key);
         }
-        let vertices = dual.positions(&moved);
+        let dual = DualBuilder::build(h, &moved);
+        debug_assert_eq!(dual.positions.len(), h.leaf_count());
         let unique_vertex: Vec<u32> = point_key
             .iter()
             .map(|k| k.and_then(|k| dual.index.get(&k).copied()).unwrap_or(u32::MAX))
             .collect();
         HexTriangulation {
-            vertices,
-            triangles: dual.triangles.clone(),
+            vertices: dual.positions,
+            triangles: dual.triangles,
             input_vertex: self
                 .input_map
                 .iter()

@@ -37,7 +37,7 @@ pub(crate) const FAMILIES: [Family; 9] = [
 pub(crate) fn sample(family: Family, rng: &mut ChaCha8Rng) -> Vec<Vec2> {
     let offset = Vec2::new(rng.random_range(-100.0..100.0), rng.random_range(-100.0..100.0));
     let scale = 10f64.powf(rng.random_range(-2.0..2.0));
-    let mut u = |rng: &mut ChaCha8Rng| rng.random_range(-1.0..1.0f64);
+    let u = |rng: &mut ChaCha8Rng| rng.random_range(-1.0..1.0f64);
     let n = rng.random_range(2..24usize);
     let pts: Vec<Vec2> = match family {
         Family::Uniform => (0..n)
