@@ -51,8 +51,11 @@ impl<'h> DualBuilder<'h> {
             positions: Vec::with_capacity(leaves),
             triangles: Vec::with_capacity(2 * leaves),
         };
+        let o = b.vertex(1, (0, 0));
+        let corners: [u32; 6] = std::array::from_fn(|i| b.vertex(1, DIRS[i]));
         for i in 0..6 {
-            b.emit(1, (0, 0), DIRS[i], DIRS[(i + 1) % 6]);
+            let j = (i + 1) % 6;
+            b.emit(1, [(0, 0), DIRS[i], DIRS[j]], [o, corners[i], corners[j]]);
         }
         b
     }
@@ -72,35 +75,43 @@ impl<'h> DualBuilder<'h> {
         })
     }
 
-    fn emit(&mut self, k: u32, a: Axial, b: Axial, c: Axial) {
-        let (sa, sb, sc) = (
+    /// Emits the lattice triangle `t` at level `k` (counter-clockwise) whose corner vertex
+    /// indices `ids` are known: only new midpoints are looked up, about one hash look-up per
+    /// output triangle.
+    fn emit(&mut self, k: u32, t: [Axial; 3], ids: [u32; 3]) {
+        let [a, b, c] = t;
+        let split = [
             self.h.is_split(k, a),
             self.h.is_split(k, b),
             self.h.is_split(k, c),
-        );
-        match (sa, sb, sc) {
-            (true, true, true) => {
+        ];
+        match split {
+            [true, true, true] => {
                 let (ab, bc, ca) = (add(a, b), add(b, c), add(c, a));
+                let (iab, ibc, ica) = (
+                    self.vertex(k + 1, ab),
+                    self.vertex(k + 1, bc),
+                    self.vertex(k + 1, ca),
+                );
                 let (a2, b2, c2) = ((2 * a.0, 2 * a.1), (2 * b.0, 2 * b.1), (2 * c.0, 2 * c.1));
-                self.emit(k + 1, a2, ab, ca);
-                self.emit(k + 1, ab, b2, bc);
-                self.emit(k + 1, ca, bc, c2);
-                self.emit(k + 1, ab, bc, ca);
+                let [ia, ib, ic] = ids;
+                self.emit(k + 1, [a2, ab, ca], [ia, iab, ica]);
+                self.emit(k + 1, [ab, b2, bc], [iab, ib, ibc]);
+                self.emit(k + 1, [ca, bc, c2], [ica, ibc, ic]);
+                self.emit(k + 1, [ab, bc, ca], [iab, ibc, ica]);
             }
-            (true, true, false) => self.bisect(k, a, b, c),
-            (false, true, true) => self.bisect(k, b, c, a),
-            (true, false, true) => self.bisect(k, c, a, b),
-            _ => {
-                let t = [self.vertex(k, a), self.vertex(k, b), self.vertex(k, c)];
-                self.triangles.push(t);
-            }
+            [true, true, false] => self.bisect(k, a, b, [ids[0], ids[1], ids[2]]),
+            [false, true, true] => self.bisect(k, b, c, [ids[1], ids[2], ids[0]]),
+            [true, false, true] => self.bisect(k, c, a, [ids[2], ids[0], ids[1]]),
+            _ => self.triangles.push(ids),
         }
     }
 
-    /// `a`, `b` split, `c` not (counter-clockwise a, b, c): two right triangles at `a + b`.
-    fn bisect(&mut self, k: u32, a: Axial, b: Axial, c: Axial) {
+    /// Corners `a`, `b` split, the third not (counter-clockwise a, b, c; `ids` in that order):
+    /// two right triangles meeting at the joined hexagon `a + b`.
+    fn bisect(&mut self, k: u32, a: Axial, b: Axial, ids: [u32; 3]) {
         let m = self.vertex(k + 1, add(a, b));
-        let (va, vb, vc) = (self.vertex(k, a), self.vertex(k, b), self.vertex(k, c));
+        let [va, vb, vc] = ids;
         self.triangles.push([va, m, vc]);
         self.triangles.push([m, vb, vc]);
     }
