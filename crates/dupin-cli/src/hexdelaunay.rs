@@ -42,8 +42,8 @@ pub struct HexDelaunayArgs {
 /// Runs the command.
 pub fn run(args: HexDelaunayArgs) -> Result<(), CliError> {
     let points_path = args.points.display().to_string();
-    let points = parse_points(&read_text(&args.points)?)
-        .map_err(|e| CliError::input(&points_path, e))?;
+    let points =
+        parse_points(&read_text(&args.points)?).map_err(|e| CliError::input(&points_path, e))?;
     if points.is_empty() {
         return Err(CliError::Input(format!("{points_path}: no points")));
     }

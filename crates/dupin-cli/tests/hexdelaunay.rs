@@ -8,10 +8,7 @@ static COUNTER: AtomicUsize = AtomicUsize::new(0);
 
 fn temp(name: &str, content: Option<&str>) -> PathBuf {
     let n = COUNTER.fetch_add(1, Ordering::SeqCst);
-    let p = std::env::temp_dir().join(format!(
-        "dupin-hexd-{}-{n}-{name}",
-        std::process::id()
-    ));
+    let p = std::env::temp_dir().join(format!("dupin-hexd-{}-{n}-{name}", std::process::id()));
     if let Some(c) = content {
         std::fs::write(&p, c).unwrap();
     }
@@ -70,7 +67,8 @@ fn triangulates_and_reports_contract_fields() {
     ]);
     assert_eq!(code, 0, "{stderr}");
     assert_eq!(stdout.lines().count(), 1);
-    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&rep).unwrap()).unwrap();
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&rep).unwrap()).unwrap();
     let keys: Vec<&String> = r.as_object().unwrap().keys().collect();
     let mut expected = [
         "input_points",
@@ -95,7 +93,9 @@ fn triangulates_and_reports_contract_fields() {
     assert_eq!(mesh.num_faces() as u64, r["triangles"].as_u64().unwrap());
     for p in dupin_core::parse_points(text).unwrap() {
         assert!(
-            mesh.positions.iter().any(|v| v.x == p.x && v.y == p.y && v.z == 0.0),
+            mesh.positions
+                .iter()
+                .any(|v| v.x == p.x && v.y == p.y && v.z == 0.0),
             "input point {p:?} is not an exact vertex"
         );
     }

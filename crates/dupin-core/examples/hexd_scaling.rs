@@ -100,13 +100,21 @@ fn main() {
         for &n in &[16000usize, 64000] {
             let pts = uniform(n, n as u64);
             let t0 = Instant::now();
-            let mut s = dupin_core::HexDelaunayStepper::new(&pts, &[], HexDelaunayMode::Simple).unwrap();
+            let mut s =
+                dupin_core::HexDelaunayStepper::new(&pts, &[], HexDelaunayMode::Simple).unwrap();
             let t1 = Instant::now();
             s.run().unwrap();
             let t2 = Instant::now();
             let tri = s.triangulation();
             let t3 = Instant::now();
-            println!("{n}: setup {:.4} refine {:.4} dual {:.4} splits {} tris {}", (t1-t0).as_secs_f64(), (t2-t1).as_secs_f64(), (t3-t2).as_secs_f64(), s.split_count(), tri.triangles.len());
+            println!(
+                "{n}: setup {:.4} refine {:.4} dual {:.4} splits {} tris {}",
+                (t1 - t0).as_secs_f64(),
+                (t2 - t1).as_secs_f64(),
+                (t3 - t2).as_secs_f64(),
+                s.split_count(),
+                tri.triangles.len()
+            );
         }
     }
     println!("fitted exponent of time against triangles (1k..64k points): {slope:.3}");

@@ -105,7 +105,10 @@ mod tests {
             parse_points("inf 0\n"),
             Err(PointSetError::NonFinite { line: 1 })
         );
-        assert_eq!(parse_segments("0 1\n# x\n2 3").unwrap(), vec![[0, 1], [2, 3]]);
+        assert_eq!(
+            parse_segments("0 1\n# x\n2 3").unwrap(),
+            vec![[0, 1], [2, 3]]
+        );
         assert!(matches!(
             parse_segments("0 -1\n"),
             Err(PointSetError::Malformed { line: 1, .. })

@@ -42,6 +42,13 @@ pub enum HexDelaunayError {
         /// The cap on full-hexagon levels.
         max_level: u32,
     },
+    /// A point inserted into an existing triangulation lies outside (or on) its bounding
+    /// hexagon Ω.
+    #[error("inserted point {index} lies outside the bounding hexagon")]
+    OutsideDomain {
+        /// Index of the point in the inserted batch (0-based).
+        index: usize,
+    },
     /// A segment names a point that does not exist.
     #[error("segment {segment} refers to point {index}, but there are only {points} points")]
     SegmentIndex {

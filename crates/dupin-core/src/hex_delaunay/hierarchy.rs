@@ -135,7 +135,8 @@ impl Hierarchy {
             }
         }
         if self.split.len() <= level as usize {
-            self.split.resize_with(level as usize + 1, FxHashSet::default);
+            self.split
+                .resize_with(level as usize + 1, FxHashSet::default);
         }
         self.split[level as usize].insert(v);
         self.split_count += 1;

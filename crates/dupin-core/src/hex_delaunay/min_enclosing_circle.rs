@@ -41,7 +41,11 @@ impl Circle {
         let d = 2.0 * (bx * cy - by * cx);
         let fallback = || {
             // (Nearly) collinear: the circle on the farthest pair.
-            let cands = [Circle::from_two(a, b), Circle::from_two(a, c), Circle::from_two(b, c)];
+            let cands = [
+                Circle::from_two(a, b),
+                Circle::from_two(a, c),
+                Circle::from_two(b, c),
+            ];
             cands
                 .into_iter()
                 .filter(|k| k.contains(a) && k.contains(b) && k.contains(c))

@@ -19,8 +19,10 @@
 //! that costs O(1) per output triangle. See `hierarchy.rs`, `simple_refinement.rs`, `dual.rs`.
 //!
 //! Not implemented yet (each returns [`HexDelaunayError::Unsupported`] where it is asked for):
-//! the extended refinement of section 5 (43.9°..90°), PSLG input (section 7), the reverse
-//! operations with split counters (section 3.2, needed for blossoms) and incremental insertion.
+//! the extended refinement of section 5 (43.9°..90°), PSLG input (section 7, segments are
+//! validated, then refused) and the reverse operations with split counters (section 3.2, needed
+//! only for the extended refinement's blossoms). Incremental insertion is
+//! [`HexDelaunayStepper::insert`].
 
 mod dual;
 mod error;

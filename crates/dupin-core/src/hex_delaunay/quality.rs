@@ -88,7 +88,10 @@ pub fn triangulation_quality(vertices: &[Vec2], triangles: &[[u32; 3]]) -> Trian
         let circ = la * lb * lc / (4.0 * area);
         q.max_aspect_ratio = q.max_aspect_ratio.max(circ / (2.0 * inr));
         for i in 0..3 {
-            if edges.insert((t[i], t[(i + 1) % 3]), t[(i + 2) % 3]).is_some() {
+            if edges
+                .insert((t[i], t[(i + 1) % 3]), t[(i + 2) % 3])
+                .is_some()
+            {
                 q.nonmanifold_edges += 1;
             }
         }

@@ -71,6 +71,19 @@ impl Refinement {
         }
     }
 
+    /// Adds a point (inside Ω) to an existing refinement and queues it; refinement resumes with
+    /// the next [`step`](Self::step). Returns its index among the distinct points.
+    pub fn add_point(&mut self, p: Vec2) -> u32 {
+        let i = self.points.len() as u32;
+        self.points.push(p);
+        let c = self.hierarchy.locate(p);
+        self.cell_of.push(c);
+        self.occupants.entry(c).or_default().push(i);
+        self.queued.push(false);
+        self.push(i);
+        i
+    }
+
     /// Whether the work queue is empty (refinement finished).
     pub fn is_done(&self) -> bool {
         self.queue.is_empty()

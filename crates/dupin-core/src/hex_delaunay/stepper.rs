@@ -29,6 +29,7 @@ pub struct HexCell {
 pub struct HexDelaunayStepper {
     refinement: Refinement,
     input_map: Vec<u32>,
+    by_bits: FxHashMap<(u64, u64), u32>,
     last: Vec<(u32, Axial)>,
     steps: usize,
 }
@@ -65,19 +66,65 @@ impl HexDelaunayStepper {
             circle.center.x.abs().max(circle.center.y.abs()).max(1.0)
         };
         // Ω has inradius 1.5 rho = 3R/4.
-        let root_radius = 2.0 * rho;
+        Self::build(unique, input_map, circle.center, 2.0 * rho)
+    }
+
+    /// Like [`new`](Self::new) but triangulating a given bounding hexagon Ω (centre `center`,
+    /// inradius `inradius`, corners at 30° + 60° i) instead of the one derived from the points'
+    /// enclosing circle, as the paper's "two close points in a unit hexagon" benchmark does.
+    /// Every point must lie strictly inside Ω; the minimum-edge bound then holds only for points
+    /// at least d_min/2 away from Ω's boundary.
+    pub fn new_in_domain(
+        points: &[Vec2],
+        mode: HexDelaunayMode,
+        center: Vec2,
+        inradius: f64,
+    ) -> Result<Self, HexDelaunayError> {
+        let (unique, input_map) = check_points(points)?;
+        if mode == HexDelaunayMode::Extended {
+            return Err(HexDelaunayError::Unsupported(
+                "extended refinement (section 5, 43.9..90 degrees); use the simple mode",
+            ));
+        }
+        if !(inradius.is_finite() && inradius >= MIN_EXTENT && inradius <= MAX_COORDINATE)
+            || !center.x.is_finite()
+            || !center.y.is_finite()
+        {
+            return Err(HexDelaunayError::TooSmall {
+                extent: inradius,
+                limit: MIN_EXTENT,
+            });
+        }
+        let mut s = Self::build(Vec::new(), Vec::new(), center, inradius / 0.75)?;
+        s.insert(&unique)?;
+        s.input_map = input_map;
+        Ok(s)
+    }
+
+    fn build(
+        unique: Vec<Vec2>,
+        input_map: Vec<u32>,
+        center: Vec2,
+        root_radius: f64,
+    ) -> Result<Self, HexDelaunayError> {
         let frame = Frame {
-            origin: circle.center,
+            origin: center,
             root_radius,
         };
         // Cells finer than 2^-42 of the coordinates' magnitude lose their shape in f64.
-        let scale = circle.center.x.abs().max(circle.center.y.abs()) + root_radius;
+        let scale = center.x.abs().max(center.y.abs()) + root_radius;
         let by_precision = 42.0 - (scale / root_radius).log2();
         let max_level = (by_precision.floor().max(0.0) as u32).min(MAX_LEVEL);
         let hierarchy = Hierarchy::new(frame, max_level);
+        let by_bits = unique
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (bits(p), i as u32))
+            .collect();
         Ok(HexDelaunayStepper {
             refinement: Refinement::new(hierarchy, unique),
             input_map,
+            by_bits,
             last: Vec::new(),
             steps: 0,
         })
@@ -92,6 +139,43 @@ impl HexDelaunayStepper {
             self.steps += 1;
             Ok(true)
         }
+    }
+
+    /// Incremental insertion (the paper's abstract and section 9): adds further points to the
+    /// current subdivision, which is refined further (never coarsened) by the following steps or
+    /// [`run`](Self::run). The points must lie strictly inside [`domain`](Self::domain), which
+    /// the first batch fixed. They are numbered after all earlier points in
+    /// [`HexTriangulation::input_vertex`]. On error nothing is inserted.
+    pub fn insert(&mut self, points: &[Vec2]) -> Result<(), HexDelaunayError> {
+        let f = self.refinement.hierarchy.frame;
+        // Ω's inradius is 3R/4; its edges' outward normals point at 0°, 60°, ...
+        let inr = 0.75 * f.root_radius;
+        for (index, p) in points.iter().enumerate() {
+            if !p.x.is_finite() || !p.y.is_finite() {
+                return Err(HexDelaunayError::NonFinite { index });
+            }
+            let q = p - f.origin;
+            let inside = (0..6).all(|i| {
+                let t = std::f64::consts::FRAC_PI_3 * i as f64;
+                q.x * t.cos() + q.y * t.sin() < inr
+            });
+            if !inside {
+                return Err(HexDelaunayError::OutsideDomain { index });
+            }
+        }
+        for p in points {
+            let p = p + Vec2::new(0.0, 0.0);
+            let u = match self.by_bits.get(&bits(&p)) {
+                Some(&u) => u,
+                None => {
+                    let u = self.refinement.add_point(p);
+                    self.by_bits.insert(bits(&p), u);
+                    u
+                }
+            };
+            self.input_map.push(u);
+        }
+        Ok(())
     }
 
     /// Runs all remaining steps.
@@ -198,7 +282,10 @@ impl HexDelaunayStepper {
         debug_assert_eq!(dual.positions.len(), h.leaf_count());
         let unique_vertex: Vec<u32> = point_key
             .iter()
-            .map(|k| k.and_then(|k| dual.index.get(&k).copied()).unwrap_or(u32::MAX))
+            .map(|k| {
+                k.and_then(|k| dual.index.get(&k).copied())
+                    .unwrap_or(u32::MAX)
+            })
             .collect();
         HexTriangulation {
             vertices: dual.positions,
@@ -212,6 +299,10 @@ impl HexDelaunayStepper {
             depth: h.depth(),
         }
     }
+}
+
+fn bits(p: &Vec2) -> (u64, u64) {
+    ((p.x + 0.0).to_bits(), (p.y + 0.0).to_bits())
 }
 
 /// Checks coordinates and removes exact duplicates. Returns the distinct points and, for each

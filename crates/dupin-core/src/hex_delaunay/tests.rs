@@ -35,7 +35,10 @@ pub(crate) const FAMILIES: [Family; 9] = [
 ];
 
 pub(crate) fn sample(family: Family, rng: &mut ChaCha8Rng) -> Vec<Vec2> {
-    let offset = Vec2::new(rng.random_range(-100.0..100.0), rng.random_range(-100.0..100.0));
+    let offset = Vec2::new(
+        rng.random_range(-100.0..100.0),
+        rng.random_range(-100.0..100.0),
+    );
     let scale = 10f64.powf(rng.random_range(-2.0..2.0));
     let u = |rng: &mut ChaCha8Rng| rng.random_range(-1.0..1.0f64);
     let n = rng.random_range(2..24usize);
@@ -118,11 +121,24 @@ fn d_min(points: &[Vec2]) -> f64 {
 pub(crate) fn check_simple(points: &[Vec2], what: &str) -> usize {
     let t = hex_delaunay(points, &[], HexDelaunayMode::Simple)
         .unwrap_or_else(|e| panic!("{what}: {e}"));
+    check_triangulation(&t, points, what)
+}
+
+/// Checks every guarantee of the simple refinement on a result for `points`.
+pub(crate) fn check_triangulation(t: &HexTriangulation, points: &[Vec2], what: &str) -> usize {
     let q = triangulation_quality(&t.vertices, &t.triangles);
     assert_eq!(q.inverted, 0, "{what}: inverted triangles");
     assert_eq!(q.nonmanifold_edges, 0, "{what}: non-manifold edges");
-    assert!(q.min_angle_deg >= 29.99, "{what}: min angle {}", q.min_angle_deg);
-    assert!(q.max_angle_deg <= 120.01, "{what}: max angle {}", q.max_angle_deg);
+    assert!(
+        q.min_angle_deg >= 29.99,
+        "{what}: min angle {}",
+        q.min_angle_deg
+    );
+    assert!(
+        q.max_angle_deg <= 120.01,
+        "{what}: max angle {}",
+        q.max_angle_deg
+    );
     assert_eq!(q.delaunay_violations, 0, "{what}: not Delaunay");
     assert!(
         q.max_aspect_ratio <= SIMPLE_ASPECT * (1.0 + 1e-6),
@@ -136,7 +152,11 @@ pub(crate) fn check_simple(points: &[Vec2], what: &str) -> usize {
     let perimeter: f64 = (0..6)
         .map(|i| (t.domain[i] - t.domain[(i + 1) % 6]).norm())
         .sum();
-    let mag = t.domain.iter().map(|p| p.x.abs().max(p.y.abs())).fold(0.0, f64::max);
+    let mag = t
+        .domain
+        .iter()
+        .map(|p| p.x.abs().max(p.y.abs()))
+        .fold(0.0, f64::max);
     assert!(
         (q.area - area).abs() <= 1e-9 * area + perimeter * 64.0 * f64::EPSILON * mag,
         "{what}: area {} vs {}",
@@ -328,3 +348,115 @@ fn bad_input_is_refused() {
     ));
 }
 
+#[test]
+fn incremental_insertion_keeps_the_guarantees() {
+    let mut rng = ChaCha8Rng::seed_from_u64(77);
+    for case in 0..300 {
+        let first = sample(FAMILIES[case % 5], &mut rng);
+        // Further points inside the hull of the first batch (hence inside Ω), some duplicates,
+        // none closer than 1e-6 of the batch's extent to another (or the depth cap is hit).
+        let extent = first
+            .iter()
+            .map(|p| (p - first[0]).norm())
+            .fold(0.0, f64::max);
+        let mut more: Vec<Vec2> = Vec::new();
+        let candidates: Vec<Vec2> = (0..rng.random_range(1..10))
+            .map(|_| {
+                let (i, j) = (
+                    rng.random_range(0..first.len()),
+                    rng.random_range(0..first.len()),
+                );
+                if rng.random_range(0..4) == 0 {
+                    first[i]
+                } else {
+                    let t = rng.random::<f64>();
+                    first[i] * t + first[j] * (1.0 - t)
+                }
+            })
+            .collect();
+        for c in candidates {
+            let near = |p: &Vec2| *p != c && (p - c).norm() < 1e-6 * extent;
+            if !first.iter().chain(&more).any(near) {
+                more.push(c);
+            }
+        }
+        let mut s = HexDelaunayStepper::new(&first, &[], HexDelaunayMode::Simple).unwrap();
+        s.run().unwrap();
+        let before = s.triangulation();
+        s.insert(&more).unwrap();
+        s.run().unwrap();
+        let after = s.triangulation();
+        assert_eq!(after.domain, before.domain);
+        assert!(after.triangles.len() >= before.triangles.len());
+        let all: Vec<Vec2> = first.iter().chain(&more).copied().collect();
+        check_triangulation(&after, &all, &format!("incremental case {case}"));
+    }
+    // Outside Ω: refused, nothing inserted.
+    let pts = [Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0)];
+    let mut s = HexDelaunayStepper::new(&pts, &[], HexDelaunayMode::Simple).unwrap();
+    s.run().unwrap();
+    let n = s.triangulation().input_vertex.len();
+    assert_eq!(
+        s.insert(&[Vec2::new(0.5, 0.1), Vec2::new(0.5, 10.0)]),
+        Err(HexDelaunayError::OutsideDomain { index: 1 })
+    );
+    assert_eq!(
+        s.insert(&[Vec2::new(0.5, f64::NAN)]),
+        Err(HexDelaunayError::NonFinite { index: 0 })
+    );
+    assert_eq!(s.triangulation().input_vertex.len(), n);
+}
+
+/// The paper's data sets (Table 1), seeded: two points 0.02 apart, 100 random points on a line,
+/// 100 / 1k / 2k random points in the plane. (The IMR letters are a PSLG, not supported yet.)
+pub(crate) fn paper_data_sets() -> Vec<(&'static str, Vec<Vec2>, usize)> {
+    let mut rng = ChaCha8Rng::seed_from_u64(2008);
+    let mut plane = |n: usize| -> Vec<Vec2> {
+        (0..n)
+            .map(|_| Vec2::new(rng.random::<f64>(), rng.random::<f64>()))
+            .collect()
+    };
+    let p100 = plane(100);
+    let p1k = plane(1000);
+    let p2k = plane(2000);
+    let mut rng = ChaCha8Rng::seed_from_u64(2009);
+    let line: Vec<Vec2> = (0..100)
+        .map(|_| {
+            let t = rng.random::<f64>();
+            Vec2::new(t, 0.3 * t)
+        })
+        .collect();
+    vec![
+        (
+            "2 close pts",
+            vec![Vec2::new(0.0, 0.0), Vec2::new(0.02, 0.0)],
+            684,
+        ),
+        ("100 pts on line", line, 18667),
+        ("100 pts on plane", p100, 12748),
+        ("1k pts on plane", p1k, 127729),
+        ("2k pts on plane", p2k, 268138),
+    ]
+}
+
+#[test]
+fn paper_data_sets_take_fewer_triangles_than_table_1() {
+    for (name, pts, paper) in paper_data_sets() {
+        let n = if name == "2 close pts" {
+            // The paper's set-up: a hexagon of unit (circum)radius around the pair.
+            let mut s = HexDelaunayStepper::new_in_domain(
+                &pts,
+                HexDelaunayMode::Simple,
+                Vec2::new(0.01, 0.0),
+                3f64.sqrt() / 2.0,
+            )
+            .unwrap();
+            s.run().unwrap();
+            check_triangulation(&s.triangulation(), &pts, name)
+        } else {
+            check_simple(&pts, name)
+        };
+        println!("{name}: {n} triangles (paper, extended mode: {paper})");
+        assert!(n < paper, "{name}: {n} triangles, paper {paper}");
+    }
+}
