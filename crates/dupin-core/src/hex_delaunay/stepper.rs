@@ -86,10 +86,10 @@ impl HexDelaunayStepper {
                 "extended refinement (section 5, 43.9..90 degrees); use the simple mode",
             ));
         }
-        if !(inradius.is_finite() && inradius >= MIN_EXTENT && inradius <= MAX_COORDINATE)
-            || !center.x.is_finite()
-            || !center.y.is_finite()
-        {
+        let valid = (MIN_EXTENT..=MAX_COORDINATE).contains(&inradius)
+            && center.x.is_finite()
+            && center.y.is_finite();
+        if !valid {
             return Err(HexDelaunayError::TooSmall {
                 extent: inradius,
                 limit: MIN_EXTENT,
