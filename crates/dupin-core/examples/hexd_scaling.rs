@@ -59,6 +59,14 @@ fn main() {
     );
     for &n in &sizes {
         let pts = uniform(n, n as u64);
+        if let Ok(dir) = std::env::var("HEXD_DUMP") {
+            // The same points for an outside comparison (e.g. Triangle): one `x y` per line.
+            let text: String = pts
+                .iter()
+                .map(|p| format!("{:?} {:?}\n", p.x, p.y))
+                .collect();
+            std::fs::write(format!("{dir}/uniform_{n}.txt"), text).expect("writable dump dir");
+        }
         let mut best = f64::INFINITY;
         let mut tris = 0;
         let mut peak = 0;
@@ -96,7 +104,7 @@ fn main() {
         .map(|(x, y)| (x - sx) * (y - sy))
         .sum::<f64>()
         / xs.iter().map(|x| (x - sx).powi(2)).sum::<f64>();
-    if std::env::var("PHASES").is_ok() {
+    if std::env::var("HEXD_PHASES").is_ok() {
         for &n in &[16000usize, 64000] {
             let pts = uniform(n, n as u64);
             let t0 = Instant::now();

@@ -11,17 +11,19 @@
 
 use super::hierarchy::Hierarchy;
 use super::lattice::{Axial, DIRS, add, normalize};
+use super::spatial_hash::LatticeMap;
 use crate::math::Vec2;
 use rustc_hash::FxHashMap;
 
-/// A normalised lattice position packed into 16 bytes: `(a << 6 | level, b)`.
+/// A normalised lattice position packed into 16 bytes: `(a + 2^50 | level << 56, b)`, the
+/// coordinates' low bits kept low for the locality-preserving hash.
 pub type Key = (i64, i64);
 
-/// Packs a normalised `(level, v)` (level < 64, |a| < 2^56).
+/// Packs a normalised `(level, v)` (level < 64, |a| < 2^50).
 #[inline]
 pub fn pack(level: u32, v: Axial) -> Key {
     let (l, v) = normalize(level, v);
-    ((v.0 << 6) | l as i64, v.1)
+    ((v.0 + (1 << 50)) | ((l as i64) << 56), v.1)
 }
 
 /// The dual triangles and vertex positions of a hexagon mesh.
@@ -29,7 +31,7 @@ pub struct DualBuilder<'h> {
     h: &'h Hierarchy,
     moved: &'h FxHashMap<Key, Vec2>,
     /// Vertex index of each lattice key.
-    pub index: FxHashMap<Key, u32>,
+    pub index: LatticeMap<Key, u32>,
     /// Vertex positions: lattice positions, or the input point of an occupied hexagon.
     pub positions: Vec<Vec2>,
     /// Triangles, counter-clockwise.
@@ -42,7 +44,7 @@ impl<'h> DualBuilder<'h> {
     /// per leaf full hexagon, at most two triangles per vertex), so nothing is reallocated.
     pub fn build(h: &'h Hierarchy, moved: &'h FxHashMap<Key, Vec2>) -> Self {
         let leaves = h.leaf_count();
-        let mut index = FxHashMap::default();
+        let mut index = LatticeMap::default();
         index.reserve(leaves);
         let mut b = DualBuilder {
             h,

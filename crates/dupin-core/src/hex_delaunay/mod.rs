@@ -31,6 +31,7 @@ mod lattice;
 mod min_enclosing_circle;
 mod quality;
 mod simple_refinement;
+mod spatial_hash;
 mod stepper;
 
 pub use error::HexDelaunayError;

@@ -324,18 +324,40 @@ fn check_points(points: &[Vec2]) -> Result<(Vec<Vec2>, Vec<u32>), HexDelaunayErr
             });
         }
     }
+    // Distinct points in Morton (Z-curve) order, so that refinement works through space
+    // coherently and the locality-preserving hash tables stay cache-friendly.
+    let (mut lo, mut hi) = (points[0], points[0]);
+    for p in points {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    let span = (hi - lo).max().max(f64::MIN_POSITIVE);
+    let morton = |p: &Vec2| {
+        let q = |t: f64| ((t / span) * 1048575.0).clamp(0.0, 1048575.0) as u64;
+        let (mut x, mut y, mut m) = (q(p.x - lo.x), q(p.y - lo.y), 0u64);
+        for bit in 0..20 {
+            m |= ((x & 1) << (2 * bit)) | ((y & 1) << (2 * bit + 1));
+            x >>= 1;
+            y >>= 1;
+        }
+        m
+    };
     let mut order: Vec<u32> = (0..points.len() as u32).collect();
     let key = |i: u32| {
         let p = points[i as usize];
         // +0.0 and -0.0 are the same point.
+        (morton(&p), (p.x + 0.0).to_bits(), (p.y + 0.0).to_bits())
+    };
+    let dedup_key = |i: u32| {
+        let p = points[i as usize];
         ((p.x + 0.0).to_bits(), (p.y + 0.0).to_bits())
     };
-    order.sort_unstable_by_key(|&i| key(i));
+    order.sort_by_cached_key(|&i| key(i));
     let mut map = vec![0u32; points.len()];
     let mut unique = Vec::new();
     let mut prev = None;
     for i in order {
-        let k = key(i);
+        let k = dedup_key(i);
         if prev != Some(k) {
             unique.push(points[i as usize] + Vec2::new(0.0, 0.0));
             prev = Some(k);
