@@ -70,7 +70,7 @@ fn main() {
         let mut best = f64::INFINITY;
         let mut tris = 0;
         let mut peak = 0;
-        let reps = if n <= 16000 { 3 } else { 1 };
+        let reps = if n <= 16000 { 7 } else { 3 };
         for _ in 0..reps {
             let base = LIVE.load(Ordering::Relaxed);
             PEAK.store(base, Ordering::Relaxed);

@@ -8,9 +8,16 @@
 //! becomes two 30-60-90 triangles meeting at the joined hexagon `a+b` (the paper's "half angle
 //! at the centre of the un-subdivided hexagon"); otherwise it is a leaf. The balancing rule
 //! guarantees nothing finer hides inside a leaf. Cost: O(1) expected per output triangle.
+//!
+//! Vertex numbering: corner ids are passed down the recursion, so only the midpoint of a
+//! lattice edge (a joined hexagon) needs a look-up, and exactly the two triangles on either side
+//! of that edge ask for it (conformity, from balancing); one on Ω's boundary is asked for once.
+//! The map therefore forgets a midpoint at its second request and never stores boundary ones:
+//! it holds only the front of the depth-first traversal, stays small and cache-resident, and
+//! the extraction's time per triangle does not grow with the mesh.
 
 use super::hierarchy::Hierarchy;
-use super::lattice::{Axial, DIRS, add, normalize};
+use super::lattice::{Axial, DIRS, add, normalize, on_boundary};
 use super::spatial_hash::LatticeMap;
 use crate::math::Vec2;
 use rustc_hash::FxHashMap;
@@ -30,8 +37,10 @@ pub fn pack(level: u32, v: Axial) -> Key {
 pub struct DualBuilder<'h> {
     h: &'h Hierarchy,
     moved: &'h FxHashMap<Key, Vec2>,
-    /// Vertex index of each lattice key.
-    pub index: LatticeMap<Key, u32>,
+    /// Vertex index of the midpoints requested once so far.
+    open: LatticeMap<Key, u32>,
+    /// Vertex index of every relocated (occupied) centre.
+    pub moved_vertex: FxHashMap<Key, u32>,
     /// Vertex positions: lattice positions, or the input point of an occupied hexagon.
     pub positions: Vec<Vec2>,
     /// Triangles, counter-clockwise.
@@ -44,37 +53,55 @@ impl<'h> DualBuilder<'h> {
     /// per leaf full hexagon, at most two triangles per vertex), so nothing is reallocated.
     pub fn build(h: &'h Hierarchy, moved: &'h FxHashMap<Key, Vec2>) -> Self {
         let leaves = h.leaf_count();
-        let mut index = LatticeMap::default();
-        index.reserve(leaves);
         let mut b = DualBuilder {
             h,
             moved,
-            index,
+            open: LatticeMap::default(),
+            moved_vertex: FxHashMap::default(),
             positions: Vec::with_capacity(leaves),
             triangles: Vec::with_capacity(2 * leaves),
         };
-        let o = b.vertex(1, (0, 0));
-        let corners: [u32; 6] = std::array::from_fn(|i| b.vertex(1, DIRS[i]));
+        let o = b.new_vertex(1, (0, 0));
+        let corners: [u32; 6] = std::array::from_fn(|i| b.new_vertex(1, DIRS[i]));
         for i in 0..6 {
             let j = (i + 1) % 6;
             b.emit(1, [(0, 0), DIRS[i], DIRS[j]], [o, corners[i], corners[j]]);
         }
+        debug_assert!(
+            b.open.is_empty(),
+            "a joined hexagon was requested only once"
+        );
         b
     }
 
-    fn vertex(&mut self, level: u32, v: Axial) -> u32 {
-        let key = pack(level, v);
+    fn new_vertex(&mut self, level: u32, v: Axial) -> u32 {
         let n = self.positions.len() as u32;
-        let (h, moved, positions) = (self.h, self.moved, &mut self.positions);
-        *self.index.entry(key).or_insert_with(|| {
-            positions.push(
-                moved
-                    .get(&key)
-                    .copied()
-                    .unwrap_or_else(|| h.frame.position(level, v)),
-            );
-            n
-        })
+        let key = pack(level, v);
+        let p = match self.moved.get(&key) {
+            Some(&p) => {
+                self.moved_vertex.insert(key, n);
+                p
+            }
+            None => self.h.frame.position(level, v),
+        };
+        self.positions.push(p);
+        n
+    }
+
+    /// The vertex of the joined hexagon `v` at `level` (a lattice-edge midpoint).
+    fn midpoint(&mut self, level: u32, v: Axial) -> u32 {
+        if on_boundary(level, v) {
+            return self.new_vertex(level, v);
+        }
+        let key = pack(level, v);
+        match self.open.remove(&key) {
+            Some(i) => i,
+            None => {
+                let i = self.new_vertex(level, v);
+                self.open.insert(key, i);
+                i
+            }
+        }
     }
 
     /// Emits the lattice triangle `t` at level `k` (counter-clockwise) whose corner vertex
@@ -91,9 +118,9 @@ impl<'h> DualBuilder<'h> {
             [true, true, true] => {
                 let (ab, bc, ca) = (add(a, b), add(b, c), add(c, a));
                 let (iab, ibc, ica) = (
-                    self.vertex(k + 1, ab),
-                    self.vertex(k + 1, bc),
-                    self.vertex(k + 1, ca),
+                    self.midpoint(k + 1, ab),
+                    self.midpoint(k + 1, bc),
+                    self.midpoint(k + 1, ca),
                 );
                 let (a2, b2, c2) = ((2 * a.0, 2 * a.1), (2 * b.0, 2 * b.1), (2 * c.0, 2 * c.1));
                 let [ia, ib, ic] = ids;
@@ -112,7 +139,7 @@ impl<'h> DualBuilder<'h> {
     /// Corners `a`, `b` split, the third not (counter-clockwise a, b, c; `ids` in that order):
     /// two right triangles meeting at the joined hexagon `a + b`.
     fn bisect(&mut self, k: u32, a: Axial, b: Axial, ids: [u32; 3]) {
-        let m = self.vertex(k + 1, add(a, b));
+        let m = self.midpoint(k + 1, add(a, b));
         let [va, vb, vc] = ids;
         self.triangles.push([va, m, vc]);
         self.triangles.push([m, vb, vc]);

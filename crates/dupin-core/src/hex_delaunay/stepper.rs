@@ -283,7 +283,7 @@ impl HexDelaunayStepper {
         let unique_vertex: Vec<u32> = point_key
             .iter()
             .map(|k| {
-                k.and_then(|k| dual.index.get(&k).copied())
+                k.and_then(|k| dual.moved_vertex.get(&k).copied())
                     .unwrap_or(u32::MAX)
             })
             .collect();
