@@ -18,7 +18,6 @@
 
 use super::hierarchy::Hierarchy;
 use super::lattice::{Axial, DIRS, add, normalize, on_boundary};
-use super::spatial_hash::LatticeMap;
 use crate::math::Vec2;
 use rustc_hash::FxHashMap;
 
@@ -38,7 +37,7 @@ pub struct DualBuilder<'h> {
     h: &'h Hierarchy,
     moved: &'h FxHashMap<Key, Vec2>,
     /// Vertex index of the midpoints requested once so far.
-    open: LatticeMap<Key, u32>,
+    open: FxHashMap<Key, u32>,
     /// Vertex index of every relocated (occupied) centre.
     pub moved_vertex: FxHashMap<Key, u32>,
     /// Vertex positions: lattice positions, or the input point of an occupied hexagon.
@@ -56,7 +55,7 @@ impl<'h> DualBuilder<'h> {
         let mut b = DualBuilder {
             h,
             moved,
-            open: LatticeMap::default(),
+            open: FxHashMap::default(),
             moved_vertex: FxHashMap::default(),
             positions: Vec::with_capacity(leaves),
             triangles: Vec::with_capacity(2 * leaves),

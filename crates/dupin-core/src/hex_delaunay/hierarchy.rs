@@ -20,8 +20,8 @@ use super::error::HexDelaunayError;
 use super::lattice::{
     Axial, DIRS, Frame, add, in_domain, is_even, on_boundary, parents_of_midpoint,
 };
-use super::spatial_hash::LatticeSet;
 use crate::math::Vec2;
+use rustc_hash::FxHashSet;
 
 /// A leaf cell of the hexagon mesh.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -38,7 +38,7 @@ pub enum Cell {
 pub struct Hierarchy {
     /// Placement of the lattice.
     pub frame: Frame,
-    split: Vec<LatticeSet<Axial>>,
+    split: Vec<FxHashSet<Axial>>,
     /// Deepest level a hexagon may be split at.
     pub max_level: u32,
     /// Number of split hexagons.
@@ -48,7 +48,7 @@ pub struct Hierarchy {
 impl Hierarchy {
     /// A hierarchy whose root hexagon is split (so Ω is covered by the seven level-1 hexagons).
     pub fn new(frame: Frame, max_level: u32) -> Self {
-        let mut root = LatticeSet::default();
+        let mut root = FxHashSet::default();
         root.insert((0, 0));
         Hierarchy {
             frame,
@@ -136,7 +136,7 @@ impl Hierarchy {
         }
         if self.split.len() <= level as usize {
             self.split
-                .resize_with(level as usize + 1, LatticeSet::default);
+                .resize_with(level as usize + 1, FxHashSet::default);
         }
         self.split[level as usize].insert(v);
         self.split_count += 1;

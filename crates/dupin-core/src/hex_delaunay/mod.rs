@@ -31,7 +31,6 @@ mod lattice;
 mod min_enclosing_circle;
 mod quality;
 mod simple_refinement;
-mod spatial_hash;
 mod stepper;
 
 pub use error::HexDelaunayError;

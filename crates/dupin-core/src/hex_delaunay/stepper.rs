@@ -325,7 +325,7 @@ fn check_points(points: &[Vec2]) -> Result<(Vec<Vec2>, Vec<u32>), HexDelaunayErr
         }
     }
     // Distinct points in Morton (Z-curve) order, so that refinement works through space
-    // coherently and the locality-preserving hash tables stay cache-friendly.
+    // coherently.
     let (mut lo, mut hi) = (points[0], points[0]);
     for p in points {
         lo = lo.inf(p);
