@@ -204,3 +204,54 @@ impl Refinement {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::lattice::{in_domain, on_boundary};
+    use super::super::tests::{FAMILIES, sample};
+    use super::*;
+    use crate::HexDelaunayStepper;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+
+    /// Section 4.1's final state and section 3.3's balancing rule, checked on the hierarchy.
+    #[test]
+    fn final_state_rings_and_balance() {
+        let mut rng = ChaCha8Rng::seed_from_u64(31);
+        for case in 0..900 {
+            let pts = sample(FAMILIES[case % FAMILIES.len()], &mut rng);
+            let mut s =
+                HexDelaunayStepper::new(&pts, &[], crate::HexDelaunayMode::Simple).unwrap();
+            s.run().unwrap();
+            let r = s.refinement();
+            let h = &r.hierarchy;
+            // Balancing: every split hexagon has its six neighbours (inside Ω) present, i.e.
+            // adjacent cells differ by at most one paper level.
+            for k in 0..h.depth() {
+                for &x in h.split_at(k) {
+                    assert!(h.is_present(k, x), "case {case}: split but absent");
+                    for d in DIRS {
+                        let y = add(x, d);
+                        if in_domain(k, y) {
+                            assert!(h.is_present(k, y), "case {case}: unbalanced at {k} {x:?}");
+                        }
+                    }
+                }
+            }
+            // Every occupied cell is an interior full hexagon with one point, inside a ring of
+            // six present, unsplit, unoccupied full hexagons of its level.
+            for c in &r.cell_of {
+                let Cell::Full(k, x) = *c else {
+                    panic!("case {case}: a point ends in a semi-hexagon");
+                };
+                assert_eq!(r.occupied(c), 1, "case {case}");
+                assert!(!on_boundary(k, x), "case {case}");
+                for d in DIRS {
+                    let y = add(x, d);
+                    assert!(h.is_present(k, y) && !h.is_split(k, y), "case {case}");
+                    assert_eq!(r.occupied(&Cell::Full(k, y)), 0, "case {case}");
+                }
+            }
+        }
+    }
+}

@@ -178,6 +178,11 @@ impl HexDelaunayStepper {
         Ok(())
     }
 
+    #[cfg(test)]
+    pub(crate) fn refinement(&self) -> &Refinement {
+        &self.refinement
+    }
+
     /// Runs all remaining steps.
     pub fn run(&mut self) -> Result<(), HexDelaunayError> {
         self.refinement.run()
