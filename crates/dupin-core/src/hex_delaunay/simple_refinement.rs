@@ -220,8 +220,7 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(31);
         for case in 0..900 {
             let pts = sample(FAMILIES[case % FAMILIES.len()], &mut rng);
-            let mut s =
-                HexDelaunayStepper::new(&pts, &[], crate::HexDelaunayMode::Simple).unwrap();
+            let mut s = HexDelaunayStepper::new(&pts, &[], crate::HexDelaunayMode::Simple).unwrap();
             s.run().unwrap();
             let r = s.refinement();
             let h = &r.hierarchy;

@@ -217,8 +217,9 @@ impl HexDelaunayStepper {
         self.refinement.hierarchy.frame.domain_corners()
     }
 
-    /// The current leaf cells (full and semi-hexagons) clipped to nothing: boundary cells are
-    /// drawn whole, as the paper's virtual full hexagons.
+    /// The current leaf cells (full and semi-hexagons). Boundary cells, whose centres lie on
+    /// Ω's edges, are returned whole, as the paper's virtual full hexagons (half of each lies
+    /// outside Ω).
     pub fn cells(&self) -> Vec<HexCell> {
         let h = &self.refinement.hierarchy;
         let f = &h.frame;
