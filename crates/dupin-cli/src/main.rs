@@ -6,6 +6,7 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 mod common;
+mod hexdelaunay;
 mod surface_info;
 
 /// Planar-panel geometry for architecture.
@@ -20,11 +21,14 @@ struct Cli {
 enum Command {
     /// Position, normal and curvature of a library surface at (U, V), as JSON.
     SurfaceInfo(surface_info::SurfaceInfoArgs),
+    /// Hexagonal Delaunay triangulation of a point set (angles in [30, 120] degrees).
+    Hexdelaunay(hexdelaunay::HexDelaunayArgs),
 }
 
 fn run(cli: Cli) -> Result<(), common::CliError> {
     match cli.command {
         Command::SurfaceInfo(args) => surface_info::run(args),
+        Command::Hexdelaunay(args) => hexdelaunay::run(args),
     }
 }
 

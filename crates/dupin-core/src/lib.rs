@@ -20,11 +20,13 @@
 mod curvature;
 mod dupin_center;
 mod dupin_indicatrix;
+mod hex_delaunay;
 mod ideal_triangle;
 mod math;
 mod mesh;
 mod obj;
 mod planarity;
+mod point_set;
 mod polygon;
 mod render_buffers;
 mod surface;
@@ -37,6 +39,11 @@ pub use dupin_center::{
     dupin_conic_through,
 };
 pub use dupin_indicatrix::{DupinConic, DupinIndicatrix, IndicatrixError};
+pub use hex_delaunay::{
+    Circle, HexCell, HexDelaunayError, HexDelaunayMode, HexDelaunayStepper, HexTriangulation,
+    MAX_COORDINATE, MAX_LEVEL, MIN_EXTENT, TriangulationQuality, hex_delaunay,
+    min_enclosing_circle, triangulation_quality,
+};
 pub use ideal_triangle::{
     IdealTriangle, IdealTriangleError, ideal_apex_3d, ideal_triangle,
     is_affine_quasi_regular_hexagon, is_affine_regular_hexagon,
@@ -45,6 +52,7 @@ pub use math::{Vec2, Vec3};
 pub use mesh::{MeshError, PolyMesh};
 pub use obj::{ObjError, parse_obj, write_obj};
 pub use planarity::{face_planarity, max_planarity};
+pub use point_set::{PointSetError, parse_points, parse_segments};
 pub use polygon::{PolygonError, is_simple_polygon, segments_intersect, strictly_inside_triangle};
 pub use render_buffers::{TriangleBuffers, sample_surface};
 pub use surface::{

@@ -1,0 +1,85 @@
+//! `dupin hexdelaunay`: hexagonal Delaunay triangulation of a point set (contract:
+//! `--points pts.txt [--segments segs.txt] [--mode simple|extended] --out tri.obj
+//! [--report r.json]`).
+
+use crate::common::{CliError, read_text, write_report, write_text};
+use clap::{Args, ValueEnum};
+use dupin_core::{
+    HexDelaunayMode, hex_delaunay, parse_points, parse_segments, triangulation_quality, write_obj,
+};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Refinement mode.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum Mode {
+    /// Section 4: angles in [30, 120] degrees.
+    Simple,
+    /// Section 5: angles in [43.9, 90] degrees (not implemented yet).
+    Extended,
+}
+
+/// Arguments of `dupin hexdelaunay`.
+#[derive(Args, Debug)]
+pub struct HexDelaunayArgs {
+    /// Points file: one `x y` per line, `#` comments and blank lines ignored.
+    #[arg(long)]
+    points: PathBuf,
+    /// Segments file: one `i j` per line, 0-based indices into the points file.
+    #[arg(long)]
+    segments: Option<PathBuf>,
+    /// Refinement mode.
+    #[arg(long, value_enum, default_value = "simple")]
+    mode: Mode,
+    /// Output OBJ (triangles, z = 0).
+    #[arg(long)]
+    out: PathBuf,
+    /// JSON report file.
+    #[arg(long)]
+    report: Option<PathBuf>,
+}
+
+/// Runs the command.
+pub fn run(args: HexDelaunayArgs) -> Result<(), CliError> {
+    let points_path = args.points.display().to_string();
+    let points =
+        parse_points(&read_text(&args.points)?).map_err(|e| CliError::input(&points_path, e))?;
+    if points.is_empty() {
+        return Err(CliError::Input(format!("{points_path}: no points")));
+    }
+    let segments = match &args.segments {
+        Some(p) => parse_segments(&read_text(p)?)
+            .map_err(|e| CliError::input(&p.display().to_string(), e))?,
+        None => Vec::new(),
+    };
+    let mode = match args.mode {
+        Mode::Simple => HexDelaunayMode::Simple,
+        Mode::Extended => HexDelaunayMode::Extended,
+    };
+    let start = Instant::now();
+    let tri = hex_delaunay(&points, &segments, mode).map_err(|e| CliError::input("", e))?;
+    let seconds = start.elapsed().as_secs_f64();
+    let q = triangulation_quality(&tri.vertices, &tri.triangles);
+    write_text(&args.out, &write_obj(&tri.to_mesh()))?;
+    let report = serde_json::json!({
+        "input_points": points.len(),
+        "vertices": tri.vertices.len(),
+        "triangles": tri.triangles.len(),
+        "min_angle_deg": q.min_angle_deg,
+        "max_angle_deg": q.max_angle_deg,
+        "delaunay": q.is_delaunay(),
+        "seconds": seconds,
+    });
+    write_report(args.report.as_deref(), &report)?;
+    println!(
+        "hexdelaunay: {} points -> {} vertices, {} triangles, angles {:.4}..{:.4} deg, delaunay {}, {:.3} s",
+        points.len(),
+        tri.vertices.len(),
+        tri.triangles.len(),
+        q.min_angle_deg,
+        q.max_angle_deg,
+        q.is_delaunay(),
+        seconds
+    );
+    Ok(())
+}

@@ -1,0 +1,133 @@
+//! End-to-end tests of `dupin hexdelaunay`.
+
+use std::path::PathBuf;
+use std::process::Command;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+static COUNTER: AtomicUsize = AtomicUsize::new(0);
+
+fn temp(name: &str, content: Option<&str>) -> PathBuf {
+    let n = COUNTER.fetch_add(1, Ordering::SeqCst);
+    let p = std::env::temp_dir().join(format!("dupin-hexd-{}-{n}-{name}", std::process::id()));
+    if let Some(c) = content {
+        std::fs::write(&p, c).unwrap();
+    }
+    p
+}
+
+fn run(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_dupin"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn bad(points: &str, segments: Option<&str>, extra: &[&str]) -> String {
+    let pts = temp("pts.txt", Some(points));
+    let out = temp("out.obj", None);
+    let mut args = vec![
+        "hexdelaunay",
+        "--points",
+        pts.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    let segs = segments.map(|s| temp("segs.txt", Some(s)));
+    if let Some(s) = &segs {
+        args.extend(["--segments", s.to_str().unwrap()]);
+    }
+    args.extend(extra);
+    let (code, stdout, stderr) = run(&args);
+    assert_eq!(code, 2, "stdout {stdout} stderr {stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.starts_with("error:"), "{stderr}");
+    assert!(!stderr.contains("panicked"));
+    stderr
+}
+
+#[test]
+fn triangulates_and_reports_contract_fields() {
+    let text = "# points\n0 0\n1 0\n0.25 0.5\n\n0.7 0.9\n0.7 0.9\n0.123456789012345678 0.3\n";
+    let pts = temp("pts.txt", Some(text));
+    let out = temp("out.obj", None);
+    let rep = temp("r.json", None);
+    let (code, stdout, stderr) = run(&[
+        "hexdelaunay",
+        "--points",
+        pts.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--report",
+        rep.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert_eq!(stdout.lines().count(), 1);
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&rep).unwrap()).unwrap();
+    let keys: Vec<&String> = r.as_object().unwrap().keys().collect();
+    let mut expected = [
+        "input_points",
+        "vertices",
+        "triangles",
+        "min_angle_deg",
+        "max_angle_deg",
+        "delaunay",
+        "seconds",
+    ];
+    expected.sort();
+    let mut keys: Vec<&str> = keys.iter().map(|s| s.as_str()).collect();
+    keys.sort();
+    assert_eq!(keys, expected);
+    assert_eq!(r["input_points"], 6);
+    assert!(r["min_angle_deg"].as_f64().unwrap() >= 29.99);
+    assert!(r["max_angle_deg"].as_f64().unwrap() <= 120.01);
+    assert_eq!(r["delaunay"], true);
+    assert!(r["seconds"].as_f64().unwrap() >= 0.0);
+    let mesh = dupin_core::parse_obj(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    assert_eq!(mesh.num_vertices() as u64, r["vertices"].as_u64().unwrap());
+    assert_eq!(mesh.num_faces() as u64, r["triangles"].as_u64().unwrap());
+    for p in dupin_core::parse_points(text).unwrap() {
+        assert!(
+            mesh.positions
+                .iter()
+                .any(|v| v.x == p.x && v.y == p.y && v.z == 0.0),
+            "input point {p:?} is not an exact vertex"
+        );
+    }
+    assert!(mesh.positions.iter().all(|v| v.z == 0.0));
+}
+
+#[test]
+fn bad_input_exits_2_with_one_error_line() {
+    assert!(bad("", None, &[]).contains("no points"));
+    assert!(bad("# only a comment\n\n", None, &[]).contains("no points"));
+    assert!(bad("0 0\n1 1\n2 x\n", None, &[]).contains("line 3"));
+    assert!(bad("0 0\n1\n", None, &[]).contains("line 2"));
+    assert!(bad("0 0\nnan 1\n", None, &[]).contains("line 2"));
+    assert!(bad("0 0\n1 inf\n", None, &[]).contains("line 2"));
+    assert!(bad("0 0\n1e300 0\n", None, &[]).contains("magnitude"));
+    assert!(bad("0 0\n1e-300 0\n", None, &[]).contains("span"));
+    assert!(bad("1e6 0\n1000000.000000001 0\n", None, &[]).contains("depth cap"));
+    let square = "0 0\n1 1\n0 1\n1 0\n";
+    assert!(bad(square, Some("0 1\n2 3\n"), &[]).contains("cross"));
+    assert!(bad(square, Some("0 9\n"), &[]).contains("point 9"));
+    assert!(bad(square, Some("0 1\nx\n"), &[]).contains("line 2"));
+    assert!(bad(square, None, &["--mode", "extended"]).contains("not implemented"));
+    assert!(bad(square, None, &["--mode", "fancy"]).contains("error"));
+    let missing = temp("missing.txt", None);
+    let out = temp("out.obj", None);
+    let (code, _, stderr) = run(&[
+        "hexdelaunay",
+        "--points",
+        missing.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2);
+    assert!(stderr.starts_with("error:"));
+}

@@ -1,0 +1,51 @@
+//! Criterion benchmarks of the hexagonal Delaunay triangulation (simple refinement) on seeded
+//! uniform points, with spade's constrained Delaunay refinement at its default 30° bound on the
+//! same points as the peer. Run: `cargo bench -p dupin-core --bench hex_delaunay -- --quick`.
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use dupin_core::{HexDelaunayMode, Vec2, hex_delaunay};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use spade::{ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation};
+use std::hint::black_box;
+
+fn uniform(n: usize) -> Vec<Vec2> {
+    let mut rng = ChaCha8Rng::seed_from_u64(n as u64);
+    (0..n)
+        .map(|_| Vec2::new(rng.random::<f64>(), rng.random::<f64>()))
+        .collect()
+}
+
+fn spade_refine(points: &[Vec2]) -> usize {
+    let v: Vec<Point2<f64>> = points.iter().map(|p| Point2::new(p.x, p.y)).collect();
+    let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::bulk_load_cdt(v, vec![])
+        .expect("finite points");
+    cdt.refine(RefinementParameters::default());
+    cdt.num_inner_faces()
+}
+
+fn bench(c: &mut Criterion) {
+    let mut g = c.benchmark_group("hex_delaunay");
+    g.sample_size(10);
+    for n in [2000usize, 16000] {
+        let pts = uniform(n);
+        let ours = hex_delaunay(&pts, &[], HexDelaunayMode::Simple)
+            .expect("valid input")
+            .triangles
+            .len();
+        let theirs = spade_refine(&pts);
+        eprintln!("{n} points: hex_delaunay {ours} triangles, spade 30deg {theirs} triangles");
+        g.bench_with_input(BenchmarkId::new("simple", n), &pts, |b, p| {
+            b.iter(|| {
+                hex_delaunay(black_box(p), &[], HexDelaunayMode::Simple).map(|t| t.triangles.len())
+            })
+        });
+        g.bench_with_input(BenchmarkId::new("spade_refine_30deg", n), &pts, |b, p| {
+            b.iter(|| spade_refine(black_box(p)))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,129 @@
+//! Scaling study for the hexagonal Delaunay triangulation: time and peak heap memory against
+//! output triangles for 1k..64k uniform points, the fitted exponent, and spade's 30° refinement
+//! on the same points. Run: `cargo run --release -p dupin-core --example hexd_scaling`.
+
+use dupin_core::{HexDelaunayMode, Vec2, hex_delaunay};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
+
+/// Counts live heap bytes and their peak.
+struct Counting;
+static LIVE: AtomicUsize = AtomicUsize::new(0);
+static PEAK: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let p = unsafe { System.alloc(layout) };
+        if !p.is_null() {
+            let now = LIVE.fetch_add(layout.size(), Ordering::Relaxed) + layout.size();
+            PEAK.fetch_max(now, Ordering::Relaxed);
+        }
+        p
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) };
+        LIVE.fetch_sub(layout.size(), Ordering::Relaxed);
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn uniform(n: usize, seed: u64) -> Vec<Vec2> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    (0..n)
+        .map(|_| Vec2::new(rng.random::<f64>(), rng.random::<f64>()))
+        .collect()
+}
+
+fn spade_refine(points: &[Vec2]) -> (usize, f64) {
+    use spade::{ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation};
+    let start = Instant::now();
+    let v: Vec<Point2<f64>> = points.iter().map(|p| Point2::new(p.x, p.y)).collect();
+    let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::bulk_load_cdt(v, vec![])
+        .expect("finite points");
+    cdt.refine(RefinementParameters::default());
+    (cdt.num_inner_faces(), start.elapsed().as_secs_f64())
+}
+
+fn main() {
+    let sizes = [1000usize, 2000, 4000, 8000, 16000, 32000, 64000];
+    let mut xs = Vec::new();
+    let mut ys = Vec::new();
+    println!(
+        "{:>7} {:>10} {:>9} {:>10} {:>12} {:>9} | {:>10} {:>9}",
+        "points", "triangles", "seconds", "ns/tri", "peak MB", "B/tri", "spade tri", "spade s"
+    );
+    for &n in &sizes {
+        let pts = uniform(n, n as u64);
+        if let Ok(dir) = std::env::var("HEXD_DUMP") {
+            // The same points for an outside comparison (e.g. Triangle): one `x y` per line.
+            let text: String = pts
+                .iter()
+                .map(|p| format!("{:?} {:?}\n", p.x, p.y))
+                .collect();
+            std::fs::write(format!("{dir}/uniform_{n}.txt"), text).expect("writable dump dir");
+        }
+        let mut best = f64::INFINITY;
+        let mut tris = 0;
+        let mut peak = 0;
+        let reps = if n <= 16000 { 7 } else { 3 };
+        for _ in 0..reps {
+            let base = LIVE.load(Ordering::Relaxed);
+            PEAK.store(base, Ordering::Relaxed);
+            let start = Instant::now();
+            let t = hex_delaunay(&pts, &[], HexDelaunayMode::Simple).expect("valid input");
+            let s = start.elapsed().as_secs_f64();
+            peak = PEAK.load(Ordering::Relaxed) - base;
+            best = best.min(s);
+            tris = t.triangles.len();
+        }
+        let (st, ss) = spade_refine(&pts);
+        println!(
+            "{:>7} {:>10} {:>9.4} {:>10.1} {:>12.1} {:>9.1} | {:>10} {:>9.4}",
+            n,
+            tris,
+            best,
+            best * 1e9 / tris as f64,
+            peak as f64 / 1e6,
+            peak as f64 / tris as f64,
+            st,
+            ss
+        );
+        xs.push((tris as f64).ln());
+        ys.push(best.ln());
+    }
+    let m = xs.len() as f64;
+    let (sx, sy) = (xs.iter().sum::<f64>() / m, ys.iter().sum::<f64>() / m);
+    let slope = xs
+        .iter()
+        .zip(&ys)
+        .map(|(x, y)| (x - sx) * (y - sy))
+        .sum::<f64>()
+        / xs.iter().map(|x| (x - sx).powi(2)).sum::<f64>();
+    if std::env::var("HEXD_PHASES").is_ok() {
+        for &n in &[16000usize, 64000] {
+            let pts = uniform(n, n as u64);
+            let t0 = Instant::now();
+            let mut s =
+                dupin_core::HexDelaunayStepper::new(&pts, &[], HexDelaunayMode::Simple).unwrap();
+            let t1 = Instant::now();
+            s.run().unwrap();
+            let t2 = Instant::now();
+            let tri = s.triangulation();
+            let t3 = Instant::now();
+            println!(
+                "{n}: setup {:.4} refine {:.4} dual {:.4} splits {} tris {}",
+                (t1 - t0).as_secs_f64(),
+                (t2 - t1).as_secs_f64(),
+                (t3 - t2).as_secs_f64(),
+                s.split_count(),
+                tri.triangles.len()
+            );
+        }
+    }
+    println!("fitted exponent of time against triangles (1k..64k points): {slope:.3}");
+}

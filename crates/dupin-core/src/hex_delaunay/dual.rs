@@ -1,0 +1,146 @@
+//! Dual mesh extraction (section 4.2).
+//!
+//! Every full hexagon's centre is joined to its full neighbours' centres, and across a
+//! semi-hexagon to the centre of the semi-hexagon's opposite full hexagon; occupied centres are
+//! then moved to their input point. On the lattice this dual is a recursive refinement of Ω's six
+//! level-1 equilateral triangles: a level-`k` lattice triangle whose three corner hexagons are
+//! split becomes its four level-`k+1` children; with exactly two split corners `a`, `b` it
+//! becomes two 30-60-90 triangles meeting at the joined hexagon `a+b` (the paper's "half angle
+//! at the centre of the un-subdivided hexagon"); otherwise it is a leaf. The balancing rule
+//! guarantees nothing finer hides inside a leaf. Cost: O(1) expected per output triangle.
+//!
+//! Vertex numbering: corner ids are passed down the recursion, so only the midpoint of a
+//! lattice edge (a joined hexagon) needs a look-up, and exactly the two triangles on either side
+//! of that edge ask for it (conformity, from balancing); one on Ω's boundary is asked for once.
+//! The map therefore forgets a midpoint at its second request and never stores boundary ones:
+//! it holds only the front of the depth-first traversal, stays small and cache-resident, and
+//! the extraction's time per triangle does not grow with the mesh.
+
+use super::hierarchy::Hierarchy;
+use super::lattice::{Axial, DIRS, add, normalize, on_boundary};
+use crate::math::Vec2;
+use rustc_hash::FxHashMap;
+
+/// A normalised lattice position packed into 16 bytes: `(a + 2^50 | level << 56, b)`, the
+/// coordinates' low bits kept low for the locality-preserving hash.
+pub type Key = (i64, i64);
+
+/// Packs a normalised `(level, v)` (level < 64, |a| < 2^50).
+#[inline]
+pub fn pack(level: u32, v: Axial) -> Key {
+    let (l, v) = normalize(level, v);
+    ((v.0 + (1 << 50)) | ((l as i64) << 56), v.1)
+}
+
+/// The dual triangles and vertex positions of a hexagon mesh.
+pub struct DualBuilder<'h> {
+    h: &'h Hierarchy,
+    moved: &'h FxHashMap<Key, Vec2>,
+    /// Vertex index of the midpoints requested once so far.
+    open: FxHashMap<Key, u32>,
+    /// Vertex index of every relocated (occupied) centre.
+    pub moved_vertex: FxHashMap<Key, u32>,
+    /// Vertex positions: lattice positions, or the input point of an occupied hexagon.
+    pub positions: Vec<Vec2>,
+    /// Triangles, counter-clockwise.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl<'h> DualBuilder<'h> {
+    /// Extracts the dual triangulation of the hierarchy's current hexagon mesh; `moved` gives
+    /// the new positions of occupied centres. Storage is reserved exactly up front (one vertex
+    /// per leaf full hexagon, at most two triangles per vertex), so nothing is reallocated.
+    pub fn build(h: &'h Hierarchy, moved: &'h FxHashMap<Key, Vec2>) -> Self {
+        let leaves = h.leaf_count();
+        let mut b = DualBuilder {
+            h,
+            moved,
+            open: FxHashMap::default(),
+            moved_vertex: FxHashMap::default(),
+            positions: Vec::with_capacity(leaves),
+            triangles: Vec::with_capacity(2 * leaves),
+        };
+        let o = b.new_vertex(1, (0, 0));
+        let corners: [u32; 6] = std::array::from_fn(|i| b.new_vertex(1, DIRS[i]));
+        for i in 0..6 {
+            let j = (i + 1) % 6;
+            b.emit(1, [(0, 0), DIRS[i], DIRS[j]], [o, corners[i], corners[j]]);
+        }
+        debug_assert!(
+            b.open.is_empty(),
+            "a joined hexagon was requested only once"
+        );
+        b
+    }
+
+    fn new_vertex(&mut self, level: u32, v: Axial) -> u32 {
+        let n = self.positions.len() as u32;
+        let key = pack(level, v);
+        let p = match self.moved.get(&key) {
+            Some(&p) => {
+                self.moved_vertex.insert(key, n);
+                p
+            }
+            None => self.h.frame.position(level, v),
+        };
+        self.positions.push(p);
+        n
+    }
+
+    /// The vertex of the joined hexagon `v` at `level` (a lattice-edge midpoint).
+    fn midpoint(&mut self, level: u32, v: Axial) -> u32 {
+        if on_boundary(level, v) {
+            return self.new_vertex(level, v);
+        }
+        let key = pack(level, v);
+        match self.open.remove(&key) {
+            Some(i) => i,
+            None => {
+                let i = self.new_vertex(level, v);
+                self.open.insert(key, i);
+                i
+            }
+        }
+    }
+
+    /// Emits the lattice triangle `t` at level `k` (counter-clockwise) whose corner vertex
+    /// indices `ids` are known: only new midpoints are looked up, about one hash look-up per
+    /// output triangle.
+    fn emit(&mut self, k: u32, t: [Axial; 3], ids: [u32; 3]) {
+        let [a, b, c] = t;
+        let split = [
+            self.h.is_split(k, a),
+            self.h.is_split(k, b),
+            self.h.is_split(k, c),
+        ];
+        match split {
+            [true, true, true] => {
+                let (ab, bc, ca) = (add(a, b), add(b, c), add(c, a));
+                let (iab, ibc, ica) = (
+                    self.midpoint(k + 1, ab),
+                    self.midpoint(k + 1, bc),
+                    self.midpoint(k + 1, ca),
+                );
+                let (a2, b2, c2) = ((2 * a.0, 2 * a.1), (2 * b.0, 2 * b.1), (2 * c.0, 2 * c.1));
+                let [ia, ib, ic] = ids;
+                self.emit(k + 1, [a2, ab, ca], [ia, iab, ica]);
+                self.emit(k + 1, [ab, b2, bc], [iab, ib, ibc]);
+                self.emit(k + 1, [ca, bc, c2], [ica, ibc, ic]);
+                self.emit(k + 1, [ab, bc, ca], [iab, ibc, ica]);
+            }
+            [true, true, false] => self.bisect(k, a, b, [ids[0], ids[1], ids[2]]),
+            [false, true, true] => self.bisect(k, b, c, [ids[1], ids[2], ids[0]]),
+            [true, false, true] => self.bisect(k, c, a, [ids[2], ids[0], ids[1]]),
+            _ => self.triangles.push(ids),
+        }
+    }
+
+    /// Corners `a`, `b` split, the third not (counter-clockwise a, b, c; `ids` in that order):
+    /// two right triangles meeting at the joined hexagon `a + b`.
+    fn bisect(&mut self, k: u32, a: Axial, b: Axial, ids: [u32; 3]) {
+        let m = self.midpoint(k + 1, add(a, b));
+        let [va, vb, vc] = ids;
+        self.triangles.push([va, m, vc]);
+        self.triangles.push([m, vb, vc]);
+    }
+}

@@ -1,0 +1,220 @@
+//! The hexagon hierarchy of section 3: split (subdivide) with join of semi-hexagons, the
+//! balancing rule, and point location.
+//!
+//! State: for every level `k`, the set of split full hexagons, in a hash set keyed by lattice
+//! coordinates (the O(n log n) design: every query is O(1) expected, no list scans).
+//! Presence follows from it: a level-`k` lattice point in Ω is a full hexagon iff it is the
+//! central child of a split level-`k-1` hexagon, or the join of the two semi-hexagons of two
+//! adjacent split level-`k-1` hexagons (a parent outside Ω counts as split: the boundary
+//! semi-hexagon is a virtual full hexagon, Fig. 1 right).
+//!
+//! Balancing (section 3.3, "adjacent levels differ by at most one") is equivalent to: every
+//! split hexagon has its six lattice neighbours (inside Ω) present at its own level. Making a
+//! neighbour present splits the full hexagon on the long edge of the semi-hexagon in the way
+//! (the paper's "opposite neighbour"), recursively.
+//!
+//! Split counters, merge and break (section 3.2) serve coarsening, which only the extended
+//! refinement's blossoms use; they are not implemented (see the module docs of `mod.rs`).
+
+use super::error::HexDelaunayError;
+use super::lattice::{
+    Axial, DIRS, Frame, add, in_domain, is_even, on_boundary, parents_of_midpoint,
+};
+use crate::math::Vec2;
+use rustc_hash::FxHashSet;
+
+/// A leaf cell of the hexagon mesh.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Cell {
+    /// An unsplit full hexagon: level and centre.
+    Full(u32, Axial),
+    /// A semi-hexagon: half of the (absent) level-`k` hexagon at the given centre, the half that
+    /// belongs to a split level-`k-1` hexagon whose neighbour across it is unsplit.
+    Semi(u32, Axial),
+}
+
+/// Split sets per level plus the frame that places the lattice.
+#[derive(Debug, Clone)]
+pub struct Hierarchy {
+    /// Placement of the lattice.
+    pub frame: Frame,
+    split: Vec<FxHashSet<Axial>>,
+    /// Deepest level a hexagon may be split at.
+    pub max_level: u32,
+    /// Number of split hexagons.
+    pub split_count: usize,
+}
+
+impl Hierarchy {
+    /// A hierarchy whose root hexagon is split (so Ω is covered by the seven level-1 hexagons).
+    pub fn new(frame: Frame, max_level: u32) -> Self {
+        let mut root = FxHashSet::default();
+        root.insert((0, 0));
+        Hierarchy {
+            frame,
+            split: vec![root],
+            max_level,
+            split_count: 1,
+        }
+    }
+
+    /// Deepest level that has a split hexagon.
+    pub fn depth(&self) -> u32 {
+        self.split.len() as u32
+    }
+
+    /// Whether the hexagon `v` at `level` is split.
+    #[inline]
+    pub fn is_split(&self, level: u32, v: Axial) -> bool {
+        self.split
+            .get(level as usize)
+            .is_some_and(|s| s.contains(&v))
+    }
+
+    /// Whether the lattice point `v` at `level` is a full hexagon (leaf or split).
+    pub fn is_present(&self, level: u32, v: Axial) -> bool {
+        if level == 0 {
+            return v == (0, 0);
+        }
+        if !in_domain(level, v) {
+            return false;
+        }
+        if is_even(v) {
+            return self.is_split(level - 1, (v.0 >> 1, v.1 >> 1));
+        }
+        let (a, b) = parents_of_midpoint(v);
+        [a, b]
+            .into_iter()
+            .all(|e| !in_domain(level - 1, e) || self.is_split(level - 1, e))
+    }
+
+    /// Makes `v` at `level` a full hexagon, splitting what lies on it. New splits are appended
+    /// to `out` in the order they happen.
+    pub fn ensure_present(
+        &mut self,
+        level: u32,
+        v: Axial,
+        out: &mut Vec<(u32, Axial)>,
+    ) -> Result<(), HexDelaunayError> {
+        if level == 0 {
+            return Ok(());
+        }
+        if is_even(v) {
+            return self.ensure_split(level - 1, (v.0 >> 1, v.1 >> 1), out);
+        }
+        let (a, b) = parents_of_midpoint(v);
+        for e in [a, b] {
+            if in_domain(level - 1, e) {
+                self.ensure_split(level - 1, e, out)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Splits the full hexagon `v` at `level`, first making it and its neighbours present
+    /// (balancing rule). New splits are appended to `out` in order; `v` comes last.
+    pub fn ensure_split(
+        &mut self,
+        level: u32,
+        v: Axial,
+        out: &mut Vec<(u32, Axial)>,
+    ) -> Result<(), HexDelaunayError> {
+        if self.is_split(level, v) {
+            return Ok(());
+        }
+        if level >= self.max_level {
+            return Err(HexDelaunayError::DepthLimit {
+                max_level: self.max_level,
+            });
+        }
+        self.ensure_present(level, v, out)?;
+        for d in DIRS {
+            let y = add(v, d);
+            if in_domain(level, y) {
+                self.ensure_present(level, y, out)?;
+            }
+        }
+        if self.split.len() <= level as usize {
+            self.split
+                .resize_with(level as usize + 1, FxHashSet::default);
+        }
+        self.split[level as usize].insert(v);
+        self.split_count += 1;
+        out.push((level, v));
+        Ok(())
+    }
+
+    /// The leaf cell containing `p` (which must lie in Ω). Descends from the root choosing, at
+    /// each level, the nearest of the seven children of the current split hexagon, so a point on
+    /// a shared edge is still assigned consistently to one cell (section 6.3's "first tested").
+    pub fn locate(&self, p: Vec2) -> Cell {
+        self.locate_from(p, 0, (0, 0))
+    }
+
+    /// [`locate`](Self::locate) starting below the split hexagon `a` at `level`, which must
+    /// contain `p`.
+    pub fn locate_from(&self, p: Vec2, mut level: u32, mut a: Axial) -> Cell {
+        loop {
+            let next = level + 1;
+            let mut best = (a.0 * 2, a.1 * 2);
+            let mut best_d = (self.frame.position(next, best) - p).norm_squared();
+            for d in DIRS {
+                let c = add(best_center(a), d);
+                if !in_domain(next, c) {
+                    continue;
+                }
+                let dist = (self.frame.position(next, c) - p).norm_squared();
+                if dist < best_d {
+                    best_d = dist;
+                    best = c;
+                }
+            }
+            if !self.is_present(next, best) {
+                return Cell::Semi(next, best);
+            }
+            if self.is_split(next, best) {
+                level = next;
+                a = best;
+            } else {
+                return Cell::Full(next, best);
+            }
+        }
+    }
+
+    /// Whether `v` at `level` is a boundary (virtual) hexagon.
+    #[inline]
+    pub fn on_boundary(&self, level: u32, v: Axial) -> bool {
+        on_boundary(level, v)
+    }
+
+    /// Number of leaf full hexagons (the dual mesh's vertices): every split hexagon's central
+    /// child continues its position, so this counts the root plus, per split hexagon, its joined
+    /// children (each counted from the parent that `parents_of_midpoint` names first, or from
+    /// the inner parent for a boundary join).
+    pub fn leaf_count(&self) -> usize {
+        let mut n = 1;
+        for (k, set) in self.split.iter().enumerate() {
+            let k = k as u32;
+            for &x in set {
+                for d in DIRS {
+                    let y = add(x, d);
+                    let boundary_join = !in_domain(k, y) && in_domain(k + 1, add(x, y));
+                    if boundary_join || (self.is_split(k, y) && x < y) {
+                        n += 1;
+                    }
+                }
+            }
+        }
+        n
+    }
+
+    /// Iterates over the split hexagons of `level`.
+    pub fn split_at(&self, level: u32) -> impl Iterator<Item = &Axial> {
+        self.split.get(level as usize).into_iter().flatten()
+    }
+}
+
+#[inline]
+fn best_center(a: Axial) -> Axial {
+    (a.0 * 2, a.1 * 2)
+}

@@ -1,0 +1,115 @@
+//! Hexagonal Delaunay triangulation (Sußner & Greiner, "Hexagonal Delaunay Triangulation").
+//!
+//! Input: points in the plane (optionally segments, see below). Output: a triangulation of a
+//! bounding hexagon Ω in which every input point is a vertex with its exact coordinates, dual to
+//! an adaptive hexagon subdivision (sections 3 and 4). With [`HexDelaunayMode::Simple`] every
+//! angle lies in [30°, 120°] and the mesh is Delaunay.
+//!
+//! Bounding hexagon (section 4.1): the minimum enclosing circle (Welzl) of the points, radius
+//! ρ, is the inner circle of the hexagon the paper places around the points; here Ω is that
+//! hexagon enlarged by half (inradius 1.5ρ) and turned by 30°, so that (a) its corners are
+//! hexagon centres and its edges lattice lines, making the dual triangles tile Ω exactly, and
+//! (b) every point is at least ρ/2 from Ω's boundary, so boundary hexagons (the paper's virtual
+//! full hexagons, whose centres stay on Ω's edges) never need refining below the size the
+//! points' spacing requires.
+//!
+//! Data structure (the O(n log n) requirement): split hexagons are kept in one hash set
+//! per level keyed by lattice coordinates, points are re-checked from a work queue only when a
+//! nearby hexagon changes, and the dual is extracted by a recursion over the lattice triangles
+//! that costs O(1) per output triangle. See `hierarchy.rs`, `simple_refinement.rs`, `dual.rs`.
+//!
+//! Not implemented yet (each returns [`HexDelaunayError::Unsupported`] where it is asked for):
+//! the extended refinement of section 5 (43.9°..90°), PSLG input (section 7, segments are
+//! validated, then refused) and the reverse operations with split counters (section 3.2, needed
+//! only for the extended refinement's blossoms). Incremental insertion is
+//! [`HexDelaunayStepper::insert`].
+
+mod dual;
+mod error;
+mod hierarchy;
+mod lattice;
+mod min_enclosing_circle;
+mod quality;
+mod simple_refinement;
+mod stepper;
+
+pub use error::HexDelaunayError;
+pub use min_enclosing_circle::{Circle, min_enclosing_circle};
+pub use quality::{TriangulationQuality, triangulation_quality};
+pub use stepper::{HexCell, HexDelaunayStepper};
+
+use crate::math::{Vec2, Vec3};
+use crate::mesh::PolyMesh;
+
+/// Which refinement to run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum HexDelaunayMode {
+    /// Section 4: angles in [30°, 120°].
+    #[default]
+    Simple,
+    /// Section 5: angles in [43.9°, 90°]. Not implemented yet.
+    Extended,
+}
+
+/// The result of [`hex_delaunay`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct HexTriangulation {
+    /// Vertex positions; input points keep their exact coordinates.
+    pub vertices: Vec<Vec2>,
+    /// Triangles as counter-clockwise vertex index triples.
+    pub triangles: Vec<[u32; 3]>,
+    /// For every input point (duplicates included), the index of its vertex.
+    pub input_vertex: Vec<u32>,
+    /// Corners of the bounding hexagon Ω that the triangles tile, counter-clockwise.
+    pub domain: [Vec2; 6],
+    /// Deepest full-hexagon level reached (the paper's level is twice this).
+    pub depth: u32,
+}
+
+impl HexTriangulation {
+    /// Area of Ω.
+    pub fn domain_area(&self) -> f64 {
+        let c = self.domain;
+        let mut a = 0.0;
+        for i in 1..5 {
+            // Fan from corner 0: differences keep the precision of offset hexagons.
+            a += (c[i] - c[0]).perp(&(c[i + 1] - c[0]));
+        }
+        0.5 * a
+    }
+
+    /// The triangles as a polygon mesh with z = 0 (for OBJ output).
+    pub fn to_mesh(&self) -> PolyMesh {
+        let pos = self
+            .vertices
+            .iter()
+            .map(|p| Vec3::new(p.x, p.y, 0.0))
+            .collect();
+        PolyMesh::new(pos, &self.triangles).expect("triangles index existing distinct vertices")
+    }
+}
+
+/// Largest accepted coordinate magnitude.
+pub const MAX_COORDINATE: f64 = 1e100;
+/// Smallest accepted radius of the points' enclosing circle (unless all points coincide).
+pub const MIN_EXTENT: f64 = 1e-100;
+/// Cap on the full-hexagon levels of the hierarchy.
+pub const MAX_LEVEL: u32 = 48;
+
+/// Triangulates `points` (and, once implemented, the segments `segments`, each a pair of point
+/// indices) by hexagonal subdivision. One-shot form of [`HexDelaunayStepper`].
+///
+/// Errors: empty input, NaN/infinite or out-of-range coordinates, points too close for the
+/// hierarchy depth cap, bad segments, or an unimplemented mode.
+pub fn hex_delaunay(
+    points: &[Vec2],
+    segments: &[[usize; 2]],
+    mode: HexDelaunayMode,
+) -> Result<HexTriangulation, HexDelaunayError> {
+    let mut s = HexDelaunayStepper::new(points, segments, mode)?;
+    s.run()?;
+    Ok(s.triangulation())
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,256 @@
+//! Simple refinement (section 4.1): rules 1 to 5 driven by a work queue of affected points.
+//!
+//! Each point knows its leaf cell; a hash map lists the points of every occupied cell. A point
+//! is (re)checked when it moved to a new cell or when a hexagon next to its cell was split; a
+//! check applies the first rule that fires:
+//!
+//! 1. its cell holds several points → split the cell;
+//! 2. its cell is a semi-hexagon → split the full hexagon on the semi-hexagon's long edge;
+//! 3. a neighbouring full hexagon is occupied → split the cell;
+//! 4. a neighbour is of lower level (a semi-hexagon covers the neighbour position) → split the
+//!    full hexagon on that semi-hexagon's long edge;
+//! 5. a neighbour is of higher level (split) → split the cell;
+//!
+//! 3b. (ours) another occupied hexagon of the same level lies two steps away, sharing a ring
+//!    hexagon → split the cell. Without it two relocated centres can face each other across one
+//!    ring edge with opposite angles up to 120° each, and the dual is not Delaunay (the paper
+//!    claims Delaunay only for the extended refinement, through its 90° bound).
+//!
+//! Added for the bounded domain: a point in a boundary (virtual) hexagon splits it, since a
+//! boundary centre must stay on Ω's boundary for the triangles to tile Ω. The balancing rule
+//! runs inside every split. The queue empties when every occupied cell is a full hexagon holding
+//! one point inside a ring of six unsplit, unoccupied full hexagons of its level — the paper's
+//! final state. Each split costs O(1) expected hash operations plus the re-location of the
+//! points it displaces (O(depth) each), so the whole refinement is O(T + n·depth²) for T output
+//! triangles, n points.
+
+use super::error::HexDelaunayError;
+use super::hierarchy::{Cell, Hierarchy};
+use super::lattice::{Axial, DIRS, add};
+use crate::math::Vec2;
+use rustc_hash::FxHashMap;
+use std::collections::VecDeque;
+
+/// The refinement state: hierarchy, point cells and the work queue.
+#[derive(Debug, Clone)]
+pub struct Refinement {
+    /// The hexagon hierarchy.
+    pub hierarchy: Hierarchy,
+    /// Distinct input points.
+    pub points: Vec<Vec2>,
+    /// Leaf cell of every point.
+    pub cell_of: Vec<Cell>,
+    occupants: FxHashMap<Cell, Vec<u32>>,
+    queue: VecDeque<u32>,
+    queued: Vec<bool>,
+    scratch: Vec<(u32, Axial)>,
+}
+
+enum Action {
+    Split(u32, Axial),
+    Present(u32, Axial),
+}
+
+impl Refinement {
+    /// Locates every point in the (root-split) hierarchy and queues them all.
+    pub fn new(hierarchy: Hierarchy, points: Vec<Vec2>) -> Self {
+        let mut occupants: FxHashMap<Cell, Vec<u32>> = FxHashMap::default();
+        let cell_of: Vec<Cell> = points.iter().map(|p| hierarchy.locate(*p)).collect();
+        for (i, c) in cell_of.iter().enumerate() {
+            occupants.entry(*c).or_default().push(i as u32);
+        }
+        let n = points.len();
+        Refinement {
+            hierarchy,
+            points,
+            cell_of,
+            occupants,
+            queue: (0..n as u32).collect(),
+            queued: vec![true; n],
+            scratch: Vec::new(),
+        }
+    }
+
+    /// Adds a point (inside Ω) to an existing refinement and queues it; refinement resumes with
+    /// the next [`step`](Self::step). Returns its index among the distinct points.
+    pub fn add_point(&mut self, p: Vec2) -> u32 {
+        let i = self.points.len() as u32;
+        self.points.push(p);
+        let c = self.hierarchy.locate(p);
+        self.cell_of.push(c);
+        self.occupants.entry(c).or_default().push(i);
+        self.queued.push(false);
+        self.push(i);
+        i
+    }
+
+    /// Whether the work queue is empty (refinement finished).
+    pub fn is_done(&self) -> bool {
+        self.queue.is_empty()
+    }
+
+    fn push(&mut self, i: u32) {
+        if !self.queued[i as usize] {
+            self.queued[i as usize] = true;
+            self.queue.push_back(i);
+        }
+    }
+
+    fn occupied(&self, c: &Cell) -> usize {
+        self.occupants.get(c).map_or(0, Vec::len)
+    }
+
+    fn check(&self, i: u32) -> Option<Action> {
+        let h = &self.hierarchy;
+        match self.cell_of[i as usize] {
+            Cell::Semi(k, m) => Some(Action::Present(k, m)),
+            Cell::Full(k, x) => {
+                if self.occupied(&Cell::Full(k, x)) >= 2 || h.on_boundary(k, x) {
+                    return Some(Action::Split(k, x));
+                }
+                for d in DIRS {
+                    let y = add(x, d);
+                    if !h.is_present(k, y) {
+                        return Some(Action::Present(k, y));
+                    }
+                }
+                for d in DIRS {
+                    let y = add(x, d);
+                    if h.is_split(k, y) || self.occupied(&Cell::Full(k, y)) > 0 {
+                        return Some(Action::Split(k, x));
+                    }
+                }
+                // Rule 3b (ours): no other occupied hexagon of this level shares a ring
+                // hexagon, else two relocated centres face each other across one ring edge and
+                // the two opposite angles (up to 120° each) break the Delaunay property.
+                for (j, d) in DIRS.iter().enumerate() {
+                    let e = DIRS[(j + 1) % 6];
+                    for z in [add(x, add(*d, *d)), add(x, add(*d, e))] {
+                        if self.occupied(&Cell::Full(k, z)) > 0 && !h.is_split(k, z) {
+                            return Some(Action::Split(k, x));
+                        }
+                    }
+                }
+                None
+            }
+        }
+    }
+
+    /// Processes the queue until at least one hexagon is split (one observable subdivision step,
+    /// including the balancing splits it forces) or the queue is empty. Returns the splits made,
+    /// in order; empty means refinement is finished.
+    pub fn step(&mut self) -> Result<Vec<(u32, Axial)>, HexDelaunayError> {
+        while let Some(i) = self.queue.pop_front() {
+            self.queued[i as usize] = false;
+            let Some(action) = self.check(i) else {
+                continue;
+            };
+            let mut out = std::mem::take(&mut self.scratch);
+            out.clear();
+            match action {
+                Action::Split(k, x) => self.hierarchy.ensure_split(k, x, &mut out)?,
+                Action::Present(k, y) => self.hierarchy.ensure_present(k, y, &mut out)?,
+            }
+            for &(k, x) in &out {
+                self.after_split(k, x);
+            }
+            self.push(i);
+            let made = out.clone();
+            self.scratch = out;
+            if !made.is_empty() {
+                return Ok(made);
+            }
+        }
+        Ok(Vec::new())
+    }
+
+    /// Runs the refinement to the end.
+    pub fn run(&mut self) -> Result<(), HexDelaunayError> {
+        while !self.step()?.is_empty() {}
+        Ok(())
+    }
+
+    fn relocate(&mut self, i: u32, c: Cell) {
+        self.cell_of[i as usize] = c;
+        self.occupants.entry(c).or_default().push(i);
+        self.push(i);
+    }
+
+    /// Re-locates the points displaced by splitting `x` at level `k` and queues the points whose
+    /// rules may now fire.
+    fn after_split(&mut self, k: u32, x: Axial) {
+        let moved = self.occupants.remove(&Cell::Full(k, x)).unwrap_or_default();
+        for i in moved {
+            let c = self.hierarchy.locate_from(self.points[i as usize], k, x);
+            self.relocate(i, c);
+        }
+        for d in DIRS {
+            // Semi-hexagons of split neighbours towards x are now joined into full hexagons.
+            let m = add(x, add(x, d));
+            if let Some(v) = self.occupants.remove(&Cell::Semi(k + 1, m)) {
+                for i in v {
+                    self.relocate(i, Cell::Full(k + 1, m));
+                }
+            }
+        }
+        for d in DIRS {
+            let y = add(x, d);
+            if let Some(v) = self.occupants.get(&Cell::Full(k, y)) {
+                let v = v.clone();
+                for i in v {
+                    self.push(i);
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::lattice::{in_domain, on_boundary};
+    use super::super::tests::{FAMILIES, sample};
+    use super::*;
+    use crate::HexDelaunayStepper;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+
+    /// Section 4.1's final state and section 3.3's balancing rule, checked on the hierarchy.
+    #[test]
+    fn final_state_rings_and_balance() {
+        let mut rng = ChaCha8Rng::seed_from_u64(31);
+        for case in 0..900 {
+            let pts = sample(FAMILIES[case % FAMILIES.len()], &mut rng);
+            let mut s = HexDelaunayStepper::new(&pts, &[], crate::HexDelaunayMode::Simple).unwrap();
+            s.run().unwrap();
+            let r = s.refinement();
+            let h = &r.hierarchy;
+            // Balancing: every split hexagon has its six neighbours (inside Ω) present, i.e.
+            // adjacent cells differ by at most one paper level.
+            for k in 0..h.depth() {
+                for &x in h.split_at(k) {
+                    assert!(h.is_present(k, x), "case {case}: split but absent");
+                    for d in DIRS {
+                        let y = add(x, d);
+                        if in_domain(k, y) {
+                            assert!(h.is_present(k, y), "case {case}: unbalanced at {k} {x:?}");
+                        }
+                    }
+                }
+            }
+            // Every occupied cell is an interior full hexagon with one point, inside a ring of
+            // six present, unsplit, unoccupied full hexagons of its level.
+            for c in &r.cell_of {
+                let Cell::Full(k, x) = *c else {
+                    panic!("case {case}: a point ends in a semi-hexagon");
+                };
+                assert_eq!(r.occupied(c), 1, "case {case}");
+                assert!(!on_boundary(k, x), "case {case}");
+                for d in DIRS {
+                    let y = add(x, d);
+                    assert!(h.is_present(k, y) && !h.is_split(k, y), "case {case}");
+                    assert_eq!(r.occupied(&Cell::Full(k, y)), 0, "case {case}");
+                }
+            }
+        }
+    }
+}

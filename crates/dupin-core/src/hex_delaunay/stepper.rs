@@ -1,0 +1,427 @@
+//! The stepper: the refinement one observable subdivision step at a time, for the page's 2D
+//! view, plus the input checks and bounding-hexagon set-up shared with the one-shot function.
+
+use super::dual::{DualBuilder, Key, pack};
+use super::error::HexDelaunayError;
+use super::hierarchy::{Cell, Hierarchy};
+use super::lattice::{Axial, DIRS, Frame, add, parents_of_midpoint};
+use super::min_enclosing_circle::min_enclosing_circle;
+use super::simple_refinement::Refinement;
+use super::{HexDelaunayMode, HexTriangulation, MAX_COORDINATE, MAX_LEVEL, MIN_EXTENT};
+use crate::math::Vec2;
+use robust::{Coord, orient2d};
+use rustc_hash::FxHashMap;
+
+/// A leaf cell of the current hexagon mesh, for drawing.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HexCell {
+    /// Corners, counter-clockwise (6 for a full hexagon, 4 for a semi-hexagon).
+    pub corners: Vec<Vec2>,
+    /// The paper's level: even for full hexagons, odd for semi-hexagons.
+    pub paper_level: u32,
+    /// Whether an input point lies in the cell.
+    pub occupied: bool,
+}
+
+/// Hexagonal Delaunay triangulation run step by step: each [`step`](Self::step) performs one
+/// refinement-rule subdivision (with the balancing splits it forces).
+#[derive(Debug, Clone)]
+pub struct HexDelaunayStepper {
+    refinement: Refinement,
+    input_map: Vec<u32>,
+    by_bits: FxHashMap<(u64, u64), u32>,
+    last: Vec<(u32, Axial)>,
+    steps: usize,
+}
+
+impl HexDelaunayStepper {
+    /// Checks the input, builds the bounding hexagon and locates the points.
+    pub fn new(
+        points: &[Vec2],
+        segments: &[[usize; 2]],
+        mode: HexDelaunayMode,
+    ) -> Result<Self, HexDelaunayError> {
+        let (unique, input_map) = check_points(points)?;
+        check_segments(points, segments)?;
+        if !segments.is_empty() {
+            return Err(HexDelaunayError::Unsupported(
+                "PSLG segments (section 7); triangulate the points alone",
+            ));
+        }
+        if mode == HexDelaunayMode::Extended {
+            return Err(HexDelaunayError::Unsupported(
+                "extended refinement (section 5, 43.9..90 degrees); use the simple mode",
+            ));
+        }
+        let circle = min_enclosing_circle(&unique).ok_or(HexDelaunayError::Empty)?;
+        let rho = if unique.len() > 1 {
+            if circle.radius < MIN_EXTENT {
+                return Err(HexDelaunayError::TooSmall {
+                    extent: circle.radius,
+                    limit: MIN_EXTENT,
+                });
+            }
+            circle.radius
+        } else {
+            circle.center.x.abs().max(circle.center.y.abs()).max(1.0)
+        };
+        // Ω has inradius 1.5 rho = 3R/4.
+        Self::build(unique, input_map, circle.center, 2.0 * rho)
+    }
+
+    /// Like [`new`](Self::new) but triangulating a given bounding hexagon Ω (centre `center`,
+    /// inradius `inradius`, corners at 30° + 60° i) instead of the one derived from the points'
+    /// enclosing circle, as the paper's "two close points in a unit hexagon" benchmark does.
+    /// Every point must lie strictly inside Ω; the minimum-edge bound then holds only for points
+    /// at least d_min/2 away from Ω's boundary.
+    pub fn new_in_domain(
+        points: &[Vec2],
+        mode: HexDelaunayMode,
+        center: Vec2,
+        inradius: f64,
+    ) -> Result<Self, HexDelaunayError> {
+        let (unique, input_map) = check_points(points)?;
+        if mode == HexDelaunayMode::Extended {
+            return Err(HexDelaunayError::Unsupported(
+                "extended refinement (section 5, 43.9..90 degrees); use the simple mode",
+            ));
+        }
+        let valid = (MIN_EXTENT..=MAX_COORDINATE).contains(&inradius)
+            && center.x.is_finite()
+            && center.y.is_finite();
+        if !valid {
+            return Err(HexDelaunayError::TooSmall {
+                extent: inradius,
+                limit: MIN_EXTENT,
+            });
+        }
+        let mut s = Self::build(Vec::new(), Vec::new(), center, inradius / 0.75)?;
+        s.insert(&unique)?;
+        s.input_map = input_map;
+        Ok(s)
+    }
+
+    fn build(
+        unique: Vec<Vec2>,
+        input_map: Vec<u32>,
+        center: Vec2,
+        root_radius: f64,
+    ) -> Result<Self, HexDelaunayError> {
+        let frame = Frame {
+            origin: center,
+            root_radius,
+        };
+        // Cells finer than 2^-42 of the coordinates' magnitude lose their shape in f64.
+        let scale = center.x.abs().max(center.y.abs()) + root_radius;
+        let by_precision = 42.0 - (scale / root_radius).log2();
+        let max_level = (by_precision.floor().max(0.0) as u32).min(MAX_LEVEL);
+        let hierarchy = Hierarchy::new(frame, max_level);
+        let by_bits = unique
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (bits(p), i as u32))
+            .collect();
+        Ok(HexDelaunayStepper {
+            refinement: Refinement::new(hierarchy, unique),
+            input_map,
+            by_bits,
+            last: Vec::new(),
+            steps: 0,
+        })
+    }
+
+    /// One subdivision step. Returns `Ok(false)` once refinement is finished.
+    pub fn step(&mut self) -> Result<bool, HexDelaunayError> {
+        self.last = self.refinement.step()?;
+        if self.last.is_empty() {
+            Ok(false)
+        } else {
+            self.steps += 1;
+            Ok(true)
+        }
+    }
+
+    /// Incremental insertion (the paper's abstract and section 9): adds further points to the
+    /// current subdivision, which is refined further (never coarsened) by the following steps or
+    /// [`run`](Self::run). The points must lie strictly inside [`domain`](Self::domain), which
+    /// the first batch fixed. They are numbered after all earlier points in
+    /// [`HexTriangulation::input_vertex`]. On error nothing is inserted.
+    pub fn insert(&mut self, points: &[Vec2]) -> Result<(), HexDelaunayError> {
+        let f = self.refinement.hierarchy.frame;
+        // Ω's inradius is 3R/4; its edges' outward normals point at 0°, 60°, ...
+        let inr = 0.75 * f.root_radius;
+        for (index, p) in points.iter().enumerate() {
+            if !p.x.is_finite() || !p.y.is_finite() {
+                return Err(HexDelaunayError::NonFinite { index });
+            }
+            let q = p - f.origin;
+            let inside = (0..6).all(|i| {
+                let t = std::f64::consts::FRAC_PI_3 * i as f64;
+                q.x * t.cos() + q.y * t.sin() < inr
+            });
+            if !inside {
+                return Err(HexDelaunayError::OutsideDomain { index });
+            }
+        }
+        for p in points {
+            let p = p + Vec2::new(0.0, 0.0);
+            let u = match self.by_bits.get(&bits(&p)) {
+                Some(&u) => u,
+                None => {
+                    let u = self.refinement.add_point(p);
+                    self.by_bits.insert(bits(&p), u);
+                    u
+                }
+            };
+            self.input_map.push(u);
+        }
+        Ok(())
+    }
+
+    #[cfg(test)]
+    pub(crate) fn refinement(&self) -> &Refinement {
+        &self.refinement
+    }
+
+    /// Runs all remaining steps.
+    pub fn run(&mut self) -> Result<(), HexDelaunayError> {
+        self.refinement.run()
+    }
+
+    /// Whether refinement is finished.
+    pub fn is_done(&self) -> bool {
+        self.refinement.is_done()
+    }
+
+    /// Number of steps taken through [`step`](Self::step).
+    pub fn steps(&self) -> usize {
+        self.steps
+    }
+
+    /// Number of split hexagons so far (root included).
+    pub fn split_count(&self) -> usize {
+        self.refinement.hierarchy.split_count
+    }
+
+    /// The hexagons split by the last step (centre and circumradius), balancing splits first.
+    pub fn last_splits(&self) -> Vec<(Vec2, f64)> {
+        let f = &self.refinement.hierarchy.frame;
+        self.last
+            .iter()
+            .map(|&(k, v)| (f.position(k, v), f.radius(k)))
+            .collect()
+    }
+
+    /// Corners of the bounding hexagon Ω, counter-clockwise.
+    pub fn domain(&self) -> [Vec2; 6] {
+        self.refinement.hierarchy.frame.domain_corners()
+    }
+
+    /// The current leaf cells (full and semi-hexagons). Boundary cells, whose centres lie on
+    /// Ω's edges, are returned whole, as the paper's virtual full hexagons (half of each lies
+    /// outside Ω).
+    pub fn cells(&self) -> Vec<HexCell> {
+        let h = &self.refinement.hierarchy;
+        let f = &h.frame;
+        let occupied: rustc_hash::FxHashSet<Cell> =
+            self.refinement.cell_of.iter().copied().collect();
+        let mut out = Vec::new();
+        for k in 0..h.depth() {
+            for &x in h.split_at(k) {
+                let c = (2 * x.0, 2 * x.1);
+                if !h.is_split(k + 1, c) {
+                    out.push(HexCell {
+                        corners: f.hexagon(k + 1, c).to_vec(),
+                        paper_level: 2 * (k + 1),
+                        occupied: occupied.contains(&Cell::Full(k + 1, c)),
+                    });
+                }
+                for (j, d) in DIRS.iter().enumerate() {
+                    let m = add(c, *d);
+                    if !super::lattice::in_domain(k + 1, m) {
+                        continue;
+                    }
+                    if h.is_present(k + 1, m) {
+                        let (a, _) = parents_of_midpoint(m);
+                        let first = a == x || !super::lattice::in_domain(k, a);
+                        if first && !h.is_split(k + 1, m) {
+                            out.push(HexCell {
+                                corners: f.hexagon(k + 1, m).to_vec(),
+                                paper_level: 2 * (k + 1),
+                                occupied: occupied.contains(&Cell::Full(k + 1, m)),
+                            });
+                        }
+                    } else {
+                        // The half towards x: corners j+2..=j+5 (corner i at 60i degrees,
+                        // direction d_j at 30 + 60j degrees points away from x).
+                        let hex = f.hexagon(k + 1, m);
+                        let corners = (2..6).map(|i| hex[(j + i) % 6]).collect();
+                        out.push(HexCell {
+                            corners,
+                            paper_level: 2 * k + 1,
+                            occupied: occupied.contains(&Cell::Semi(k + 1, m)),
+                        });
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// The dual triangulation of the current hexagon mesh, occupied centres moved to their
+    /// points. Input points are exact vertices only once refinement is finished.
+    pub fn triangulation(&self) -> HexTriangulation {
+        let h = &self.refinement.hierarchy;
+        let mut moved: FxHashMap<Key, Vec2> = FxHashMap::default();
+        let mut point_key = Vec::with_capacity(self.refinement.points.len());
+        for (i, c) in self.refinement.cell_of.iter().enumerate() {
+            let key = match *c {
+                Cell::Full(k, x) => Some(pack(k, x)),
+                Cell::Semi(..) => None,
+            };
+            if let Some(key) = key {
+                moved.insert(key, self.refinement.points[i]);
+            }
+            point_key.push(key);
+        }
+        let dual = DualBuilder::build(h, &moved);
+        debug_assert_eq!(dual.positions.len(), h.leaf_count());
+        let unique_vertex: Vec<u32> = point_key
+            .iter()
+            .map(|k| {
+                k.and_then(|k| dual.moved_vertex.get(&k).copied())
+                    .unwrap_or(u32::MAX)
+            })
+            .collect();
+        HexTriangulation {
+            vertices: dual.positions,
+            triangles: dual.triangles,
+            input_vertex: self
+                .input_map
+                .iter()
+                .map(|&u| unique_vertex[u as usize])
+                .collect(),
+            domain: h.frame.domain_corners(),
+            depth: h.depth(),
+        }
+    }
+}
+
+fn bits(p: &Vec2) -> (u64, u64) {
+    ((p.x + 0.0).to_bits(), (p.y + 0.0).to_bits())
+}
+
+/// Checks coordinates and removes exact duplicates. Returns the distinct points and, for each
+/// input point, the index of its distinct point.
+fn check_points(points: &[Vec2]) -> Result<(Vec<Vec2>, Vec<u32>), HexDelaunayError> {
+    if points.is_empty() {
+        return Err(HexDelaunayError::Empty);
+    }
+    for (index, p) in points.iter().enumerate() {
+        if !p.x.is_finite() || !p.y.is_finite() {
+            return Err(HexDelaunayError::NonFinite { index });
+        }
+        let m = p.x.abs().max(p.y.abs());
+        if m > MAX_COORDINATE {
+            return Err(HexDelaunayError::TooLarge {
+                index,
+                value: m,
+                limit: MAX_COORDINATE,
+            });
+        }
+    }
+    // Distinct points in Morton (Z-curve) order, so that refinement works through space
+    // coherently.
+    let (mut lo, mut hi) = (points[0], points[0]);
+    for p in points {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    let span = (hi - lo).max().max(f64::MIN_POSITIVE);
+    let morton = |p: &Vec2| {
+        let q = |t: f64| ((t / span) * 1048575.0).clamp(0.0, 1048575.0) as u64;
+        let (mut x, mut y, mut m) = (q(p.x - lo.x), q(p.y - lo.y), 0u64);
+        for bit in 0..20 {
+            m |= ((x & 1) << (2 * bit)) | ((y & 1) << (2 * bit + 1));
+            x >>= 1;
+            y >>= 1;
+        }
+        m
+    };
+    let mut order: Vec<u32> = (0..points.len() as u32).collect();
+    let key = |i: u32| {
+        let p = points[i as usize];
+        // +0.0 and -0.0 are the same point.
+        (morton(&p), (p.x + 0.0).to_bits(), (p.y + 0.0).to_bits())
+    };
+    let dedup_key = |i: u32| {
+        let p = points[i as usize];
+        ((p.x + 0.0).to_bits(), (p.y + 0.0).to_bits())
+    };
+    order.sort_by_cached_key(|&i| key(i));
+    let mut map = vec![0u32; points.len()];
+    let mut unique = Vec::new();
+    let mut prev = None;
+    for i in order {
+        let k = dedup_key(i);
+        if prev != Some(k) {
+            unique.push(points[i as usize] + Vec2::new(0.0, 0.0));
+            prev = Some(k);
+        }
+        map[i as usize] = unique.len() as u32 - 1;
+    }
+    Ok((unique, map))
+}
+
+/// Checks segment indices, lengths and crossings (exact orientation predicates).
+fn check_segments(points: &[Vec2], segments: &[[usize; 2]]) -> Result<(), HexDelaunayError> {
+    for (segment, s) in segments.iter().enumerate() {
+        for &index in s {
+            if index >= points.len() {
+                return Err(HexDelaunayError::SegmentIndex {
+                    segment,
+                    index,
+                    points: points.len(),
+                });
+            }
+        }
+        if points[s[0]] == points[s[1]] {
+            return Err(HexDelaunayError::DegenerateSegment { segment });
+        }
+    }
+    let c = |i: usize| Coord {
+        x: points[i].x,
+        y: points[i].y,
+    };
+    for i in 0..segments.len() {
+        for j in i + 1..segments.len() {
+            let [a, b] = segments[i];
+            let [p, q] = segments[j];
+            let shared = [a, b]
+                .iter()
+                .any(|&u| [p, q].iter().any(|&v| points[u] == points[v]));
+            let o1 = orient2d(c(a), c(b), c(p));
+            let o2 = orient2d(c(a), c(b), c(q));
+            let o3 = orient2d(c(p), c(q), c(a));
+            let o4 = orient2d(c(p), c(q), c(b));
+            let crosses = if o1 == 0.0 && o2 == 0.0 {
+                // Collinear: they may meet only at a shared endpoint.
+                let d = points[b] - points[a];
+                let t = |v: usize| (points[v] - points[a]).dot(&d) / d.norm_squared();
+                let (lo, hi) = (t(p).min(t(q)).max(0.0), t(p).max(t(q)).min(1.0));
+                hi > lo || (hi == lo && !shared)
+            } else if shared {
+                false
+            } else {
+                o1 * o2 <= 0.0 && o3 * o4 <= 0.0
+            };
+            if crosses {
+                return Err(HexDelaunayError::SegmentsCross {
+                    first: i,
+                    second: j,
+                });
+            }
+        }
+    }
+    Ok(())
+}

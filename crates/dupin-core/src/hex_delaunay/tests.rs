@@ -1,0 +1,462 @@
+//! Property tests of the hexagonal Delaunay triangulation over seeded random input families.
+
+use super::*;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// Largest circumradius/(2·inradius) of a triangle with all angles in [30°, 120°]: the
+/// 30-30-120 triangle, 1 / (8 sin²15° sin 60°).
+const SIMPLE_ASPECT: f64 = 2.154_700_538_379_252;
+
+/// The input families of the issue.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Family {
+    Uniform,
+    Clustered,
+    Collinear,
+    Cocircular,
+    LatticeAligned,
+    Duplicates,
+    ClosePairs,
+    Single,
+    Two,
+}
+
+pub(crate) const FAMILIES: [Family; 9] = [
+    Family::Uniform,
+    Family::Clustered,
+    Family::Collinear,
+    Family::Cocircular,
+    Family::LatticeAligned,
+    Family::Duplicates,
+    Family::ClosePairs,
+    Family::Single,
+    Family::Two,
+];
+
+pub(crate) fn sample(family: Family, rng: &mut ChaCha8Rng) -> Vec<Vec2> {
+    let offset = Vec2::new(
+        rng.random_range(-100.0..100.0),
+        rng.random_range(-100.0..100.0),
+    );
+    let scale = 10f64.powf(rng.random_range(-2.0..2.0));
+    let u = |rng: &mut ChaCha8Rng| rng.random_range(-1.0..1.0f64);
+    let n = rng.random_range(2..24usize);
+    let pts: Vec<Vec2> = match family {
+        Family::Uniform => (0..n)
+            .map(|_| Vec2::new(u(rng), u(rng)) * scale + offset)
+            .collect(),
+        Family::Clustered => {
+            let s = 10f64.powf(rng.random_range(-4.0..-1.0));
+            let centres: Vec<Vec2> = (0..rng.random_range(1..4))
+                .map(|_| Vec2::new(u(rng), u(rng)))
+                .collect();
+            (0..n)
+                .map(|i| {
+                    let c = centres[i % centres.len()];
+                    (c + Vec2::new(u(rng), u(rng)) * s) * scale + offset
+                })
+                .collect()
+        }
+        Family::Collinear => {
+            let t = rng.random_range(0.0..std::f64::consts::PI);
+            let d = Vec2::new(t.cos(), t.sin());
+            (0..n).map(|_| d * (u(rng) * scale) + offset).collect()
+        }
+        Family::Cocircular => (0..n)
+            .map(|_| {
+                let t = rng.random_range(0.0..std::f64::consts::TAU);
+                Vec2::new(t.cos(), t.sin()) * scale + offset
+            })
+            .collect(),
+        Family::LatticeAligned => {
+            let h = 2f64.powi(rng.random_range(-6..4));
+            (0..n)
+                .map(|_| {
+                    Vec2::new(
+                        rng.random_range(-5..6) as f64 * h,
+                        rng.random_range(-5..6) as f64 * h,
+                    )
+                })
+                .collect()
+        }
+        Family::Duplicates => {
+            let base: Vec<Vec2> = (0..n.div_ceil(3))
+                .map(|_| Vec2::new(u(rng), u(rng)) * scale + offset)
+                .collect();
+            (0..n).map(|i| base[i % base.len()]).collect()
+        }
+        Family::ClosePairs => {
+            let mut v = Vec::new();
+            for _ in 0..rng.random_range(1..4) {
+                let p = Vec2::new(u(rng), u(rng));
+                let t = rng.random_range(0.0..std::f64::consts::TAU);
+                v.push(p);
+                v.push(p + Vec2::new(t.cos(), t.sin()) * 1e-9);
+            }
+            v
+        }
+        Family::Single => vec![Vec2::new(u(rng), u(rng)) * scale + offset],
+        Family::Two => vec![
+            Vec2::new(u(rng), u(rng)) * scale + offset,
+            Vec2::new(u(rng), u(rng)) * scale + offset,
+        ],
+    };
+    pts
+}
+
+fn d_min(points: &[Vec2]) -> f64 {
+    let mut d = f64::INFINITY;
+    for (i, p) in points.iter().enumerate() {
+        for q in &points[i + 1..] {
+            if p != q {
+                d = d.min((p - q).norm());
+            }
+        }
+    }
+    d
+}
+
+/// Checks every guarantee of the simple refinement on one input; returns the triangle count.
+pub(crate) fn check_simple(points: &[Vec2], what: &str) -> usize {
+    let t = hex_delaunay(points, &[], HexDelaunayMode::Simple)
+        .unwrap_or_else(|e| panic!("{what}: {e}"));
+    check_triangulation(&t, points, what)
+}
+
+/// Checks every guarantee of the simple refinement on a result for `points`.
+pub(crate) fn check_triangulation(t: &HexTriangulation, points: &[Vec2], what: &str) -> usize {
+    let q = triangulation_quality(&t.vertices, &t.triangles);
+    assert_eq!(q.inverted, 0, "{what}: inverted triangles");
+    assert_eq!(q.nonmanifold_edges, 0, "{what}: non-manifold edges");
+    assert!(
+        q.min_angle_deg >= 29.99,
+        "{what}: min angle {}",
+        q.min_angle_deg
+    );
+    assert!(
+        q.max_angle_deg <= 120.01,
+        "{what}: max angle {}",
+        q.max_angle_deg
+    );
+    assert_eq!(q.delaunay_violations, 0, "{what}: not Delaunay");
+    assert!(
+        q.max_aspect_ratio <= SIMPLE_ASPECT * (1.0 + 1e-6),
+        "{what}: aspect ratio {}",
+        q.max_aspect_ratio
+    );
+    // Tiling: the signed areas add up to Ω's area and the boundary edges lie on Ω's boundary.
+    // Tolerance: 1e-9 relative, plus the rounding of boundary vertices to f64 (64 ulp of the
+    // coordinates' magnitude along the perimeter), which dominates only for tiny offset domains.
+    let area = t.domain_area();
+    let perimeter: f64 = (0..6)
+        .map(|i| (t.domain[i] - t.domain[(i + 1) % 6]).norm())
+        .sum();
+    let mag = t
+        .domain
+        .iter()
+        .map(|p| p.x.abs().max(p.y.abs()))
+        .fold(0.0, f64::max);
+    assert!(
+        (q.area - area).abs() <= 1e-9 * area + perimeter * 64.0 * f64::EPSILON * mag,
+        "{what}: area {} vs {}",
+        q.area,
+        area
+    );
+    let mut boundary = 0.0;
+    let mut directed = rustc_hash::FxHashSet::default();
+    for tri in &t.triangles {
+        for i in 0..3 {
+            directed.insert((tri[i], tri[(i + 1) % 3]));
+        }
+    }
+    for &(a, b) in &directed {
+        if !directed.contains(&(b, a)) {
+            let (p, r) = (t.vertices[a as usize], t.vertices[b as usize]);
+            boundary += (p - r).norm();
+            let on_edge = (0..6).any(|i| {
+                let (c0, c1) = (t.domain[i], t.domain[(i + 1) % 6]);
+                let e = c1 - c0;
+                let dist = |x: Vec2| e.perp(&(x - c0)).abs() / e.norm();
+                // Absolute rounding of coordinates of magnitude `mag` allowed on top.
+                let mag = c0.x.abs().max(c0.y.abs());
+                let tol = 1e-9 * e.norm() + 64.0 * f64::EPSILON * mag;
+                dist(p) <= tol && dist(r) <= tol
+            });
+            assert!(on_edge, "{what}: boundary edge off Ω's boundary");
+        }
+    }
+    assert!(
+        (boundary - perimeter).abs() <= 1e-9 * perimeter,
+        "{what}: boundary length {boundary} vs {perimeter}"
+    );
+    // Input points are vertices with their exact coordinates.
+    assert_eq!(t.input_vertex.len(), points.len());
+    for (i, p) in points.iter().enumerate() {
+        let v = t.input_vertex[i] as usize;
+        assert!(v < t.vertices.len(), "{what}: point {i} is not a vertex");
+        assert_eq!(t.vertices[v], *p, "{what}: point {i} moved");
+    }
+    // Minimum edge in terms of the closest pair d. Section 6.3's d·√7/(12√3) is derived for the
+    // extended refinement (OCCUPIED_1 rings). For the simple refinement: the first split at the
+    // deepest level K comes from rule 1, 3 or 3b, so two points lie in hexagons at most two
+    // steps apart there, d <= (2√3 + 2) r_K; an occupied leaf has r >= r_K / 2 and its point is
+    // at least (√3/2) r from the ring centres, lattice edges are at least √3 r_K / 2. Hence
+    // every edge is >= √3 d / (8 (√3 + 1)) ≈ 0.0793 d (measured minimum over the families:
+    // 0.0908 d).
+    let d = d_min(points);
+    if d.is_finite() {
+        let bound = d * 3f64.sqrt() / (8.0 * (3f64.sqrt() + 1.0));
+        assert!(
+            q.min_edge >= bound * (1.0 - 1e-9),
+            "{what}: shortest edge {} below {}",
+            q.min_edge,
+            bound
+        );
+    }
+    t.triangles.len()
+}
+
+fn run_families(per_family: usize) {
+    for (fi, family) in FAMILIES.iter().enumerate() {
+        let mut rng = ChaCha8Rng::seed_from_u64(1000 + fi as u64);
+        for case in 0..per_family {
+            let pts = sample(*family, &mut rng);
+            check_simple(&pts, &format!("{family:?} case {case}"));
+        }
+    }
+}
+
+#[test]
+fn simple_guarantees_over_seeded_families() {
+    run_families(1000);
+}
+
+#[test]
+#[ignore = "the issue's full 10^4 inputs per family; run with --ignored (release-like core)"]
+fn simple_guarantees_over_seeded_families_full() {
+    run_families(10_000);
+}
+
+#[test]
+fn larger_uniform_sets() {
+    let mut rng = ChaCha8Rng::seed_from_u64(99);
+    for n in [100, 500, 2000] {
+        let pts: Vec<Vec2> = (0..n)
+            .map(|_| Vec2::new(rng.random::<f64>(), rng.random::<f64>()))
+            .collect();
+        check_simple(&pts, &format!("uniform {n}"));
+    }
+}
+
+#[test]
+fn stepper_matches_one_shot_and_cells_tile() {
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    for case in 0..50 {
+        let pts = sample(FAMILIES[case % 9], &mut rng);
+        let one = hex_delaunay(&pts, &[], HexDelaunayMode::Simple).unwrap();
+        let mut s = HexDelaunayStepper::new(&pts, &[], HexDelaunayMode::Simple).unwrap();
+        let mut steps = 0;
+        while s.step().unwrap() {
+            steps += 1;
+            assert!(!s.last_splits().is_empty());
+            assert!(steps < 100_000, "stepper does not terminate");
+        }
+        assert!(s.is_done());
+        assert_eq!(s.triangulation(), one);
+        // The leaf cells cover the root hexagon: full hexagons and semi-hexagons with the right
+        // areas add up to the root's area (boundary cells drawn whole).
+        let cells = s.cells();
+        assert!(cells.iter().filter(|c| c.occupied).count() >= 1);
+        for c in &cells {
+            assert!(c.corners.len() == 6 || c.corners.len() == 4, "{c:?}");
+            assert_eq!(c.corners.len() == 6, c.paper_level % 2 == 0);
+        }
+    }
+}
+
+#[test]
+fn bad_input_is_refused() {
+    assert_eq!(
+        hex_delaunay(&[], &[], HexDelaunayMode::Simple),
+        Err(HexDelaunayError::Empty)
+    );
+    let nan = [Vec2::new(0.0, 0.0), Vec2::new(f64::NAN, 1.0)];
+    assert_eq!(
+        hex_delaunay(&nan, &[], HexDelaunayMode::Simple),
+        Err(HexDelaunayError::NonFinite { index: 1 })
+    );
+    let inf = [Vec2::new(f64::INFINITY, 1.0)];
+    assert!(matches!(
+        hex_delaunay(&inf, &[], HexDelaunayMode::Simple),
+        Err(HexDelaunayError::NonFinite { index: 0 })
+    ));
+    let big = [Vec2::new(1e200, 0.0), Vec2::new(0.0, 0.0)];
+    assert!(matches!(
+        hex_delaunay(&big, &[], HexDelaunayMode::Simple),
+        Err(HexDelaunayError::TooLarge { index: 0, .. })
+    ));
+    let tiny = [Vec2::new(0.0, 0.0), Vec2::new(1e-200, 0.0)];
+    assert!(matches!(
+        hex_delaunay(&tiny, &[], HexDelaunayMode::Simple),
+        Err(HexDelaunayError::TooSmall { .. })
+    ));
+    // Two points far closer than double precision can separate at their offset: depth cap.
+    let close = [Vec2::new(1e6, 0.0), Vec2::new(1e6 + 1e-9, 0.0)];
+    assert_eq!(
+        hex_delaunay(&close, &[], HexDelaunayMode::Simple),
+        Err(HexDelaunayError::DepthLimit { max_level: 0 })
+    );
+    // The cap reached in the middle of refinement.
+    let close = [
+        Vec2::new(0.0, 0.0),
+        Vec2::new(10.0, 0.0),
+        Vec2::new(1e-12, 0.0),
+    ];
+    assert_eq!(
+        hex_delaunay(&close, &[], HexDelaunayMode::Simple),
+        Err(HexDelaunayError::DepthLimit { max_level: 41 })
+    );
+    let pts = [
+        Vec2::new(0.0, 0.0),
+        Vec2::new(1.0, 1.0),
+        Vec2::new(0.0, 1.0),
+        Vec2::new(1.0, 0.0),
+    ];
+    assert_eq!(
+        hex_delaunay(&pts, &[[0, 7]], HexDelaunayMode::Simple),
+        Err(HexDelaunayError::SegmentIndex {
+            segment: 0,
+            index: 7,
+            points: 4
+        })
+    );
+    assert_eq!(
+        hex_delaunay(&pts, &[[0, 1], [2, 3]], HexDelaunayMode::Simple),
+        Err(HexDelaunayError::SegmentsCross {
+            first: 0,
+            second: 1
+        })
+    );
+    assert_eq!(
+        hex_delaunay(&pts, &[[0, 0]], HexDelaunayMode::Simple),
+        Err(HexDelaunayError::DegenerateSegment { segment: 0 })
+    );
+    assert!(matches!(
+        hex_delaunay(&pts, &[], HexDelaunayMode::Extended),
+        Err(HexDelaunayError::Unsupported(_))
+    ));
+}
+
+#[test]
+fn incremental_insertion_keeps_the_guarantees() {
+    let mut rng = ChaCha8Rng::seed_from_u64(77);
+    for case in 0..300 {
+        let first = sample(FAMILIES[case % 5], &mut rng);
+        // Further points inside the hull of the first batch (hence inside Ω), some duplicates,
+        // none closer than 1e-6 of the batch's extent to another (or the depth cap is hit).
+        let extent = first
+            .iter()
+            .map(|p| (p - first[0]).norm())
+            .fold(0.0, f64::max);
+        let mut more: Vec<Vec2> = Vec::new();
+        let candidates: Vec<Vec2> = (0..rng.random_range(1..10))
+            .map(|_| {
+                let (i, j) = (
+                    rng.random_range(0..first.len()),
+                    rng.random_range(0..first.len()),
+                );
+                if rng.random_range(0..4) == 0 {
+                    first[i]
+                } else {
+                    let t = rng.random::<f64>();
+                    first[i] * t + first[j] * (1.0 - t)
+                }
+            })
+            .collect();
+        for c in candidates {
+            let near = |p: &Vec2| *p != c && (p - c).norm() < 1e-6 * extent;
+            if !first.iter().chain(&more).any(near) {
+                more.push(c);
+            }
+        }
+        let mut s = HexDelaunayStepper::new(&first, &[], HexDelaunayMode::Simple).unwrap();
+        s.run().unwrap();
+        let before = s.triangulation();
+        s.insert(&more).unwrap();
+        s.run().unwrap();
+        let after = s.triangulation();
+        assert_eq!(after.domain, before.domain);
+        assert!(after.triangles.len() >= before.triangles.len());
+        let all: Vec<Vec2> = first.iter().chain(&more).copied().collect();
+        check_triangulation(&after, &all, &format!("incremental case {case}"));
+    }
+    // Outside Ω: refused, nothing inserted.
+    let pts = [Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0)];
+    let mut s = HexDelaunayStepper::new(&pts, &[], HexDelaunayMode::Simple).unwrap();
+    s.run().unwrap();
+    let n = s.triangulation().input_vertex.len();
+    assert_eq!(
+        s.insert(&[Vec2::new(0.5, 0.1), Vec2::new(0.5, 10.0)]),
+        Err(HexDelaunayError::OutsideDomain { index: 1 })
+    );
+    assert_eq!(
+        s.insert(&[Vec2::new(0.5, f64::NAN)]),
+        Err(HexDelaunayError::NonFinite { index: 0 })
+    );
+    assert_eq!(s.triangulation().input_vertex.len(), n);
+}
+
+/// The paper's data sets (Table 1), seeded: two points 0.02 apart, 100 random points on a line,
+/// 100 / 1k / 2k random points in the plane. (The IMR letters are a PSLG, not supported yet.)
+pub(crate) fn paper_data_sets() -> Vec<(&'static str, Vec<Vec2>, usize)> {
+    let mut rng = ChaCha8Rng::seed_from_u64(2008);
+    let mut plane = |n: usize| -> Vec<Vec2> {
+        (0..n)
+            .map(|_| Vec2::new(rng.random::<f64>(), rng.random::<f64>()))
+            .collect()
+    };
+    let p100 = plane(100);
+    let p1k = plane(1000);
+    let p2k = plane(2000);
+    let mut rng = ChaCha8Rng::seed_from_u64(2009);
+    let line: Vec<Vec2> = (0..100)
+        .map(|_| {
+            let t = rng.random::<f64>();
+            Vec2::new(t, 0.3 * t)
+        })
+        .collect();
+    vec![
+        (
+            "2 close pts",
+            vec![Vec2::new(0.0, 0.0), Vec2::new(0.02, 0.0)],
+            684,
+        ),
+        ("100 pts on line", line, 18667),
+        ("100 pts on plane", p100, 12748),
+        ("1k pts on plane", p1k, 127729),
+        ("2k pts on plane", p2k, 268138),
+    ]
+}
+
+#[test]
+fn paper_data_sets_take_fewer_triangles_than_table_1() {
+    for (name, pts, paper) in paper_data_sets() {
+        let n = if name == "2 close pts" {
+            // The paper's set-up: a hexagon of unit (circum)radius around the pair.
+            let mut s = HexDelaunayStepper::new_in_domain(
+                &pts,
+                HexDelaunayMode::Simple,
+                Vec2::new(0.01, 0.0),
+                3f64.sqrt() / 2.0,
+            )
+            .unwrap();
+            s.run().unwrap();
+            check_triangulation(&s.triangulation(), &pts, name)
+        } else {
+            check_simple(&pts, name)
+        };
+        println!("{name}: {n} triangles (paper, extended mode: {paper})");
+        assert!(n < paper, "{name}: {n} triangles, paper {paper}");
+    }
+}
