@@ -129,6 +129,7 @@ function frame() {
   const w = Math.max(1, Math.round(canvas.clientWidth * dpr));
   const h = Math.max(1, Math.round(canvas.clientHeight * dpr));
   if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; viewer.resize(w, h); dirty = true; }
+  viewer.poll();
   if (dirty) {
     dirty = false;
     try {

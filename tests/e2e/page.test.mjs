@@ -2,7 +2,7 @@
 // from the URL, export OBJ and reject bad input inline.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { byId, drag, openPage, pixelStats, shot } from './harness.mjs';
+import { SHOTS, byId, drag, openPage, pixelStats, shot } from './harness.mjs';
 
 for (const [backend, webgpu] of [['WebGPU', true], ['WebGL2', false]]) {
   test(`${backend}: loads cleanly, draws the torus and orbits on drag`, async () => {
@@ -16,6 +16,10 @@ for (const [backend, webgpu] of [['WebGPU', true], ['WebGL2', false]]) {
       const second = await shot(page, `${backend.toLowerCase()}-dragged`);
       const { differing } = await pixelStats(page, first, second);
       assert.ok(differing > 0.01, `a drag changed only ${(differing * 100).toFixed(2)}% of pixels`);
+      // The browser's own screenshot of the canvas element shows the same picture.
+      const composited = await byId(page, 'canvas').screenshot({ path: `${SHOTS}/${backend.toLowerCase()}-page.png` });
+      const seen = await pixelStats(page, composited);
+      assert.ok(seen.covered > 0.05, `page screenshot: only ${(seen.covered * 100).toFixed(1)}% covered`);
       assert.deepEqual(errors, [], 'console errors');
     } finally {
       await browser.close();

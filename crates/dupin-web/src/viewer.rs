@@ -150,9 +150,14 @@ impl Viewer {
                 };
             });
         });
-        // Natively this would block; in the browser it only nudges wgpu's callbacks along.
-        let _ = self.device.poll(wgpu::PollType::Poll);
+        self.poll();
         Ok(promise)
+    }
+
+    /// Lets wgpu deliver finished work (buffer maps of [`Viewer::snapshot`]). WebGPU does this
+    /// by itself; the WebGL2 backend needs it called, so the page calls it every frame.
+    pub fn poll(&self) {
+        let _ = self.device.poll(wgpu::PollType::Poll);
     }
 
     /// Draws one frame.
