@@ -12,6 +12,7 @@ mod mesh;
 mod obj;
 mod planarity;
 mod render_buffers;
+mod solver;
 mod surface;
 
 pub use math::{Vec2, Vec3};
@@ -19,4 +20,8 @@ pub use mesh::{MeshError, PolyMesh};
 pub use obj::{ObjError, parse_obj, write_obj};
 pub use planarity::{face_planarity, max_planarity};
 pub use render_buffers::{TriangleBuffers, sample_surface};
+pub use solver::{
+    ConstrainedLeastSquares, JacobianEntry, LevenbergMarquardt, LmOptions, LmStep,
+    NonlinearLeastSquares, SolverError, SparseSystem, Sqp, SqpOptions, SqpStep,
+};
 pub use surface::{Domain, Surface, SurfaceDerivatives, Torus};
