@@ -6,6 +6,7 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 mod common;
+mod planarize;
 
 /// Planar-panel geometry for architecture.
 #[derive(Parser)]
@@ -16,10 +17,15 @@ struct Cli {
 }
 
 #[derive(Subcommand)]
-enum Command {}
+enum Command {
+    /// Make every face planar (optionally conical or circular) by minimal vertex moves.
+    Planarize(planarize::PlanarizeArgs),
+}
 
 fn run(cli: Cli) -> Result<(), common::CliError> {
-    match cli.command {}
+    match cli.command {
+        Command::Planarize(a) => planarize::run(a),
+    }
 }
 
 fn main() -> ExitCode {

@@ -22,6 +22,11 @@ pub struct LmOptions {
     pub min_damping: f64,
     /// Number of damping increases tried before a step is declared failed.
     pub max_retries: usize,
+    /// Scale the damping per variable by the diagonal of JᵀJ (Marquardt) instead of one
+    /// uniform value (Levenberg); better when variables have different units.
+    pub marquardt_scaling: bool,
+    /// Factor by which the damping shrinks after an accepted step (> 1).
+    pub decrease: f64,
 }
 
 impl Default for LmOptions {
@@ -30,6 +35,8 @@ impl Default for LmOptions {
             initial_damping: 1e-4,
             min_damping: 1e-15,
             max_retries: 12,
+            decrease: 3.0,
+            marquardt_scaling: false,
         }
     }
 }
@@ -55,6 +62,8 @@ pub struct LevenbergMarquardt {
     normal: PatternMatrix,
     sys: SparseSystem,
     trial_sys: SparseSystem,
+    /// The accepted point whose evaluation is in `trial_sys`, while still valid.
+    cached_x: Option<Vec<f64>>,
     scratch: GramScratch,
 }
 
@@ -67,8 +76,20 @@ impl LevenbergMarquardt {
             normal: PatternMatrix::new(Factor::CholeskyUpper),
             sys: SparseSystem::new(),
             trial_sys: SparseSystem::new(),
+            cached_x: None,
             scratch: GramScratch::default(),
         }
+    }
+
+    /// Tells the iteration that the problem changed (e.g. its weights), so the evaluation kept
+    /// from the last accepted step must not be reused.
+    pub fn invalidate(&mut self) {
+        self.cached_x = None;
+    }
+
+    /// Sets the relative damping μ.
+    pub fn set_damping(&mut self, mu: f64) {
+        self.damping = mu;
     }
 
     /// The current relative damping μ.
@@ -84,7 +105,12 @@ impl LevenbergMarquardt {
         let sys = &self.sys;
         let scale = diag.iter().fold(0.0f64, |a, &b| a.max(b)).max(1e-300);
         for i in 0..n {
-            self.normal.add(i as u32, i as u32, mu * scale);
+            let d = if self.options.marquardt_scaling {
+                diag[i] + 1e-9 * scale
+            } else {
+                scale
+            };
+            self.normal.add(i as u32, i as u32, mu * d);
         }
         let mut rhs = sys.gradient(n);
         rhs.iter_mut().for_each(|g| *g = -*g);
@@ -103,9 +129,14 @@ impl LevenbergMarquardt {
         x: &mut [f64],
     ) -> Result<LmStep, SolverError> {
         let n = problem.num_variables();
-        self.sys.clear();
-        problem.evaluate(x, &mut self.sys);
-        self.sys.validate(n)?;
+        if self.cached_x.as_deref() == Some(&*x) {
+            std::mem::swap(&mut self.sys, &mut self.trial_sys);
+        } else {
+            self.sys.clear();
+            problem.evaluate(x, &mut self.sys);
+            self.sys.validate(n)?;
+        }
+        self.cached_x = None;
         let cost_before = self.sys.cost();
         if cost_before == 0.0 {
             return Ok(LmStep {
@@ -136,8 +167,9 @@ impl LevenbergMarquardt {
             };
             if cost_after < cost_before {
                 x.copy_from_slice(&trial);
+                self.cached_x = Some(trial);
                 let used = self.damping;
-                self.damping = (self.damping / 3.0).max(self.options.min_damping);
+                self.damping = (self.damping / self.options.decrease).max(self.options.min_damping);
                 return Ok(LmStep {
                     cost_before,
                     cost_after,
