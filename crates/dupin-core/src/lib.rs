@@ -18,8 +18,10 @@ mod offset;
 mod planarity;
 mod pq_perturbation;
 mod pq_scenes;
+mod principal_quad_mesh;
 mod render_buffers;
 mod solver;
+mod subdivision;
 mod support_structure;
 mod surface;
 
@@ -39,10 +41,12 @@ pub use pq_perturbation::{
     PqError, PqMode, PqOptions, PqPerturbation, PqPhase, PqResult, PqStepInfo, pq_perturb,
 };
 pub use pq_scenes::{skew_quad_grid, torus_centroid_dual};
+pub use principal_quad_mesh::{SurfaceOfRevolution, principal_quad_mesh};
 pub use render_buffers::{TriangleBuffers, sample_surface};
 pub use solver::{
     ConstrainedLeastSquares, JacobianEntry, LevenbergMarquardt, LmOptions, LmStep,
     NonlinearLeastSquares, SolverError, SparseSystem, Sqp, SqpOptions, SqpStep,
 };
+pub use subdivision::{catmull_clark, chaikin, doo_sabin, lane_riesenfeld_cubic};
 pub use support_structure::support_structure;
 pub use surface::{Domain, Surface, SurfaceDerivatives, Torus};
