@@ -5,7 +5,7 @@
 //!
 //! Input: a mesh with planar faces (ideally conical), the distance. Output: the offset mesh.
 
-use crate::conical::face_normals;
+use crate::conical::{cone_axes, face_normals};
 use crate::math::Vec3;
 use crate::mesh::PolyMesh;
 use crate::mesh_topology::{MeshTopology, TopologyError};
@@ -27,7 +27,9 @@ pub enum OffsetError {
 
 /// The face-offset mesh at distance `distance` (positive along the face normals).
 ///
-/// Each new vertex satisfies the shifted planes of its faces in the least-squares sense; when
+/// Interior valence-4 vertices move along their cone axis ([`crate::cone_axes`]) by
+/// `d / cos θ`, θ the angle between axis and face normals. Other vertices satisfy the shifted
+/// planes of their faces in the least-squares sense; when
 /// they do not determine it (boundary vertices in one or two faces) the remaining freedom is
 /// fixed by the point nearest to `v + d m`, m the mean face normal. At interior conical
 /// vertices all shifted planes pass through the result exactly.
@@ -44,11 +46,25 @@ pub fn offset_mesh(mesh: &PolyMesh, distance: f64) -> Result<PolyMesh, OffsetErr
         .faces()
         .map(|f| f.iter().map(|&v| mesh.positions[v as usize]).sum::<Vec3>() / f.len() as f64)
         .collect();
+    let axes = cone_axes(mesh, &topo);
     let mut positions = mesh.positions.clone();
     for (v, out) in positions.iter_mut().enumerate() {
         let star = topo.star(v);
         if star.is_empty() {
             continue;
+        }
+        // Interior valence-4 vertex: move along the cone axis by d / cos(angle to the faces);
+        // well conditioned even when the four planes are nearly parallel.
+        if let Some(a) = axes[v] {
+            let cos = star
+                .iter()
+                .map(|&c| a.dot(&normals[topo.face_of(c) as usize]))
+                .sum::<f64>()
+                / star.len() as f64;
+            if cos > 1e-6 {
+                *out = mesh.positions[v] + a * (distance / cos);
+                continue;
+            }
         }
         let p = mesh.positions[v];
         let mut a = nalgebra::Matrix3::zeros();

@@ -8,7 +8,12 @@ use crate::mesh_topology::MeshTopology;
 use crate::offset::{OffsetError, offset_mesh};
 
 /// The support structure between `mesh` and its offset at distance `distance`: one quad per
-/// edge (a, b): a, b, b', a' (primes on the offset). Returns the offset mesh too.
+/// edge (a, b): a, b, b', a' (primes on the offset), in the order of
+/// [`MeshTopology::edges`]. Returns the offset mesh too.
+///
+/// Beams between two vertices that have cone axes (interior valence-4 vertices of a conical
+/// mesh) are planar. At the boundary the offset vertex is not fixed by a cone, so beams
+/// touching the boundary are planar only approximately.
 pub fn support_structure(
     mesh: &PolyMesh,
     distance: f64,

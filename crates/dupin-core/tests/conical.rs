@@ -228,13 +228,21 @@ fn offsets_support_structure_and_fact_2() {
         }
     }
     assert!(max_planarity(&off) <= 1e-10);
-    assert!(conical_residual(&off, &topo) <= 1e-9);
-    // Support beams are planar.
+    let (c0, c1) = (conical_residual(&m, &topo), conical_residual(&off, &topo));
+    assert!(c1 <= 1e-9, "offset conical residual {c1} (original {c0})");
+    // Support beams between vertices with cone axes are planar.
     let (beams, _) = support_structure(&m, d).unwrap();
     assert_eq!(beams.num_faces(), topo.edges().len());
-    assert!(max_planarity(&beams) <= 1e-10);
-    // Geometry Fact 2: neighbouring cone axes are coplanar.
     let axes = cone_axes(&m, &topo);
+    let mut interior_beams = 0;
+    for (k, (a, b)) in topo.edges().into_iter().enumerate() {
+        if axes[a as usize].is_some() && axes[b as usize].is_some() {
+            assert!(dupin_core::face_planarity(&beams, k) <= 1e-10, "beam {k}");
+            interior_beams += 1;
+        }
+    }
+    assert!(interior_beams > 50);
+    // Geometry Fact 2: neighbouring cone axes are coplanar.
     let mut pairs = 0;
     for (a, b) in topo.edges() {
         if let (Some(x), Some(y)) = (axes[a as usize], axes[b as usize]) {
