@@ -6,6 +6,7 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 mod common;
+mod offset;
 mod planarize;
 
 /// Planar-panel geometry for architecture.
@@ -20,11 +21,14 @@ struct Cli {
 enum Command {
     /// Make every face planar (optionally conical or circular) by minimal vertex moves.
     Planarize(planarize::PlanarizeArgs),
+    /// Offset a conical mesh by a face distance, with its support structure.
+    Offset(offset::OffsetArgs),
 }
 
 fn run(cli: Cli) -> Result<(), common::CliError> {
     match cli.command {
         Command::Planarize(a) => planarize::run(a),
+        Command::Offset(a) => offset::run(a),
     }
 }
 

@@ -9,6 +9,7 @@
 
 mod circular;
 mod conical;
+mod developable_strip;
 mod discrete_terms;
 mod math;
 mod mesh;
@@ -29,6 +30,9 @@ pub use circular::{circular_residual, quad_circularity};
 pub use conical::{
     VertexType, angle_balance, cone_axes, conical_residual, face_normals, focal_points,
     spherical_image, vertex_type,
+};
+pub use developable_strip::{
+    PqStrip, StripClosure, StripRule, developable_subdivision, trefoil_moebius,
 };
 pub use math::{Vec2, Vec3};
 pub use mesh::{MeshError, PolyMesh};

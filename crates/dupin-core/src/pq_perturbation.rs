@@ -88,6 +88,9 @@ pub struct PqOptions {
     pub max_iterations: usize,
     /// Largest number of penalty iterations before switching to SQP.
     pub penalty_iterations: usize,
+    /// Pairs of vertices that are the same point and move together (gluing a cut mesh, e.g. a
+    /// Möbius band cut open along one rung, which cannot be oriented consistently).
+    pub identify: Vec<(usize, usize)>,
     /// How the final, exact phase is solved.
     pub refinement: Refinement,
     /// Add the determinant terms `c_det` of unit edge vectors to the penalty (the paper's
@@ -107,6 +110,7 @@ impl Default for PqOptions {
             max_iterations: 100,
             penalty_iterations: 4,
             determinant_terms: false,
+            identify: Vec::new(),
             refinement: Refinement::GaussNewton,
         }
     }
@@ -139,8 +143,8 @@ pub enum PqError {
     /// Circular mode on a mesh without quads.
     #[error("circular mode needs quad faces; this mesh has none")]
     NoQuadFace,
-    /// A fixed vertex index does not exist.
-    #[error("fixed vertex {index} does not exist (the mesh has {vertices} vertices)")]
+    /// A fixed or identified vertex index does not exist.
+    #[error("vertex {index} does not exist (the mesh has {vertices} vertices)")]
     FixedVertexOutOfRange {
         /// The bad index.
         index: usize,
@@ -614,6 +618,20 @@ impl PqPerturbation {
             if used[v] && !fixed[v] && !(o.fix_boundary && topo.is_boundary(v)) {
                 var_of[v] = num_vars as u32;
                 num_vars += 3;
+            }
+        }
+        for &(i, j) in &o.identify {
+            if i >= nv || j >= nv {
+                return Err(PqError::FixedVertexOutOfRange {
+                    index: i.max(j),
+                    vertices: nv,
+                });
+            }
+            if var_of[i] != NONE && var_of[j] != NONE {
+                var_of[j] = var_of[i];
+            } else {
+                var_of[i] = NONE;
+                var_of[j] = NONE;
             }
         }
         let p = &mesh.positions;
