@@ -8,6 +8,7 @@ use std::process::ExitCode;
 mod common;
 mod offset;
 mod planarize;
+mod pq;
 
 /// Planar-panel geometry for architecture.
 #[derive(Parser)]
@@ -23,12 +24,15 @@ enum Command {
     Planarize(planarize::PlanarizeArgs),
     /// Offset a conical mesh by a face distance, with its support structure.
     Offset(offset::OffsetArgs),
+    /// Build a PQ scene of the conical paper (see --list-scenes).
+    Pq(pq::PqArgs),
 }
 
 fn run(cli: Cli) -> Result<(), common::CliError> {
     match cli.command {
         Command::Planarize(a) => planarize::run(a),
         Command::Offset(a) => offset::run(a),
+        Command::Pq(a) => pq::run(a),
     }
 }
 

@@ -44,7 +44,9 @@ pub use pq_perturbation::{
     Refinement,
     PqError, PqMode, PqOptions, PqPerturbation, PqPhase, PqResult, PqStepInfo, pq_perturb,
 };
-pub use pq_scenes::{skew_quad_grid, torus_centroid_dual};
+pub use pq_scenes::{
+    PQ_SCENES, PqSceneError, PqSceneResult, pq_scene, skew_quad_grid, torus_centroid_dual,
+};
 pub use principal_quad_mesh::{SurfaceOfRevolution, principal_quad_mesh};
 pub use render_buffers::{TriangleBuffers, sample_surface};
 pub use solver::{
