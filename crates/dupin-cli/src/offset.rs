@@ -33,7 +33,8 @@ pub struct OffsetArgs {
 /// Runs `dupin offset`.
 pub fn run(args: OffsetArgs) -> Result<(), CliError> {
     let text = read_text(&args.input)?;
-    let mesh = parse_obj(&text).map_err(|e| CliError::input(&args.input.display().to_string(), e))?;
+    let mesh =
+        parse_obj(&text).map_err(|e| CliError::input(&args.input.display().to_string(), e))?;
     if !args.distance.is_finite() {
         return Err(CliError::Input(format!(
             "--distance must be finite, got {}",

@@ -50,7 +50,8 @@ pub struct PlanarizeArgs {
 /// Runs `dupin planarize`.
 pub fn run(args: PlanarizeArgs) -> Result<(), CliError> {
     let text = read_text(&args.input)?;
-    let mesh = parse_obj(&text).map_err(|e| CliError::input(&args.input.display().to_string(), e))?;
+    let mesh =
+        parse_obj(&text).map_err(|e| CliError::input(&args.input.display().to_string(), e))?;
     let mode = match args.mode {
         ModeArg::Planar => PqMode::Planar,
         ModeArg::Conical => PqMode::Conical,

@@ -64,7 +64,14 @@ fn planarizes_a_skew_grid_and_reports_exact_fields() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(String::from_utf8_lossy(&o.stdout).lines().count(), 1);
     let r = read_json(&report);
-    for key in ["vertices", "faces", "max_planarity", "max_move", "iterations", "seconds"] {
+    for key in [
+        "vertices",
+        "faces",
+        "max_planarity",
+        "max_move",
+        "iterations",
+        "seconds",
+    ] {
         assert!(r.get(key).is_some(), "missing {key}");
     }
     assert_eq!(r["faces"], 36);

@@ -287,17 +287,17 @@ mod tests {
     fn trefoil_band_reproduced_as_developable() {
         // 42 control quads, 3 rounds of cubic Lane-Riesenfeld: 336 quads as in Fig. 9.
         let s = trefoil_moebius(42, 0.35);
-        let (levels, _, converged) = developable_subdivision(
-            &s,
-            StripRule::LaneRiesenfeldCubic,
-            3,
-            &PqOptions::default(),
-        )
-        .unwrap();
+        let (levels, _, converged) =
+            developable_subdivision(&s, StripRule::LaneRiesenfeldCubic, 3, &PqOptions::default())
+                .unwrap();
         assert!(converged);
         let last = levels.last().unwrap();
         assert_eq!(last.num_quads(), 336);
         assert!(max_planarity(&last.to_mesh()) <= 1e-10);
-        assert!(last.max_determinant() <= 1e-10, "{}", last.max_determinant());
+        assert!(
+            last.max_determinant() <= 1e-10,
+            "{}",
+            last.max_determinant()
+        );
     }
 }

@@ -38,11 +38,11 @@ pub use math::{Vec2, Vec3};
 pub use mesh::{MeshError, PolyMesh};
 pub use mesh_topology::{MeshTopology, TopologyError};
 pub use obj::{ObjError, parse_obj, write_obj};
-pub use planarity::{face_planarity, max_planarity};
 pub use offset::{OffsetError, offset_mesh};
+pub use planarity::{face_planarity, max_planarity};
 pub use pq_perturbation::{
-    Refinement,
-    PqError, PqMode, PqOptions, PqPerturbation, PqPhase, PqResult, PqStepInfo, pq_perturb,
+    PqError, PqMode, PqOptions, PqPerturbation, PqPhase, PqResult, PqStepInfo, Refinement,
+    pq_perturb,
 };
 pub use pq_scenes::{
     PQ_SCENES, PqSceneError, PqSceneResult, pq_scene, skew_quad_grid, torus_centroid_dual,

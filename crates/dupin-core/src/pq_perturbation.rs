@@ -350,11 +350,7 @@ impl Problem<'_> {
             for (k, &c) in star.iter().enumerate() {
                 let a = self.topo.source(self.topo.prev(c));
                 let b = self.topo.target(c);
-                let (w, g) = angle_grad(
-                    self.pos(x, v as u32),
-                    self.pos(x, a),
-                    self.pos(x, b),
-                );
+                let (w, g) = angle_grad(self.pos(x, v as u32), self.pos(x, a), self.pos(x, b));
                 let s = if k % 2 == 0 { 1.0 } else { -1.0 };
                 sum += s * w;
                 rg.add(v as u32, g[0] * s);

@@ -64,14 +64,16 @@ pub fn torus_centroid_dual(nu: usize, nv: usize, major: f64, minor: f64) -> Poly
     PolyMesh::new(p, faces).expect("dual indices are valid")
 }
 
+use crate::circular::circular_residual;
 use crate::conical::conical_residual;
-use crate::developable_strip::{PqStrip, StripClosure, StripRule, developable_subdivision, trefoil_moebius};
+use crate::developable_strip::{
+    PqStrip, StripClosure, StripRule, developable_subdivision, trefoil_moebius,
+};
 use crate::mesh_topology::{MeshTopology, TopologyError};
 use crate::planarity::max_planarity;
 use crate::pq_perturbation::{PqError, PqMode, PqOptions, pq_perturb};
 use crate::principal_quad_mesh::{SurfaceOfRevolution, principal_quad_mesh};
 use crate::subdivision::catmull_clark;
-use crate::circular::circular_residual;
 use thiserror::Error;
 
 /// Names of the PQ scenes of the outside contract, after the conical paper's figures.
@@ -141,8 +143,7 @@ fn subdivide_and_perturb(
         max_planarity: max_planarity(&r.mesh),
         conical_residual: (options.mode == PqMode::Conical)
             .then(|| conical_residual(&r.mesh, &topo)),
-        circular_residual: (options.mode == PqMode::Circular)
-            .then(|| circular_residual(&r.mesh)),
+        circular_residual: (options.mode == PqMode::Circular).then(|| circular_residual(&r.mesh)),
         mesh: r.mesh,
         levels,
         iterations,
@@ -202,7 +203,11 @@ pub fn pq_scene(name: &str) -> Result<PqSceneResult, PqSceneError> {
             for j in 0..=n {
                 for i in 0..=n {
                     let (x, y) = (i as f64 - 2.0, j as f64 - 2.0);
-                    p.push(Vec3::new(x, y, 2.0 - 0.15 * (x * x + 0.5 * y * y) + 0.1 * x * y));
+                    p.push(Vec3::new(
+                        x,
+                        y,
+                        2.0 - 0.15 * (x * x + 0.5 * y * y) + 0.1 * x * y,
+                    ));
                 }
             }
             let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
@@ -227,7 +232,13 @@ pub fn pq_scene(name: &str) -> Result<PqSceneResult, PqSceneError> {
         "circular-principal" => {
             // Fig. 17: a mesh from principal curves (here with a small seeded disturbance)
             // made circular.
-            let mut m = principal_quad_mesh(&SurfaceOfRevolution::vase(), (0.0, 3.0), (-0.9, 0.9), 16, 12);
+            let mut m = principal_quad_mesh(
+                &SurfaceOfRevolution::vase(),
+                (0.0, 3.0),
+                (-0.9, 0.9),
+                16,
+                12,
+            );
             for (k, q) in m.positions.iter_mut().enumerate() {
                 let s = (k as f64 * 12.9898).sin() * 43758.5453;
                 let w = 0.004 * (s - s.floor() - 0.5);
@@ -263,7 +274,11 @@ pub fn pq_scene(name: &str) -> Result<PqSceneResult, PqSceneError> {
             let b: Vec<Vec3> = (0..n)
                 .map(|i| {
                     let t = i as f64;
-                    Vec3::new(t + 0.3 * (0.5 * t).cos(), 0.6 * (0.8 * t).sin() + 0.4, 2.0 + 0.3 * t)
+                    Vec3::new(
+                        t + 0.3 * (0.5 * t).cos(),
+                        0.6 * (0.8 * t).sin() + 0.4,
+                        2.0 + 0.3 * t,
+                    )
                 })
                 .collect();
             let strip = PqStrip {
@@ -303,6 +318,9 @@ mod tests {
                 assert!(d <= 1e-10, "{name}: det {d}");
             }
         }
-        assert!(matches!(pq_scene("nope"), Err(PqSceneError::UnknownScene(_))));
+        assert!(matches!(
+            pq_scene("nope"),
+            Err(PqSceneError::UnknownScene(_))
+        ));
     }
 }

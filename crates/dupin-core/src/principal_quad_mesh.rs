@@ -78,7 +78,9 @@ pub fn principal_quad_mesh(
     }
     let id = |i: usize, j: usize| (j * (nu + 1) + i) as u32;
     let faces: Vec<[u32; 4]> = (0..nv)
-        .flat_map(|j| (0..nu).map(move |i| [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]))
+        .flat_map(|j| {
+            (0..nu).map(move |i| [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)])
+        })
         .collect();
     PolyMesh::new(p, faces).expect("grid indices are valid")
 }

@@ -116,12 +116,7 @@ fn sqp_refinement_and_anchors() {
 /// A random conical vertex star: four tangent planes of a random cone through the origin,
 /// edges along the intersections of consecutive planes.
 fn conical_star(rng: &mut ChaCha8Rng) -> (PolyMesh, Vec<Vec3>) {
-    let axis = Vec3::new(
-        rng.random::<f64>() - 0.5,
-        rng.random::<f64>() - 0.5,
-        1.0,
-    )
-    .normalize();
+    let axis = Vec3::new(rng.random::<f64>() - 0.5, rng.random::<f64>() - 0.5, 1.0).normalize();
     let t = axis.cross(&Vec3::x()).normalize();
     let b = axis.cross(&t);
     let cos_t: f64 = 0.4 + 0.5 * rng.random::<f64>();
@@ -191,7 +186,11 @@ fn geometry_fact_1_both_ways() {
             a.iter()
                 .map(|&t| {
                     let c: f64 = 0.4 + 0.5 * rng.random::<f64>();
-                    Vec3::new((1.0 - c * c).sqrt() * t.cos(), (1.0 - c * c).sqrt() * t.sin(), c)
+                    Vec3::new(
+                        (1.0 - c * c).sqrt() * t.cos(),
+                        (1.0 - c * c).sqrt() * t.sin(),
+                        c,
+                    )
                 })
                 .collect()
         };
@@ -200,7 +199,10 @@ fn geometry_fact_1_both_ways() {
         let bal = angle_balance(&m, &topo, 0).unwrap();
         let det = sphere_det(&normals);
         if det.abs() > 1e-6 {
-            assert!(bal.abs() > 1e-9, "non-conical star with balance {bal}, det {det}");
+            assert!(
+                bal.abs() > 1e-9,
+                "non-conical star with balance {bal}, det {det}"
+            );
             tested += 1;
         } else {
             assert!(bal.abs() < 1e-4);
@@ -248,7 +250,10 @@ fn offsets_support_structure_and_fact_2() {
         if let (Some(x), Some(y)) = (axes[a as usize], axes[b as usize]) {
             let e = m.positions[b as usize] - m.positions[a as usize];
             let vol = x.cross(&y).dot(&e) / e.norm();
-            assert!(vol.abs() < 1e-9, "axes of edge ({a}, {b}) not coplanar: {vol}");
+            assert!(
+                vol.abs() < 1e-9,
+                "axes of edge ({a}, {b}) not coplanar: {vol}"
+            );
             pairs += 1;
         }
     }

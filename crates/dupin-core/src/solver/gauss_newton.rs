@@ -217,7 +217,10 @@ mod tests {
                 Err(e) => panic!("{e}"),
             }
         }
-        assert!((x[0] - 1.0).abs() < 1e-10 && (x[1] - 1.0).abs() < 1e-10, "{x:?}");
+        assert!(
+            (x[0] - 1.0).abs() < 1e-10 && (x[1] - 1.0).abs() < 1e-10,
+            "{x:?}"
+        );
     }
 
     /// A sparse overdetermined linear system A x = b: Gauss-Newton solves it in one step to the
@@ -258,7 +261,11 @@ mod tests {
             }
         }
         let b: Vec<f64> = (0..m).map(|_| rng.random::<f64>()).collect();
-        let p = Linear { a: a.clone(), b: b.clone(), n };
+        let p = Linear {
+            a: a.clone(),
+            b: b.clone(),
+            n,
+        };
         let mut lm = LevenbergMarquardt::new(LmOptions {
             initial_damping: 0.0,
             min_damping: 0.0,
@@ -276,7 +283,12 @@ mod tests {
             .unwrap()
             .solve(&(dense.transpose() * bv));
         for j in 0..n {
-            assert!((x[j] - want[j]).abs() < 1e-10, "{j}: {} vs {}", x[j], want[j]);
+            assert!(
+                (x[j] - want[j]).abs() < 1e-10,
+                "{j}: {} vs {}",
+                x[j],
+                want[j]
+            );
         }
     }
 

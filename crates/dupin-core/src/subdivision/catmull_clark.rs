@@ -52,7 +52,11 @@ pub fn catmull_clark(mesh: &PolyMesh) -> Result<PolyMesh, TopologyError> {
                 .map(|&c| face_pt[topo.face_of(c) as usize])
                 .sum::<Vec3>()
                 / n;
-            let r = nb.iter().map(|&u| (p[u as usize] + p[v]) * 0.5).sum::<Vec3>() / n;
+            let r = nb
+                .iter()
+                .map(|&u| (p[u as usize] + p[v]) * 0.5)
+                .sum::<Vec3>()
+                / n;
             (f + 2.0 * r + (n - 3.0) * p[v]) / n
         };
         positions.push(q);
