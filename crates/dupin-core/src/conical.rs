@@ -7,6 +7,9 @@ use crate::math::Vec3;
 use crate::mesh::PolyMesh;
 use crate::mesh_topology::MeshTopology;
 
+/// One interior angle at a vertex: value, (vertex, previous, next) and their gradients.
+pub(crate) type VertexAngle = (f64, [u32; 3], [Vec3; 3]);
+
 /// The four interior angles ω1..ω4 at an interior valence-4 vertex `v`, in rotation order,
 /// with their gradients (with respect to v, the previous and the next vertex of each face).
 /// `None` for other vertices.
@@ -14,7 +17,7 @@ pub(crate) fn vertex_angles(
     mesh: &PolyMesh,
     topo: &MeshTopology,
     v: usize,
-) -> Option<[(f64, [u32; 3], [Vec3; 3]); 4]> {
+) -> Option<[VertexAngle; 4]> {
     let star = topo.star(v);
     if topo.is_boundary(v) || star.len() != 4 {
         return None;

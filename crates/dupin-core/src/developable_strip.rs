@@ -107,7 +107,7 @@ impl PqStrip {
     }
 
     /// Rebuilds a strip of the same closure from the positions of its cut mesh.
-    fn from_cut(&self, positions: &[Vec3]) -> PqStrip {
+    fn rebuild_from_cut(&self, positions: &[Vec3]) -> PqStrip {
         let n = self.a.len();
         let m = if self.closure == StripClosure::Open {
             n
@@ -207,7 +207,7 @@ impl PqStrip {
             ..options
         };
         let r = pq_perturb(&mesh, options)?;
-        Ok((self.from_cut(&r.mesh.positions), r))
+        Ok((self.rebuild_from_cut(&r.mesh.positions), r))
     }
 }
 

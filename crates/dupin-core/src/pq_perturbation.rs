@@ -657,6 +657,7 @@ impl PqPerturbation {
         }
         let mut stencil_start = vec![0];
         let mut stencil = Vec::new();
+        #[allow(clippy::needless_range_loop)]
         for v in 0..nv {
             if !used[v] {
                 continue;

@@ -180,7 +180,9 @@ fn geometry_fact_1_both_ways() {
         // Random stars: the sphere test and the balance fail together.
         let normals: Vec<Vec3> = {
             let mut a: Vec<f64> = (0..4)
-                .map(|k| (k as f64 + 0.3 * (rng.random::<f64>() - 0.5)) * 1.5707963)
+                .map(|k| {
+                    (k as f64 + 0.3 * (rng.random::<f64>() - 0.5)) * std::f64::consts::FRAC_PI_2
+                })
                 .collect();
             a.sort_by(f64::total_cmp);
             a.iter()

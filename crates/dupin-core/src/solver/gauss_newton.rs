@@ -104,6 +104,7 @@ impl LevenbergMarquardt {
         let diag = add_gram(&self.sys, n, &mut self.normal, true, &mut self.scratch);
         let sys = &self.sys;
         let scale = diag.iter().fold(0.0f64, |a, &b| a.max(b)).max(1e-300);
+        #[allow(clippy::needless_range_loop)]
         for i in 0..n {
             let d = if self.options.marquardt_scaling {
                 diag[i] + 1e-9 * scale

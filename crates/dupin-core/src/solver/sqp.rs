@@ -219,8 +219,8 @@ mod tests {
         }
         fn constraints(&self, x: &[f64], out: &mut SparseSystem) {
             let r = out.push_residual(x.iter().map(|v| v * v).sum::<f64>() - 1.0);
-            for k in 0..3 {
-                out.push_entry(r, k as u32, 2.0 * x[k]);
+            for (k, xk) in x.iter().enumerate() {
+                out.push_entry(r, k as u32, 2.0 * xk);
             }
         }
     }

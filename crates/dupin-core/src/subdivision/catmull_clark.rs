@@ -79,6 +79,7 @@ pub fn catmull_clark(mesh: &PolyMesh) -> Result<PolyMesh, TopologyError> {
             let (a, b) = (face[i], face[j]);
             edge_index[&(a.min(b), a.max(b))]
         };
+        #[allow(clippy::needless_range_loop)]
         for k in 0..n {
             faces.push([
                 face[k],
