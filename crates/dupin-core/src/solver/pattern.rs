@@ -4,7 +4,14 @@
 use super::SolverError;
 use faer::Side;
 use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, Lu, SymbolicLlt, SymbolicLu};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::cholesky::{
+    CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
+};
+use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::{Conj, Par};
 use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
 
 /// Which factorisation a cached pattern feeds.
@@ -17,7 +24,13 @@ pub(crate) enum Factor {
 }
 
 enum Symbolic {
-    Llt(SymbolicLlt<u32>),
+    /// Supernodal Cholesky (forced: faer's automatic choice picks the simplicial kernel for
+    /// our mesh matrices, several times slower here) with its value and scratch buffers.
+    Llt {
+        symbolic: Box<SymbolicCholesky<u32>>,
+        values: Vec<f64>,
+        scratch: MemBuffer,
+    },
     Lu(SymbolicLu<u32>),
 }
 
@@ -76,9 +89,26 @@ impl PatternMatrix {
             let (sym, argsort) =
                 SymbolicSparseColMat::try_new_from_indices(n, n, &idx).map_err(|e| fe(&e))?;
             let symbolic = match self.kind {
-                Factor::CholeskyUpper => Symbolic::Llt(
-                    SymbolicLlt::try_new(sym.as_ref(), Side::Upper).map_err(|e| fe(&e))?,
-                ),
+                Factor::CholeskyUpper => {
+                    let symbolic = factorize_symbolic_cholesky(
+                        sym.as_ref(),
+                        Side::Upper,
+                        SymmetricOrdering::Amd,
+                        CholeskySymbolicParams {
+                            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                            ..Default::default()
+                        },
+                    )
+                    .map_err(|e| fe(&e))?;
+                    let req = symbolic
+                        .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
+                        .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
+                    Symbolic::Llt {
+                        values: vec![0.0; symbolic.len_val()],
+                        scratch: MemBuffer::try_new(req).map_err(|e| fe(&e))?,
+                        symbolic: Box::new(symbolic),
+                    }
+                }
                 Factor::Lu => Symbolic::Lu(SymbolicLu::try_new(sym.as_ref()).map_err(|e| fe(&e))?),
             };
             self.cached = Some((sym, argsort, symbolic));
@@ -86,15 +116,28 @@ impl PatternMatrix {
             self.new_pairs.clear();
             self.new_pairs.extend_from_slice(&self.pairs);
         }
-        let (sym, argsort, symbolic) = self.cached.as_ref().expect("cache built above");
+        let (sym, argsort, symbolic) = self.cached.as_mut().expect("cache built above");
         let mat = SparseColMat::<u32, f64>::new_from_argsort(sym.clone(), argsort, &self.values)
             .map_err(|e| fe(&e))?;
         let rhs_mat = faer::MatMut::from_column_major_slice_mut(rhs, n, 1);
         match symbolic {
-            Symbolic::Llt(s) => {
-                let f = Llt::try_new_with_symbolic(s.clone(), mat.as_ref(), Side::Upper)
+            Symbolic::Llt {
+                symbolic,
+                values,
+                scratch,
+            } => {
+                let f = symbolic
+                    .factorize_numeric_llt(
+                        values,
+                        mat.as_ref(),
+                        Side::Upper,
+                        LltRegularization::default(),
+                        Par::Seq,
+                        MemStack::new(scratch),
+                        Default::default(),
+                    )
                     .map_err(|e| fe(&e))?;
-                f.solve_in_place(rhs_mat);
+                f.solve_in_place_with_conj(Conj::No, rhs_mat, Par::Seq, MemStack::new(scratch));
             }
             Symbolic::Lu(s) => {
                 let f = Lu::try_new_with_symbolic(s.clone(), mat.as_ref()).map_err(|e| fe(&e))?;
