@@ -156,3 +156,65 @@ fn bad_input_exits_2_with_one_error_line() {
     let _ = std::fs::remove_file(&input);
     let _ = std::fs::remove_file(&out);
 }
+
+#[test]
+fn iteration_cap_returns_best_mesh_with_converged_false_and_reason() {
+    let input = tmp("cap.obj");
+    let out = tmp("cap-out.obj");
+    let report = tmp("cap.json");
+    std::fs::write(&input, skew_grid_obj()).unwrap();
+    let o = dupin(&[
+        "planarize",
+        "--input",
+        input.to_str().unwrap(),
+        "--max-iterations",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r = read_json(&report);
+    assert_eq!(r["converged"], false);
+    assert_eq!(r["iterations"], 1);
+    assert!(r["reason"].as_str().unwrap().contains("iteration cap"));
+    assert!(out.exists());
+    for p in [input, out, report] {
+        let _ = std::fs::remove_file(p);
+    }
+}
+
+#[test]
+fn hexagons_and_mixed_faces_are_planarized() {
+    // Two hexagons and a quad sharing edges, lifted out of plane.
+    let input = tmp("hex.obj");
+    let out = tmp("hex-out.obj");
+    let report = tmp("hex.json");
+    let text = "v 0 0 0\nv 1 0 0.2\nv 1.5 0.8 0\nv 1 1.6 0.3\nv 0 1.6 0\nv -0.5 0.8 0.25\n\
+                v 2.5 0.8 0.1\nv 3 1.6 -0.2\nv 2.5 2.4 0\nv 1.5 2.4 0.2\nv 0.5 2.6 0\n\
+                f 1 2 3 4 5 6\nf 3 7 8 9 10 4\nf 5 4 10 11\n";
+    std::fs::write(&input, text).unwrap();
+    let o = dupin(&[
+        "planarize",
+        "--input",
+        input.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r = read_json(&report);
+    assert!(r["max_planarity"].as_f64().unwrap() <= 1e-10, "{r}");
+    let faces: Vec<usize> = std::fs::read_to_string(&out)
+        .unwrap()
+        .lines()
+        .filter(|l| l.starts_with("f "))
+        .map(|l| l.split_whitespace().count() - 1)
+        .collect();
+    assert_eq!(faces, vec![6, 6, 4]);
+    for p in [input, out, report] {
+        let _ = std::fs::remove_file(p);
+    }
+}

@@ -2,8 +2,9 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use dupin_core::{
-    PqMode, PqOptions, SurfaceOfRevolution, catmull_clark, max_planarity, pq_perturb,
-    principal_quad_mesh, skew_quad_grid, torus_centroid_dual,
+    PqMode, PqOptions, StripRule, SurfaceOfRevolution, catmull_clark, developable_subdivision,
+    max_planarity, pq_perturb, principal_quad_mesh, skew_quad_grid, torus_centroid_dual,
+    trefoil_moebius,
 };
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -68,7 +69,37 @@ fn bench(c: &mut Criterion) {
     report("torus-centroid-dual-1152", &dual, &planar);
     report("conical-vase-subdivided", &vase, &conical);
     report("conical-vase-noisy-31x31", &noisy_vase(30), &conical);
+    // Trefoil Moebius band (Fig. 9): the PQ strip at 168 quads, one more cubic
+    // Lane-Riesenfeld round gives the 336-quad strip that is planarised.
+    let (levels, _, _) = developable_subdivision(
+        &trefoil_moebius(42, 0.35),
+        StripRule::LaneRiesenfeldCubic,
+        2,
+        &planar,
+    )
+    .unwrap();
+    let trefoil = levels
+        .last()
+        .unwrap()
+        .subdivide(StripRule::LaneRiesenfeldCubic);
+    {
+        let t = std::time::Instant::now();
+        let (s, r) = trefoil.perturb(planar.clone()).unwrap();
+        eprintln!(
+            "trefoil-336: quads {} iterations {} converged {} max_planarity {:.3e} max_det {:.3e} max_move {:.3e} time {:.4} s",
+            s.num_quads(),
+            r.iterations,
+            r.converged,
+            r.max_planarity,
+            s.max_determinant(),
+            r.max_move,
+            t.elapsed().as_secs_f64()
+        );
+    }
     let mut g = c.benchmark_group("pq");
+    g.bench_function("planarize trefoil Moebius band 336 quads", |b| {
+        b.iter(|| black_box(&trefoil).perturb(planar.clone()).unwrap())
+    });
     g.sample_size(10);
     g.bench_function("planarize skew grid 30x30 on z=xy", |b| {
         b.iter(|| pq_perturb(black_box(&grid), planar.clone()).unwrap())
