@@ -14,10 +14,11 @@ fn report(name: &str, mesh: &dupin_core::PolyMesh, options: &PqOptions) {
     let t = std::time::Instant::now();
     let r = pq_perturb(mesh, options.clone()).unwrap();
     eprintln!(
-        "{name}: vertices {} faces {} iterations {} converged {} max_planarity {:.3e} max_move {:.3e} conical {:?} time {:.4} s",
+        "{name}: vertices {} faces {} iterations {} factorizations {} converged {} max_planarity {:.3e} max_move {:.3e} conical {:?} time {:.4} s",
         mesh.num_vertices(),
         mesh.num_faces(),
         r.iterations,
+        r.factorizations,
         r.converged,
         max_planarity(&r.mesh),
         r.max_move,

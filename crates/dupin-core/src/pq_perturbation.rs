@@ -206,6 +206,8 @@ pub struct PqResult {
     pub circular_residual: Option<f64>,
     /// Largest vertex displacement from the input.
     pub max_move: f64,
+    /// Sparse factorisations used (one per tried Gauss-Newton step).
+    pub factorizations: usize,
 }
 
 /// Static data of the objective and constraints.
@@ -893,6 +895,7 @@ impl PqPerturbation {
             converged: self.converged,
             reason: self.reason,
             max_move,
+            factorizations: self.lm.factorizations(),
             mesh: self.mesh,
         }
     }

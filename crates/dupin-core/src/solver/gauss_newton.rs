@@ -62,6 +62,8 @@ pub struct LevenbergMarquardt {
     normal: PatternMatrix,
     sys: SparseSystem,
     trial_sys: SparseSystem,
+    /// Number of factorisations so far.
+    factorizations: usize,
     /// The accepted point whose evaluation is in `trial_sys`, while still valid.
     cached_x: Option<Vec<f64>>,
     scratch: GramScratch,
@@ -77,6 +79,7 @@ impl LevenbergMarquardt {
             sys: SparseSystem::new(),
             trial_sys: SparseSystem::new(),
             cached_x: None,
+            factorizations: 0,
             scratch: GramScratch::default(),
         }
     }
@@ -85,6 +88,11 @@ impl LevenbergMarquardt {
     /// from the last accepted step must not be reused.
     pub fn invalidate(&mut self) {
         self.cached_x = None;
+    }
+
+    /// Number of sparse factorisations done so far (one per tried step).
+    pub fn factorizations(&self) -> usize {
+        self.factorizations
     }
 
     /// Sets the relative damping μ.
@@ -97,24 +105,38 @@ impl LevenbergMarquardt {
         self.damping
     }
 
-    /// Solves the damped normal equations `(JᵀJ + μ·s·I) h = -Jᵀr` for the system `sys`, where
-    /// `s` is the largest diagonal entry of JᵀJ (so `mu` is relative). Returns `h`.
-    fn damped_step(&mut self, n: usize, mu: f64) -> Result<Vec<f64>, SolverError> {
+    /// Assembles JᵀJ (upper triangle) of the current system followed by `n` diagonal damping
+    /// slots, and returns the gradient Jᵀr and the per-variable damping scale `D`.
+    fn assemble(&mut self, n: usize) -> (Vec<f64>, Vec<f64>) {
         self.normal.begin(n);
         let diag = add_gram(&self.sys, n, &mut self.normal, true, &mut self.scratch);
-        let sys = &self.sys;
         let scale = diag.iter().fold(0.0f64, |a, &b| a.max(b)).max(1e-300);
-        #[allow(clippy::needless_range_loop)]
+        let d: Vec<f64> = diag
+            .iter()
+            .map(|&g| {
+                if self.options.marquardt_scaling {
+                    g + 1e-9 * scale
+                } else {
+                    scale
+                }
+            })
+            .collect();
         for i in 0..n {
-            let d = if self.options.marquardt_scaling {
-                diag[i] + 1e-9 * scale
-            } else {
-                scale
-            };
-            self.normal.add(i as u32, i as u32, mu * d);
+            self.normal.add(i as u32, i as u32, 0.0);
         }
-        let mut rhs = sys.gradient(n);
-        rhs.iter_mut().for_each(|g| *g = -*g);
+        (self.sys.gradient(n), d)
+    }
+
+    /// Solves `(JᵀJ + μ D) h = -g` with the assembled matrix (only the damping slots change
+    /// between tries).
+    fn damped_step(&mut self, g: &[f64], d: &[f64], mu: f64) -> Result<Vec<f64>, SolverError> {
+        let n = g.len();
+        let base = self.normal.values.len() - n;
+        for i in 0..n {
+            self.normal.values[base + i] = mu * d[i];
+        }
+        let mut rhs: Vec<f64> = g.iter().map(|v| -v).collect();
+        self.factorizations += 1;
         self.normal.solve(&mut rhs)?;
         Ok(rhs)
     }
@@ -147,9 +169,11 @@ impl LevenbergMarquardt {
                 damping: self.damping,
             });
         }
+        let (g, d) = self.assemble(n);
         let mut trial = vec![0.0; n];
+        let mut grow = 2.0;
         for _ in 0..=self.options.max_retries {
-            let h = match self.damped_step(n, self.damping) {
+            let h = match self.damped_step(&g, &d, self.damping) {
                 Ok(h) => h,
                 Err(_) => {
                     self.damping = (self.damping * 10.0).max(1e-12);
@@ -167,10 +191,28 @@ impl LevenbergMarquardt {
                 f64::INFINITY
             };
             if cost_after < cost_before {
+                // Gain ratio against the model decrease ½ hᵀ(μ D h - g).
+                let predicted: f64 = 0.5
+                    * (0..n)
+                        .map(|i| h[i] * (self.damping * d[i] * h[i] - g[i]))
+                        .sum::<f64>();
+                let rho = if predicted > 0.0 {
+                    (cost_before - cost_after) / predicted
+                } else {
+                    1.0
+                };
                 x.copy_from_slice(&trial);
                 self.cached_x = Some(trial);
                 let used = self.damping;
-                self.damping = (self.damping / self.options.decrease).max(self.options.min_damping);
+                // Trust-region style: shrink on a good model, keep on a fair one, grow on a poor.
+                let factor = if rho > 0.5 {
+                    1.0 / self.options.decrease
+                } else if rho > 0.1 {
+                    1.0
+                } else {
+                    2.0
+                };
+                self.damping = (self.damping * factor).max(self.options.min_damping);
                 return Ok(LmStep {
                     cost_before,
                     cost_after,
@@ -178,7 +220,8 @@ impl LevenbergMarquardt {
                     damping: used,
                 });
             }
-            self.damping = (self.damping * 4.0).max(1e-12);
+            self.damping = (self.damping * grow).max(1e-12);
+            grow *= 2.0;
         }
         Err(SolverError::NoDescent {
             damping: self.damping,
