@@ -727,6 +727,7 @@ impl PqPerturbation {
             x,
             lm: LevenbergMarquardt::new(LmOptions {
                 decrease: 10.0,
+                step_halvings: 2,
                 ..LmOptions::default()
             }),
             sqp: Sqp::new(SqpOptions {
@@ -872,7 +873,8 @@ impl PqPerturbation {
     fn enter_refinement(&mut self) {
         self.phase = PqPhase::Sqp;
         self.lm.invalidate();
-        self.lm.set_damping(1e-6);
+        // Near-Gauss-Newton steps on the constraints: quadratic convergence once close.
+        self.lm.set_damping(1e-9);
     }
 
     /// Runs to the end and returns the result.

@@ -25,6 +25,9 @@ pub struct LmOptions {
     /// Scale the damping per variable by the diagonal of JᵀJ (Marquardt) instead of one
     /// uniform value (Levenberg); better when variables have different units.
     pub marquardt_scaling: bool,
+    /// Step halvings tried on a rejected step before the damping is raised (each costs one
+    /// evaluation instead of a factorisation).
+    pub step_halvings: usize,
     /// Factor by which the damping shrinks after an accepted step (> 1).
     pub decrease: f64,
 }
@@ -36,6 +39,7 @@ impl Default for LmOptions {
             min_damping: 1e-15,
             max_retries: 12,
             decrease: 3.0,
+            step_halvings: 0,
             marquardt_scaling: false,
         }
     }
@@ -180,16 +184,41 @@ impl LevenbergMarquardt {
                     continue;
                 }
             };
-            for i in 0..n {
-                trial[i] = x[i] + h[i];
+            // Try the full step, then (cheaper than a new factorisation) a few shortened ones.
+            let mut h = h;
+            let mut cost_after = f64::INFINITY;
+            let mut shortened = false;
+            for k in 0..=self.options.step_halvings {
+                if k > 0 {
+                    h.iter_mut().for_each(|v| *v *= 0.5);
+                    shortened = true;
+                }
+                for i in 0..n {
+                    trial[i] = x[i] + h[i];
+                }
+                self.trial_sys.clear();
+                problem.evaluate(&trial, &mut self.trial_sys);
+                cost_after = if self.trial_sys.validate(n).is_ok() {
+                    self.trial_sys.cost()
+                } else {
+                    f64::INFINITY
+                };
+                if cost_after < cost_before {
+                    break;
+                }
             }
-            self.trial_sys.clear();
-            problem.evaluate(&trial, &mut self.trial_sys);
-            let cost_after = if self.trial_sys.validate(n).is_ok() {
-                self.trial_sys.cost()
-            } else {
-                f64::INFINITY
-            };
+            if cost_after < cost_before && shortened {
+                x.copy_from_slice(&trial);
+                self.cached_x = Some(trial);
+                let used = self.damping;
+                self.damping = (self.damping * 2.0).max(1e-12);
+                return Ok(LmStep {
+                    cost_before,
+                    cost_after,
+                    step_norm: h.iter().map(|v| v * v).sum::<f64>().sqrt(),
+                    damping: used,
+                });
+            }
             if cost_after < cost_before {
                 // Gain ratio against the model decrease ½ hᵀ(μ D h - g).
                 let predicted: f64 = 0.5
