@@ -136,8 +136,8 @@ impl LevenbergMarquardt {
     fn damped_step(&mut self, g: &[f64], d: &[f64], mu: f64) -> Result<Vec<f64>, SolverError> {
         let n = g.len();
         let base = self.normal.values.len() - n;
-        for i in 0..n {
-            self.normal.values[base + i] = mu * d[i];
+        for (slot, di) in self.normal.values[base..].iter_mut().zip(d) {
+            *slot = mu * di;
         }
         let mut rhs: Vec<f64> = g.iter().map(|v| -v).collect();
         self.factorizations += 1;
