@@ -10,11 +10,21 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::hint::black_box;
 
+/// CPU time of this thread in seconds (Linux `schedstat`), to separate our own work from the
+/// waiting caused by other processes on a shared machine; `None` elsewhere.
+fn thread_cpu_seconds() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    let ns: f64 = s.split_whitespace().next()?.parse().ok()?;
+    Some(ns * 1e-9)
+}
+
 fn report(name: &str, mesh: &dupin_core::PolyMesh, options: &PqOptions) {
     let t = std::time::Instant::now();
+    let c0 = thread_cpu_seconds();
     let r = pq_perturb(mesh, options.clone()).unwrap();
+    let cpu = c0.and_then(|c| Some(thread_cpu_seconds()? - c));
     eprintln!(
-        "{name}: vertices {} faces {} iterations {} factorizations {} converged {} max_planarity {:.3e} max_move {:.3e} conical {:?} time {:.4} s",
+        "{name}: cpu {cpu:.4?} s, vertices {} faces {} iterations {} factorizations {} converged {} max_planarity {:.3e} max_move {:.3e} conical {:?} time {:.4} s",
         mesh.num_vertices(),
         mesh.num_faces(),
         r.iterations,
@@ -85,9 +95,11 @@ fn bench(c: &mut Criterion) {
         .subdivide(StripRule::LaneRiesenfeldCubic);
     {
         let t = std::time::Instant::now();
+        let c0 = thread_cpu_seconds();
         let (s, r) = trefoil.perturb(planar.clone()).unwrap();
+        let cpu = c0.and_then(|c| Some(thread_cpu_seconds()? - c));
         eprintln!(
-            "trefoil-336: quads {} iterations {} converged {} max_planarity {:.3e} max_det {:.3e} max_move {:.3e} time {:.4} s",
+            "trefoil-336: cpu {cpu:.4?} s, quads {} iterations {} converged {} max_planarity {:.3e} max_det {:.3e} max_move {:.3e} time {:.4} s",
             s.num_quads(),
             r.iterations,
             r.converged,
