@@ -30,8 +30,11 @@ pub struct PlanarizeArgs {
     /// Keep the boundary vertices fixed.
     #[arg(long)]
     pub fix_boundary: bool,
+    /// Anchors: vertices that must not move, 1-based OBJ indices, comma separated.
+    #[arg(long, value_delimiter = ',')]
+    pub fix_vertices: Vec<usize>,
     /// Initial closeness weight (>= 0).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 0.01)]
     pub closeness: f64,
     /// Iteration cap.
     #[arg(long, default_value_t = 100)]
@@ -57,8 +60,19 @@ pub fn run(args: PlanarizeArgs) -> Result<(), CliError> {
         ModeArg::Conical => PqMode::Conical,
         ModeArg::Circular => PqMode::Circular,
     };
+    let mut fixed_vertices = Vec::with_capacity(args.fix_vertices.len());
+    for &i in &args.fix_vertices {
+        if i == 0 || i > mesh.num_vertices() {
+            return Err(CliError::Input(format!(
+                "--fix-vertices: vertex {i} does not exist (1-based, the mesh has {} vertices)",
+                mesh.num_vertices()
+            )));
+        }
+        fixed_vertices.push(i - 1);
+    }
     let options = PqOptions {
         mode,
+        fixed_vertices,
         fix_boundary: args.fix_boundary,
         closeness: args.closeness,
         max_iterations: args.max_iterations,

@@ -218,3 +218,55 @@ fn hexagons_and_mixed_faces_are_planarized() {
         let _ = std::fs::remove_file(p);
     }
 }
+
+#[test]
+fn anchors_stay_put_and_bad_anchor_is_rejected() {
+    let input = tmp("anchor.obj");
+    let out = tmp("anchor-out.obj");
+    std::fs::write(&input, skew_grid_obj()).unwrap();
+    let o = dupin(&[
+        "planarize",
+        "--input",
+        input.to_str().unwrap(),
+        "--fix-vertices",
+        "1,25,49",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let a: Vec<String> = std::fs::read_to_string(&input)
+        .unwrap()
+        .lines()
+        .map(String::from)
+        .collect();
+    let b: Vec<String> = std::fs::read_to_string(&out)
+        .unwrap()
+        .lines()
+        .map(String::from)
+        .collect();
+    for i in [0, 24, 48] {
+        let pa: Vec<f64> = a[i]
+            .split_whitespace()
+            .skip(1)
+            .map(|t| t.parse().unwrap())
+            .collect();
+        let pb: Vec<f64> = b[i]
+            .split_whitespace()
+            .skip(1)
+            .map(|t| t.parse().unwrap())
+            .collect();
+        assert_eq!(pa, pb, "vertex {}", i + 1);
+    }
+    let o = dupin(&[
+        "planarize",
+        "--input",
+        input.to_str().unwrap(),
+        "--fix-vertices",
+        "50",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let _ = std::fs::remove_file(&input);
+    let _ = std::fs::remove_file(&out);
+}
