@@ -292,3 +292,48 @@ fn vertex_types_on_the_torus() {
     }
     assert!(seen.0 > 0 && seen.1 > 0);
 }
+
+/// A valence-4 star at the origin with the given edge directions (in rotation order).
+fn star_with_edges(dirs: [Vec3; 4]) -> PolyMesh {
+    let mut pos = vec![Vec3::zeros()];
+    pos.extend(dirs.iter().copied());
+    for k in 0..4 {
+        pos.push(1.2 * (dirs[k] + dirs[(k + 1) % 4]));
+    }
+    let faces: Vec<[u32; 4]> = (0..4u32)
+        .map(|k| [0, 1 + k, 5 + k, 1 + (k + 1) % 4])
+        .collect();
+    PolyMesh::new(pos, faces).unwrap()
+}
+
+#[test]
+fn vertex_types_elliptic_hyperbolic_parabolic() {
+    let e = |x: f64, y: f64, z: f64| Vec3::new(x, y, z).normalize();
+    // Convex spherical quad in the upper hemisphere: elliptic.
+    let m = star_with_edges([
+        e(1.0, 0.0, -0.3),
+        e(0.0, 1.0, -0.3),
+        e(-1.0, 0.0, -0.3),
+        e(0.0, -1.0, -0.3),
+    ]);
+    let t = MeshTopology::new(&m).unwrap();
+    assert_eq!(vertex_type(&m, &t, 0), Some(VertexType::Elliptic));
+    // Saddle: up, down, up, down: no hemisphere holds them.
+    let m = star_with_edges([
+        e(1.0, 0.0, 0.4),
+        e(0.0, 1.0, -0.4),
+        e(-1.0, 0.0, 0.4),
+        e(0.0, -1.0, -0.4),
+    ]);
+    let t = MeshTopology::new(&m).unwrap();
+    assert_eq!(vertex_type(&m, &t, 0), Some(VertexType::Hyperbolic));
+    // In one hemisphere (z < 0.3) but one direction folded inwards: parabolic.
+    let m = star_with_edges([
+        e(1.0, 0.0, -0.2),
+        e(0.0, 1.0, -0.2),
+        e(-1.0, 0.0, -0.2),
+        e(0.0, 0.3, -1.0),
+    ]);
+    let t = MeshTopology::new(&m).unwrap();
+    assert_eq!(vertex_type(&m, &t, 0), Some(VertexType::Parabolic));
+}
