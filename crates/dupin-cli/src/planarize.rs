@@ -3,7 +3,7 @@
 
 use crate::common::{CliError, read_text, write_report, write_text};
 use clap::{Args, ValueEnum};
-use dupin_core::{PqMode, PqOptions, parse_obj, pq_perturb, write_obj};
+use dupin_core::{PqMode, PqOptions, Refinement, parse_obj, pq_perturb, write_obj};
 use serde_json::json;
 use std::path::PathBuf;
 
@@ -16,6 +16,15 @@ pub enum ModeArg {
     Conical,
     /// Planar faces and circular quads (opposite angles sum to pi).
     Circular,
+}
+
+/// Solver of the exact phase after the penalty iterations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RefineArg {
+    /// Gauss-Newton on the constraints (fast; default).
+    GaussNewton,
+    /// SQP on the KKT system (paper's eq. (3); slower on large meshes).
+    Sqp,
 }
 
 /// Arguments of `dupin planarize`.
@@ -42,6 +51,9 @@ pub struct PlanarizeArgs {
     /// Target for max_planarity and the mode residual.
     #[arg(long, default_value_t = 1e-11)]
     pub tolerance: f64,
+    /// Solver of the exact phase.
+    #[arg(long, value_enum, default_value = "gauss-newton")]
+    pub refinement: RefineArg,
     /// Output OBJ.
     #[arg(long)]
     pub out: PathBuf,
@@ -73,6 +85,10 @@ pub fn run(args: PlanarizeArgs) -> Result<(), CliError> {
     let options = PqOptions {
         mode,
         fixed_vertices,
+        refinement: match args.refinement {
+            RefineArg::GaussNewton => Refinement::GaussNewton,
+            RefineArg::Sqp => Refinement::Sqp,
+        },
         fix_boundary: args.fix_boundary,
         closeness: args.closeness,
         max_iterations: args.max_iterations,

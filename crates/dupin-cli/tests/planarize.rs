@@ -270,3 +270,29 @@ fn anchors_stay_put_and_bad_anchor_is_rejected() {
     let _ = std::fs::remove_file(&input);
     let _ = std::fs::remove_file(&out);
 }
+
+#[test]
+fn sqp_refinement_reaches_the_same_accuracy() {
+    let input = tmp("sqp.obj");
+    let out = tmp("sqp-out.obj");
+    let report = tmp("sqp.json");
+    std::fs::write(&input, skew_grid_obj()).unwrap();
+    let o = dupin(&[
+        "planarize",
+        "--input",
+        input.to_str().unwrap(),
+        "--refinement",
+        "sqp",
+        "--out",
+        out.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r = read_json(&report);
+    assert_eq!(r["converged"], true, "{r}");
+    assert!(r["max_planarity"].as_f64().unwrap() <= 1e-10);
+    for p in [input, out, report] {
+        let _ = std::fs::remove_file(p);
+    }
+}
