@@ -71,6 +71,8 @@ pub struct LevenbergMarquardt {
     /// The accepted point whose evaluation is in `trial_sys`, while still valid.
     cached_x: Option<Vec<f64>>,
     scratch: GramScratch,
+    /// Residual count and Jacobian (row, col) pattern behind the cached normal matrix.
+    last_pattern: (usize, Vec<(u32, u32)>),
 }
 
 impl LevenbergMarquardt {
@@ -85,6 +87,7 @@ impl LevenbergMarquardt {
             cached_x: None,
             factorizations: 0,
             scratch: GramScratch::default(),
+            last_pattern: (0, Vec::new()),
         }
     }
 
@@ -112,8 +115,34 @@ impl LevenbergMarquardt {
     /// Assembles JᵀJ (upper triangle) of the current system followed by `n` diagonal damping
     /// slots, and returns the gradient Jᵀr and the per-variable damping scale `D`.
     fn assemble(&mut self, n: usize) -> (Vec<f64>, Vec<f64>) {
-        self.normal.begin(n);
-        let diag = add_gram(&self.sys, n, &mut self.normal, true, &mut self.scratch);
+        // Same Jacobian pattern as last time: push the values only, in the cached order.
+        let same = self.normal.has_pattern(n)
+            && self.last_pattern.0 == self.sys.residuals.len()
+            && self.last_pattern.1.len() == self.sys.entries.len()
+            && self
+                .sys
+                .entries
+                .iter()
+                .zip(&self.last_pattern.1)
+                .all(|(e, &(r, c))| e.row == r && e.col == c);
+        if same {
+            self.normal.begin_values_only();
+        } else {
+            self.normal.begin(n);
+            self.last_pattern.0 = self.sys.residuals.len();
+            self.last_pattern.1.clear();
+            self.last_pattern
+                .1
+                .extend(self.sys.entries.iter().map(|e| (e.row, e.col)));
+        }
+        let diag = add_gram(
+            &self.sys,
+            n,
+            &mut self.normal,
+            true,
+            &mut self.scratch,
+            same,
+        );
         let scale = diag.iter().fold(0.0f64, |a, &b| a.max(b)).max(1e-300);
         let d: Vec<f64> = diag
             .iter()
@@ -126,7 +155,11 @@ impl LevenbergMarquardt {
             })
             .collect();
         for i in 0..n {
-            self.normal.add(i as u32, i as u32, 0.0);
+            if same {
+                self.normal.add_value(0.0);
+            } else {
+                self.normal.add(i as u32, i as u32, 0.0);
+            }
         }
         (self.sys.gradient(n), d)
     }

@@ -45,6 +45,8 @@ pub(crate) struct PatternMatrix {
     pub new_pairs: Vec<(u32, u32)>,
     /// Values of the matrix being assembled, aligned with `new_pairs`.
     pub values: Vec<f64>,
+    /// The caller promised the same pattern as the cached one (values only were pushed).
+    same_pattern: bool,
 }
 
 impl PatternMatrix {
@@ -56,7 +58,26 @@ impl PatternMatrix {
             cached: None,
             new_pairs: Vec::new(),
             values: Vec::new(),
+            same_pattern: false,
         }
+    }
+
+    /// Whether a pattern has been analysed for size `n` (so values-only assembly is possible).
+    pub(crate) fn has_pattern(&self, n: usize) -> bool {
+        self.cached.is_some() && self.n == n
+    }
+
+    /// Starts a values-only assembly: the caller pushes values with [`Self::add_value`] in the
+    /// exact order of the cached pattern.
+    pub(crate) fn begin_values_only(&mut self) {
+        self.values.clear();
+        self.same_pattern = true;
+    }
+
+    /// Adds the next value of a values-only assembly.
+    #[inline]
+    pub(crate) fn add_value(&mut self, value: f64) {
+        self.values.push(value);
     }
 
     /// Starts a new assembly of an `n x n` matrix.
@@ -67,6 +88,7 @@ impl PatternMatrix {
         }
         self.new_pairs.clear();
         self.values.clear();
+        self.same_pattern = false;
     }
 
     /// Adds `value` at (row, col); repeated positions are summed.
@@ -80,7 +102,18 @@ impl PatternMatrix {
     pub(crate) fn solve(&mut self, rhs: &mut [f64]) -> Result<(), SolverError> {
         let n = self.n;
         let fe = |e: &dyn std::fmt::Debug| SolverError::Factorization(format!("{e:?}"));
-        if self.cached.is_none() || self.pairs != self.new_pairs {
+        let reuse = self.cached.is_some()
+            && if self.same_pattern {
+                self.values.len() == self.pairs.len()
+            } else {
+                self.pairs == self.new_pairs
+            };
+        if !reuse {
+            if self.same_pattern {
+                return Err(SolverError::Factorization(
+                    "values-only assembly without a matching pattern".into(),
+                ));
+            }
             let idx: Vec<Pair<u32, u32>> = self
                 .new_pairs
                 .iter()
@@ -114,8 +147,10 @@ impl PatternMatrix {
             self.cached = Some((sym, argsort, symbolic));
             std::mem::swap(&mut self.pairs, &mut self.new_pairs);
             self.new_pairs.clear();
-            self.new_pairs.extend_from_slice(&self.pairs);
         }
+        // The values now follow the cached pattern: further solves with changed values (e.g.
+        // damping retries) reuse it without comparing.
+        self.same_pattern = true;
         let (sym, argsort, symbolic) = self.cached.as_mut().expect("cache built above");
         let mat = SparseColMat::<u32, f64>::new_from_argsort(sym.clone(), argsort, &self.values)
             .map_err(|e| fe(&e))?;
@@ -169,6 +204,7 @@ pub(crate) fn add_gram(
     pm: &mut PatternMatrix,
     upper_only: bool,
     scratch: &mut GramScratch,
+    values_only: bool,
 ) -> Vec<f64> {
     let m = sys.residuals.len();
     // Group the entries by row (counting sort).
@@ -198,7 +234,11 @@ pub(crate) fn add_gram(
             for &b in row {
                 let eb = sys.entries[b];
                 if !upper_only || ea.col <= eb.col {
-                    pm.add(ea.col, eb.col, ea.value * eb.value);
+                    if values_only {
+                        pm.add_value(ea.value * eb.value);
+                    } else {
+                        pm.add(ea.col, eb.col, ea.value * eb.value);
+                    }
                 }
                 if ea.col == eb.col {
                     diag[ea.col as usize] += ea.value * eb.value;
