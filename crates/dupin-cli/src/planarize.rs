@@ -43,13 +43,13 @@ pub struct PlanarizeArgs {
     #[arg(long, value_delimiter = ',')]
     pub fix_vertices: Vec<usize>,
     /// Initial closeness weight (>= 0).
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long, default_value_t = 0.01, allow_hyphen_values = true)]
     pub closeness: f64,
     /// Iteration cap.
     #[arg(long, default_value_t = 100)]
     pub max_iterations: usize,
     /// Target for max_planarity and the mode residual.
-    #[arg(long, default_value_t = 1e-11)]
+    #[arg(long, default_value_t = 1e-11, allow_hyphen_values = true)]
     pub tolerance: f64,
     /// Solver of the exact phase.
     #[arg(long, value_enum, default_value = "gauss-newton")]
