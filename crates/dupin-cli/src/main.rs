@@ -7,6 +7,9 @@ use std::process::ExitCode;
 
 mod common;
 mod hexdelaunay;
+mod offset;
+mod planarize;
+mod pq;
 mod surface_info;
 
 /// Planar-panel geometry for architecture.
@@ -23,12 +26,21 @@ enum Command {
     SurfaceInfo(surface_info::SurfaceInfoArgs),
     /// Hexagonal Delaunay triangulation of a point set (angles in [30, 120] degrees).
     Hexdelaunay(hexdelaunay::HexDelaunayArgs),
+    /// Make every face planar (optionally conical or circular) by minimal vertex moves.
+    Planarize(planarize::PlanarizeArgs),
+    /// Offset a conical mesh by a face distance, with its support structure.
+    Offset(offset::OffsetArgs),
+    /// Build a PQ scene of the conical paper (see --list-scenes).
+    Pq(pq::PqArgs),
 }
 
 fn run(cli: Cli) -> Result<(), common::CliError> {
     match cli.command {
         Command::SurfaceInfo(args) => surface_info::run(args),
         Command::Hexdelaunay(args) => hexdelaunay::run(args),
+        Command::Planarize(a) => planarize::run(a),
+        Command::Offset(a) => offset::run(a),
+        Command::Pq(a) => pq::run(a),
     }
 }
 

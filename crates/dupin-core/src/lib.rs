@@ -17,23 +17,43 @@
 // `!(x > t)` is used on purpose throughout: unlike `x <= t` it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod circular;
+mod conical;
 mod curvature;
+mod developable_strip;
+mod discrete_terms;
 mod dupin_center;
 mod dupin_indicatrix;
 mod hex_delaunay;
 mod ideal_triangle;
 mod math;
 mod mesh;
+mod mesh_topology;
 mod obj;
+mod offset;
 mod planarity;
 mod point_set;
 mod polygon;
+mod pq_perturbation;
+mod pq_scenes;
+mod principal_quad_mesh;
 mod render_buffers;
+mod solver;
+mod subdivision;
+mod support_structure;
 mod surface;
 mod tangent_duality;
 mod triangle_star;
 
+pub use circular::{circular_residual, quad_circularity};
+pub use conical::{
+    VertexType, angle_balance, cone_axes, conical_residual, face_normals, focal_points,
+    spherical_image, vertex_type,
+};
 pub use curvature::{Curvature, CurvatureError, CurvatureTolerance, PointType, TangentFrame};
+pub use developable_strip::{
+    PqStrip, StripClosure, StripRule, developable_subdivision, trefoil_moebius,
+};
 pub use dupin_center::{
     DupinCenterError, DupinCenterMethod, approximate_dupin_center, dupin_center, dupin_center_3d,
     dupin_conic_through,
@@ -50,11 +70,27 @@ pub use ideal_triangle::{
 };
 pub use math::{Vec2, Vec3};
 pub use mesh::{MeshError, PolyMesh};
+pub use mesh_topology::{MeshTopology, TopologyError};
 pub use obj::{ObjError, parse_obj, write_obj};
+pub use offset::{OffsetError, offset_mesh};
 pub use planarity::{face_planarity, max_planarity};
 pub use point_set::{PointSetError, parse_points, parse_segments};
 pub use polygon::{PolygonError, is_simple_polygon, segments_intersect, strictly_inside_triangle};
+pub use pq_perturbation::{
+    PqError, PqMode, PqOptions, PqPerturbation, PqPhase, PqResult, PqStepInfo, Refinement,
+    pq_perturb,
+};
+pub use pq_scenes::{
+    PQ_SCENES, PqSceneError, PqSceneResult, pq_scene, skew_quad_grid, torus_centroid_dual,
+};
+pub use principal_quad_mesh::{SurfaceOfRevolution, principal_quad_mesh};
 pub use render_buffers::{TriangleBuffers, sample_surface};
+pub use solver::{
+    ConstrainedLeastSquares, JacobianEntry, LevenbergMarquardt, LmOptions, LmStep,
+    NonlinearLeastSquares, SolverError, SparseSystem, Sqp, SqpOptions, SqpStep,
+};
+pub use subdivision::{catmull_clark, chaikin, doo_sabin, lane_riesenfeld_cubic};
+pub use support_structure::support_structure;
 pub use surface::{
     BSplinePatch, BSplinePatchError, Catenoid, ClosestPoint, ClosestPointError, Cylinder, Domain,
     DupinCyclide, Ellipsoid, Enneper, FundamentalForms, HyperbolicParaboloid, Hyperboloid,
