@@ -1,7 +1,7 @@
 //! # dupin-web
 //!
 //! The browser face of Dupin: the only crate with `#[wasm_bindgen]`. It exposes the core's
-//! computations to JavaScript as typed arrays and plain objects, and a [`Viewer`] that draws
+//! computations to JavaScript as typed arrays and plain objects, and a `Viewer` that draws
 //! them with `dupin-render` into a canvas (WebGPU, or WebGL2 where WebGPU is missing).
 //! Errors cross the boundary as JS `Error`s carrying the Rust message.
 
