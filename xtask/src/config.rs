@@ -73,7 +73,7 @@ impl WebBuild {
     pub fn test_node(&self) -> Result<()> {
         let mut cmd = Command::new("wasm-pack");
         cmd.current_dir(root())
-            .args(["test", "--node", &self.file.build.krate, "--"])
+            .args(["test", "--node", &self.file.build.krate])
             .args(&self.file.test.node);
         run(&mut cmd)
     }
@@ -84,7 +84,7 @@ impl WebBuild {
         cmd.current_dir(root())
             .args(["test", "--headless", "--chrome", "--chromedriver"])
             .arg(&self.file.test.chromedriver)
-            .args([&self.file.build.krate, "--"])
+            .arg(&self.file.build.krate)
             .args(&self.file.test.chrome);
         run(&mut cmd)
     }

@@ -58,14 +58,23 @@ pub fn run() -> Result<()> {
                 .env("RUSTDOCFLAGS", "-D warnings"),
         )
     })?;
-    step("core for wasm32", &mut || {
-        util::run(cargo().args([
-            "build",
-            "-p",
-            "dupin-core",
-            "--target",
-            "wasm32-unknown-unknown",
-        ]))
+    step("core tests on wasm32 (Node)", &mut || {
+        // The core's wasm32 test files run under wasm-bindgen-test-runner in Node.
+        util::run(
+            cargo()
+                .args([
+                    "test",
+                    "-p",
+                    "dupin-core",
+                    "--target",
+                    "wasm32-unknown-unknown",
+                ])
+                .args(["--test", "wasm_smoke"])
+                .env(
+                    "CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER",
+                    "wasm-bindgen-test-runner",
+                ),
+        )
     })?;
     step("wasm tests (Node)", &mut || web.test_node())?;
     step("wasm tests (headless Chromium)", &mut || web.test_chrome())?;
