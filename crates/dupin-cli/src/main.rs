@@ -6,6 +6,9 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 mod common;
+mod offset;
+mod planarize;
+mod pq;
 
 /// Planar-panel geometry for architecture.
 #[derive(Parser)]
@@ -16,10 +19,21 @@ struct Cli {
 }
 
 #[derive(Subcommand)]
-enum Command {}
+enum Command {
+    /// Make every face planar (optionally conical or circular) by minimal vertex moves.
+    Planarize(planarize::PlanarizeArgs),
+    /// Offset a conical mesh by a face distance, with its support structure.
+    Offset(offset::OffsetArgs),
+    /// Build a PQ scene of the conical paper (see --list-scenes).
+    Pq(pq::PqArgs),
+}
 
 fn run(cli: Cli) -> Result<(), common::CliError> {
-    match cli.command {}
+    match cli.command {
+        Command::Planarize(a) => planarize::run(a),
+        Command::Offset(a) => offset::run(a),
+        Command::Pq(a) => pq::run(a),
+    }
 }
 
 fn main() -> ExitCode {

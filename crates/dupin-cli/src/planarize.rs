@@ -1,0 +1,113 @@
+//! `dupin planarize`: PQ / conical / circular perturbation of any polygon mesh (conical paper,
+//! Sec. 2.2 and 5).
+
+use crate::common::{CliError, read_text, write_report, write_text};
+use clap::{Args, ValueEnum};
+use dupin_core::{PqMode, PqOptions, parse_obj, pq_perturb, write_obj};
+use serde_json::json;
+use std::path::PathBuf;
+
+/// Which property to enforce besides planar faces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ModeArg {
+    /// Planar faces only.
+    Planar,
+    /// Planar faces and conical vertices (angle balance at interior valence-4 vertices).
+    Conical,
+    /// Planar faces and circular quads (opposite angles sum to pi).
+    Circular,
+}
+
+/// Arguments of `dupin planarize`.
+#[derive(Debug, Args)]
+pub struct PlanarizeArgs {
+    /// Input OBJ (any polygon mesh).
+    #[arg(long)]
+    pub input: PathBuf,
+    /// Property to enforce.
+    #[arg(long, value_enum, default_value = "planar")]
+    pub mode: ModeArg,
+    /// Keep the boundary vertices fixed.
+    #[arg(long)]
+    pub fix_boundary: bool,
+    /// Initial closeness weight (>= 0).
+    #[arg(long, default_value_t = 1.0)]
+    pub closeness: f64,
+    /// Iteration cap.
+    #[arg(long, default_value_t = 100)]
+    pub max_iterations: usize,
+    /// Target for max_planarity and the mode residual.
+    #[arg(long, default_value_t = 1e-11)]
+    pub tolerance: f64,
+    /// Output OBJ.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// JSON report file.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+}
+
+/// Runs `dupin planarize`.
+pub fn run(args: PlanarizeArgs) -> Result<(), CliError> {
+    let text = read_text(&args.input)?;
+    let mesh =
+        parse_obj(&text).map_err(|e| CliError::input(&args.input.display().to_string(), e))?;
+    let mode = match args.mode {
+        ModeArg::Planar => PqMode::Planar,
+        ModeArg::Conical => PqMode::Conical,
+        ModeArg::Circular => PqMode::Circular,
+    };
+    let options = PqOptions {
+        mode,
+        fix_boundary: args.fix_boundary,
+        closeness: args.closeness,
+        max_iterations: args.max_iterations,
+        tolerance: args.tolerance,
+        ..PqOptions::default()
+    };
+    let start = std::time::Instant::now();
+    let result = pq_perturb(&mesh, options).map_err(|e| CliError::input("", e))?;
+    let seconds = start.elapsed().as_secs_f64();
+    write_text(&args.out, &write_obj(&result.mesh))?;
+    let mut report = json!({
+        "vertices": result.mesh.num_vertices(),
+        "faces": result.mesh.num_faces(),
+        "max_planarity": result.max_planarity,
+        "max_move": result.max_move,
+        "iterations": result.iterations,
+        "seconds": seconds,
+        "converged": result.converged,
+    });
+    if let Some(c) = result.conical_residual {
+        report["conical_residual"] = json!(c);
+    }
+    if let Some(c) = result.circular_residual {
+        report["circular_residual"] = json!(c);
+    }
+    if let Some(r) = &result.reason {
+        report["reason"] = json!(r);
+    }
+    write_report(args.report.as_deref(), &report)?;
+    let mut line = format!(
+        "planarize: {} faces, max_planarity {:.3e}, max_move {:.3e}, {} iterations, {:.3} s",
+        result.mesh.num_faces(),
+        result.max_planarity,
+        result.max_move,
+        result.iterations,
+        seconds
+    );
+    if let Some(c) = result.conical_residual {
+        line += &format!(", conical_residual {c:.3e}");
+    }
+    if let Some(c) = result.circular_residual {
+        line += &format!(", circular_residual {c:.3e}");
+    }
+    if !result.converged {
+        line += &format!(
+            ", NOT converged: {}",
+            result.reason.as_deref().unwrap_or("unknown")
+        );
+    }
+    println!("{line}");
+    Ok(())
+}

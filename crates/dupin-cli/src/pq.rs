@@ -1,0 +1,76 @@
+//! `dupin pq`: the PQ scenes of the conical paper (subdivision with PQ / conical / circular
+//! perturbation, developable strips).
+
+use crate::common::{CliError, write_report, write_text};
+use clap::Args;
+use dupin_core::{PQ_SCENES, pq_scene, write_obj};
+use serde_json::json;
+use std::path::PathBuf;
+
+/// Arguments of `dupin pq`.
+#[derive(Debug, Args)]
+pub struct PqArgs {
+    /// Scene name (see --list-scenes).
+    #[arg(long, required_unless_present = "list_scenes")]
+    pub scene: Option<String>,
+    /// Print the scene names, one a line.
+    #[arg(long)]
+    pub list_scenes: bool,
+    /// Output OBJ.
+    #[arg(long, required_unless_present = "list_scenes")]
+    pub out: Option<PathBuf>,
+    /// JSON report file.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+}
+
+/// Runs `dupin pq`.
+pub fn run(args: PqArgs) -> Result<(), CliError> {
+    if args.list_scenes {
+        for s in PQ_SCENES {
+            println!("{s}");
+        }
+        return Ok(());
+    }
+    let name = args.scene.unwrap_or_default();
+    let out = args
+        .out
+        .ok_or_else(|| CliError::Input("--out is required".into()))?;
+    let start = std::time::Instant::now();
+    let r = pq_scene(&name).map_err(|e| CliError::input("", e))?;
+    let seconds = start.elapsed().as_secs_f64();
+    write_text(&out, &write_obj(&r.mesh))?;
+    let mut report = json!({
+        "scene": name,
+        "vertices": r.mesh.num_vertices(),
+        "faces": r.mesh.num_faces(),
+        "max_planarity": r.max_planarity,
+        "levels": r.levels,
+        "iterations": r.iterations,
+        "converged": r.converged,
+        "seconds": seconds,
+    });
+    if let Some(c) = r.conical_residual {
+        report["conical_residual"] = json!(c);
+    }
+    if let Some(c) = r.circular_residual {
+        report["circular_residual"] = json!(c);
+    }
+    if let Some(d) = r.max_determinant {
+        report["max_determinant"] = json!(d);
+    }
+    if let Some(k) = r.singular_points_inside {
+        report["singular_points_inside"] = json!(k);
+    }
+    write_report(args.report.as_deref(), &report)?;
+    println!(
+        "pq {name}: {} faces, max_planarity {:.3e}, {} levels, {} iterations, {:.3} s{}",
+        r.mesh.num_faces(),
+        r.max_planarity,
+        r.levels,
+        r.iterations,
+        seconds,
+        if r.converged { "" } else { ", NOT converged" }
+    );
+    Ok(())
+}

@@ -1,0 +1,103 @@
+//! End-to-end tests of `dupin pq` and `dupin offset`.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn tmp(name: &str) -> PathBuf {
+    std::env::temp_dir().join(format!("dupin-pq-{}-{name}", std::process::id()))
+}
+
+fn dupin(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_dupin"))
+        .args(args)
+        .output()
+        .expect("dupin runs")
+}
+
+fn json(p: &PathBuf) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+}
+
+#[test]
+fn lists_the_contract_scenes() {
+    let o = dupin(&["pq", "--list-scenes"]);
+    assert!(o.status.success());
+    let names: Vec<String> = String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .map(String::from)
+        .collect();
+    for want in [
+        "pq-catmull-clark",
+        "conical-station",
+        "developable-trefoil",
+        "developable-strips",
+        "circular-principal",
+    ] {
+        assert!(names.iter().any(|n| n == want), "{want}");
+    }
+}
+
+#[test]
+fn conical_station_then_offset_with_support() {
+    let mesh = tmp("station.obj");
+    let report = tmp("station.json");
+    let o = dupin(&[
+        "pq",
+        "--scene",
+        "conical-station",
+        "--out",
+        mesh.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r = json(&report);
+    assert!(r["max_planarity"].as_f64().unwrap() <= 1e-10);
+    assert!(r["conical_residual"].as_f64().unwrap() <= 1e-10);
+
+    let off = tmp("station-off.obj");
+    let beams = tmp("station-beams.obj");
+    let rep2 = tmp("offset.json");
+    let o = dupin(&[
+        "offset",
+        "--input",
+        mesh.to_str().unwrap(),
+        "--distance",
+        "0.05",
+        "--out",
+        off.to_str().unwrap(),
+        "--support",
+        beams.to_str().unwrap(),
+        "--report",
+        rep2.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r = json(&rep2);
+    assert!(r["max_distance_error"].as_f64().unwrap() <= 1e-9 * 0.05 * 10.0);
+    assert!(r["warnings"].as_array().unwrap().is_empty());
+    assert!(std::fs::read_to_string(&beams).unwrap().contains("\nf "));
+    for p in [mesh, report, off, beams, rep2] {
+        let _ = std::fs::remove_file(p);
+    }
+}
+
+#[test]
+fn unknown_scene_and_bad_distance_exit_2() {
+    let out = tmp("x.obj");
+    let o = dupin(&["pq", "--scene", "nope", "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).starts_with("error:"));
+    let input = tmp("in.obj");
+    std::fs::write(&input, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n").unwrap();
+    let o = dupin(&[
+        "offset",
+        "--input",
+        input.to_str().unwrap(),
+        "--distance",
+        "nan",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let _ = std::fs::remove_file(&input);
+}

@@ -1,0 +1,938 @@
+//! PQ perturbation (conical paper, Sec. 2.2 and 5): move the vertices of any polygon mesh as
+//! little as possible so that every face becomes planar, and optionally every interior
+//! valence-4 vertex conical (eq. (6)) or every quad circular (eq. (7)).
+//!
+//! Inputs: a [`PolyMesh`] (any face sizes), [`PqOptions`]. Output: [`PqResult`] with the
+//! perturbed mesh, or a [`PqError`] for input the method cannot work on.
+//!
+//! The method follows the paper:
+//! 1. **Penalty phase** (eq. (5)): Gauss-Newton with Levenberg-Marquardt damping on
+//!    `w1 f_fair + w2 f_close + f_plane + f_angle (+ f_det)` where
+//!    - `f_angle` is the angle-sum condition of eq. (1) generalised to n-gons,
+//!      `Σ φ_k - (n - 2) π`, used for faces that are convex at the start (for non-convex planar
+//!      polygons the angle sum is not `(n - 2)π`, so the term would fight planarity). It keeps
+//!      faces convex, as in the paper;
+//!    - `f_plane` makes the faces planar: every face of 4+ vertices carries a plane (unit
+//!      normal n, offset d) as extra unknowns with residuals `(n·v - d)/L` per vertex and
+//!      `|n|² - 1`. The angle sum deviates from `(n - 2)π` only to second order in the
+//!      non-planarity, so it cannot drive planarity to 1e-10 quickly; the plane terms are
+//!      first order, bilinear and well conditioned (this is the one departure from the paper);
+//!    - `f_det` (option [`PqOptions::determinant_terms`], for PQ strips, the paper's µ = 1):
+//!      `det(ê_k, ê_{k+1}, ê_{k+2})` of unit vectors along every three consecutive edges; for a
+//!      quad exactly the paper's four `c_det` terms;
+//!    - `f_fair` is the row/column bending energy `(v_{i+1} - 2 v_i + v_{i-1})²` through
+//!      opposite neighbours of even-valence vertices and along the boundary (the umbrella
+//!      Laplacian at odd valence);
+//!    - `f_close` is the tangent-plane (Gauss-Newton) approximation `((v - y)·n)²` of the
+//!      squared distance to the reference surface, here the input mesh with footpoint y the
+//!      input vertex and n its area-weighted normal.
+//!
+//!    `w1` and `w2` start at the user's weights and are halved after every iteration.
+//! 2. **Exact phase**, see [`Refinement`]: the constraints are the plane terms, the angle
+//!    balance of eq. (6) (conical) and `φ1 + φ3 - π` per quad (circular; with planarity this
+//!    implies eq. (7)). Either SQP on the KKT system of eq. (3), or Gauss-Newton on the
+//!    constraints alone (default). The angle sum of eq. (1) is left out here: its gradient
+//!    vanishes on planar faces, which would make the KKT system singular.
+//!
+//! Every face gets planar to the contract's `max_planarity` <= tolerance, including the
+//! hexagons of P-Hex meshes and mixed meshes; triangles are planar already.
+
+use crate::circular::circular_residual;
+use crate::conical::conical_residual;
+use crate::discrete_terms::{angle_grad, quad_det_grad};
+use crate::math::Vec3;
+use crate::mesh::PolyMesh;
+use crate::mesh_topology::{MeshTopology, TopologyError};
+use crate::planarity::max_planarity;
+use crate::solver::{
+    ConstrainedLeastSquares, LevenbergMarquardt, LmOptions, NonlinearLeastSquares, SparseSystem,
+    Sqp, SqpOptions,
+};
+use std::f64::consts::PI;
+use thiserror::Error;
+
+const NONE: u32 = u32::MAX;
+
+/// Which property the perturbation enforces besides planar faces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum PqMode {
+    /// Planar faces only (PQ mesh for quads; any polygon mesh).
+    #[default]
+    Planar,
+    /// Planar faces and the angle balance at interior valence-4 vertices (conical mesh).
+    Conical,
+    /// Planar faces and opposite angles of every quad summing to π (circular mesh).
+    Circular,
+}
+
+/// Settings of [`pq_perturb`] and [`PqPerturbation`].
+///
+/// Weights are dimensionless: fairness and closeness residuals are divided by the mean edge
+/// length, so the defaults suit meshes of any scale.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PqOptions {
+    /// Property to enforce.
+    pub mode: PqMode,
+    /// Vertices that must not move (anchors), 0-based.
+    pub fixed_vertices: Vec<usize>,
+    /// Keep every boundary vertex fixed.
+    pub fix_boundary: bool,
+    /// Initial closeness weight w2 (≥ 0).
+    pub closeness: f64,
+    /// Initial fairness weight w1 (≥ 0).
+    pub fairness: f64,
+    /// Convergence: contract `max_planarity` and the mode's residual (radians) both at most
+    /// this (> 0).
+    pub tolerance: f64,
+    /// Iteration cap (penalty and SQP iterations together, ≥ 1).
+    pub max_iterations: usize,
+    /// Largest number of penalty iterations before switching to SQP.
+    pub penalty_iterations: usize,
+    /// Pairs of vertices that are the same point and move together (gluing a cut mesh, e.g. a
+    /// Möbius band cut open along one rung, which cannot be oriented consistently).
+    pub identify: Vec<(usize, usize)>,
+    /// How the final, exact phase is solved.
+    pub refinement: Refinement,
+    /// Add the determinant terms `c_det` of unit edge vectors to the penalty (the paper's
+    /// µ = 1, needed for thin quads of PQ strips, where face planes degenerate).
+    pub determinant_terms: bool,
+}
+
+impl Default for PqOptions {
+    fn default() -> Self {
+        PqOptions {
+            mode: PqMode::Planar,
+            fixed_vertices: Vec::new(),
+            fix_boundary: false,
+            closeness: 0.01,
+            fairness: 0.001,
+            tolerance: 1e-11,
+            max_iterations: 100,
+            penalty_iterations: 4,
+            determinant_terms: false,
+            identify: Vec::new(),
+            refinement: Refinement::GaussNewton,
+        }
+    }
+}
+
+/// The solver of the exact phase that follows the penalty phase.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Refinement {
+    /// SQP on the KKT system (eq. (3)) with sparse LU: fairness and closeness (at the weights
+    /// reached by the penalty phase) stay the objective while the constraints become exact.
+    /// Newton-SQP for the plane constraints (their Hessian is supplied). It optimises the
+    /// objective on the constraint manifold, which can take 20-50 steps (as the paper notes).
+    Sqp,
+    /// Gauss-Newton / Levenberg-Marquardt on the constraint residuals alone: the smallest
+    /// damped correction that makes the constraints exact. Several times cheaper per step than
+    /// the KKT factorisation and converging in a few steps; the default.
+    #[default]
+    GaussNewton,
+}
+
+/// Why a perturbation could not start.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum PqError {
+    /// The mesh is not an oriented manifold with boundary.
+    #[error(transparent)]
+    Topology(#[from] TopologyError),
+    /// Conical mode on a mesh with no interior vertex of valence four.
+    #[error("conical mode needs an interior vertex of valence 4; this mesh has none")]
+    NoConicalVertex,
+    /// Circular mode on a mesh without quads.
+    #[error("circular mode needs quad faces; this mesh has none")]
+    NoQuadFace,
+    /// A fixed or identified vertex index does not exist.
+    #[error("vertex {index} does not exist (the mesh has {vertices} vertices)")]
+    FixedVertexOutOfRange {
+        /// The bad index.
+        index: usize,
+        /// Number of vertices.
+        vertices: usize,
+    },
+    /// A weight, tolerance or iteration count is out of range.
+    #[error("invalid option {name} = {value}: {requirement}")]
+    InvalidOption {
+        /// Option name.
+        name: &'static str,
+        /// The given value.
+        value: f64,
+        /// What it must satisfy.
+        requirement: &'static str,
+    },
+}
+
+/// The phase a [`PqPerturbation`] is in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PqPhase {
+    /// Penalty method: Gauss-Newton / Levenberg-Marquardt with weight halving.
+    Penalty,
+    /// SQP refinement on the KKT system.
+    Sqp,
+    /// Finished (converged or stopped).
+    Done,
+}
+
+/// Metrics after one step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PqStepInfo {
+    /// Iterations done so far.
+    pub iteration: usize,
+    /// Phase after this step.
+    pub phase: PqPhase,
+    /// Contract `max_planarity` of the current mesh.
+    pub max_planarity: f64,
+    /// Conical or circular residual (0 in planar mode).
+    pub mode_residual: f64,
+}
+
+/// Result of a perturbation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PqResult {
+    /// The perturbed mesh (the best one reached when not converged).
+    pub mesh: PolyMesh,
+    /// Iterations used.
+    pub iterations: usize,
+    /// Whether the tolerance was reached.
+    pub converged: bool,
+    /// Why it stopped without converging.
+    pub reason: Option<String>,
+    /// Contract `max_planarity`.
+    pub max_planarity: f64,
+    /// `conical_residual` (conical mode only).
+    pub conical_residual: Option<f64>,
+    /// `circular_residual` (circular mode only).
+    pub circular_residual: Option<f64>,
+    /// Largest vertex displacement from the input.
+    pub max_move: f64,
+}
+
+/// Static data of the objective and constraints.
+struct Terms {
+    var_of: Vec<u32>,
+    /// Per face: first of its 4 plane variables (unit normal n, offset d), or NONE.
+    plane_of: Vec<u32>,
+    num_vars: usize,
+    convex: Vec<bool>,
+    conical_vertices: Vec<usize>,
+    /// Fairness stencils: (start offsets, (vertex, coefficient)).
+    stencil_start: Vec<usize>,
+    stencil: Vec<(u32, f64)>,
+    normals0: Vec<Vec3>,
+    positions0: Vec<Vec3>,
+    scale: f64,
+}
+
+struct Problem<'a> {
+    mesh: &'a PolyMesh,
+    topo: &'a MeshTopology,
+    terms: &'a Terms,
+    mode: PqMode,
+    determinant_terms: bool,
+    w_fair: f64,
+    w_close: f64,
+}
+
+/// Accumulates per-vertex gradients of one residual and emits them merged.
+struct RowGrad(Vec<(u32, Vec3)>);
+impl RowGrad {
+    fn add(&mut self, v: u32, g: Vec3) {
+        if let Some(e) = self.0.iter_mut().find(|e| e.0 == v) {
+            e.1 += g;
+        } else {
+            self.0.push((v, g));
+        }
+    }
+}
+
+impl Problem<'_> {
+    #[inline]
+    fn pos(&self, x: &[f64], v: u32) -> Vec3 {
+        let b = self.terms.var_of[v as usize];
+        if b == NONE {
+            self.mesh.positions[v as usize]
+        } else {
+            let b = b as usize;
+            Vec3::new(x[b], x[b + 1], x[b + 2])
+        }
+    }
+
+    #[inline]
+    fn emit(&self, out: &mut SparseSystem, row: u32, v: u32, g: Vec3) {
+        let b = self.terms.var_of[v as usize];
+        if b != NONE {
+            out.push_entry(row, b, g.x);
+            out.push_entry(row, b + 1, g.y);
+            out.push_entry(row, b + 2, g.z);
+        }
+    }
+
+    fn emit_row(&self, out: &mut SparseSystem, value: f64, grad: &RowGrad) {
+        let r = out.push_residual(value);
+        for &(v, g) in &grad.0 {
+            self.emit(out, r, v, g);
+        }
+    }
+
+    fn face_points(&self, x: &[f64], f: usize) -> Vec<Vec3> {
+        self.mesh.face(f).iter().map(|&v| self.pos(x, v)).collect()
+    }
+
+    /// Determinant terms of face `f` for quadruples starting at `ks`.
+    fn dets(&self, x: &[f64], f: usize, all: bool, out: &mut SparseSystem) {
+        let face = self.mesh.face(f);
+        let n = face.len();
+        if n < 4 {
+            return;
+        }
+        let pts = self.face_points(x, f);
+        let count = if all { n } else { n - 3 };
+        for k in 0..count {
+            let idx = [k, (k + 1) % n, (k + 2) % n, (k + 3) % n];
+            let (d, g) = quad_det_grad(idx.map(|i| pts[i]));
+            let mut rg = RowGrad(Vec::with_capacity(4));
+            for (j, &i) in idx.iter().enumerate() {
+                rg.add(face[i], g[j]);
+            }
+            self.emit_row(out, d, &rg);
+        }
+    }
+
+    /// Face-plane terms of face `f`: `(n·v - d) / L` per vertex and `|n|² - 1`.
+    fn planes(&self, x: &[f64], f: usize, out: &mut SparseSystem) {
+        let pb = self.terms.plane_of[f];
+        if pb == NONE {
+            return;
+        }
+        let b = pb as usize;
+        let n = Vec3::new(x[b], x[b + 1], x[b + 2]);
+        let d = x[b + 3];
+        let inv = 1.0 / self.terms.scale;
+        for &v in self.mesh.face(f) {
+            let p = self.pos(x, v);
+            let r = out.push_residual((n.dot(&p) - d) * inv);
+            self.emit(out, r, v, n * inv);
+            for k in 0..3u32 {
+                out.push_entry(r, pb + k, p[k as usize] * inv);
+            }
+            out.push_entry(r, pb + 3, -inv);
+        }
+        let r = out.push_residual(n.norm_squared() - 1.0);
+        for k in 0..3u32 {
+            out.push_entry(r, pb + k, 2.0 * n[k as usize]);
+        }
+    }
+
+    /// Sum over corners `ks` of face `f` of the corner angles, minus `target`.
+    fn angle_sum(&self, x: &[f64], f: usize, ks: &[usize], target: f64, out: &mut SparseSystem) {
+        let face = self.mesh.face(f);
+        let n = face.len();
+        let pts = self.face_points(x, f);
+        let mut sum = -target;
+        let mut rg = RowGrad(Vec::with_capacity(n));
+        for &k in ks {
+            let (a, b) = ((k + n - 1) % n, (k + 1) % n);
+            let (w, g) = angle_grad(pts[k], pts[a], pts[b]);
+            sum += w;
+            rg.add(face[k], g[0]);
+            rg.add(face[a], g[1]);
+            rg.add(face[b], g[2]);
+        }
+        self.emit_row(out, sum, &rg);
+    }
+
+    fn conical(&self, x: &[f64], out: &mut SparseSystem) {
+        for &v in &self.terms.conical_vertices {
+            let star = self.topo.star(v);
+            let mut sum = 0.0;
+            let mut rg = RowGrad(Vec::with_capacity(5));
+            for (k, &c) in star.iter().enumerate() {
+                let a = self.topo.source(self.topo.prev(c));
+                let b = self.topo.target(c);
+                let (w, g) = angle_grad(self.pos(x, v as u32), self.pos(x, a), self.pos(x, b));
+                let s = if k % 2 == 0 { 1.0 } else { -1.0 };
+                sum += s * w;
+                rg.add(v as u32, g[0] * s);
+                rg.add(a, g[1] * s);
+                rg.add(b, g[2] * s);
+            }
+            self.emit_row(out, sum, &rg);
+        }
+    }
+
+    fn fairness_closeness(&self, x: &[f64], out: &mut SparseSystem) {
+        let t = self.terms;
+        if self.w_fair > 0.0 {
+            let s = self.w_fair.sqrt() / t.scale;
+            for i in 0..t.stencil_start.len() - 1 {
+                let st = &t.stencil[t.stencil_start[i]..t.stencil_start[i + 1]];
+                let mut val = Vec3::zeros();
+                for &(v, c) in st {
+                    val += c * self.pos(x, v);
+                }
+                for k in 0..3 {
+                    let r = out.push_residual(s * val[k]);
+                    for &(v, c) in st {
+                        let b = t.var_of[v as usize];
+                        if b != NONE {
+                            out.push_entry(r, b + k as u32, s * c);
+                        }
+                    }
+                }
+            }
+        }
+        if self.w_close > 0.0 {
+            let s = self.w_close.sqrt() / t.scale;
+            for v in 0..t.var_of.len() {
+                if t.var_of[v] == NONE {
+                    continue;
+                }
+                let n = t.normals0[v];
+                let d = (self.pos(x, v as u32) - t.positions0[v]).dot(&n);
+                let r = out.push_residual(s * d);
+                self.emit(out, r, v as u32, s * n);
+            }
+        }
+    }
+}
+
+impl NonlinearLeastSquares for Problem<'_> {
+    fn num_variables(&self) -> usize {
+        self.terms.num_vars
+    }
+    fn evaluate(&self, x: &[f64], out: &mut SparseSystem) {
+        for f in 0..self.mesh.num_faces() {
+            let n = self.mesh.face(f).len();
+            if self.mode == PqMode::Circular && n == 4 {
+                self.angle_sum(x, f, &[0, 2], PI, out);
+                self.angle_sum(x, f, &[1, 3], PI, out);
+            } else if self.terms.convex[f] && n > 3 {
+                let ks: Vec<usize> = (0..n).collect();
+                self.angle_sum(x, f, &ks, (n as f64 - 2.0) * PI, out);
+            }
+            if self.determinant_terms {
+                self.dets(x, f, true, out);
+            }
+            self.planes(x, f, out);
+        }
+        if self.mode == PqMode::Conical {
+            self.conical(x, out);
+        }
+        self.fairness_closeness(x, out);
+    }
+}
+
+impl ConstrainedLeastSquares for Problem<'_> {
+    fn num_variables(&self) -> usize {
+        self.terms.num_vars
+    }
+    fn objective(&self, x: &[f64], out: &mut SparseSystem) {
+        self.fairness_closeness(x, out);
+    }
+    fn constraints(&self, x: &[f64], out: &mut SparseSystem) {
+        for f in 0..self.mesh.num_faces() {
+            self.planes(x, f, out);
+            if self.mode == PqMode::Circular && self.mesh.face(f).len() == 4 {
+                self.angle_sum(x, f, &[0, 2], PI, out);
+            }
+        }
+        if self.mode == PqMode::Conical {
+            self.conical(x, out);
+        }
+    }
+    /// The plane constraints `(n·v - d)/L` are bilinear: their Hessian couples v and n by
+    /// `I/L`; `|n|² - 1` has Hessian `2I` on n. Angle constraints keep the Gauss-Newton part.
+    fn constraint_hessian(&self, _x: &[f64], nu: &[f64], out: &mut Vec<(u32, u32, f64)>) {
+        let inv = 1.0 / self.terms.scale;
+        let mut row = 0usize;
+        for f in 0..self.mesh.num_faces() {
+            let face = self.mesh.face(f);
+            let pb = self.terms.plane_of[f];
+            if pb != NONE {
+                for &v in face {
+                    let vb = self.terms.var_of[v as usize];
+                    if vb != NONE {
+                        for k in 0..3 {
+                            let w = nu[row] * inv;
+                            out.push((vb + k, pb + k, w));
+                            out.push((pb + k, vb + k, w));
+                        }
+                    }
+                    row += 1;
+                }
+                for k in 0..3 {
+                    out.push((pb + k, pb + k, 2.0 * nu[row]));
+                }
+                row += 1;
+            }
+            if self.mode == PqMode::Circular && face.len() == 4 {
+                row += 1;
+            }
+        }
+    }
+}
+
+/// The exact constraints of the SQP phase as a least-squares problem (Gauss-Newton
+/// refinement).
+struct Feasibility<'a, 'b>(&'a Problem<'b>);
+
+impl NonlinearLeastSquares for Feasibility<'_, '_> {
+    fn num_variables(&self) -> usize {
+        self.0.terms.num_vars
+    }
+    fn evaluate(&self, x: &[f64], out: &mut SparseSystem) {
+        self.0.constraints(x, out);
+    }
+}
+
+/// Newell normal (area-weighted) of a polygon.
+fn newell(pts: &[Vec3]) -> Vec3 {
+    let n = pts.len();
+    let mut s = Vec3::zeros();
+    for k in 0..n {
+        s += pts[k].cross(&pts[(k + 1) % n]);
+    }
+    s * 0.5
+}
+
+/// Least-squares plane (unit normal along the Newell normal, offset) of a polygon.
+fn lsq_plane(pts: &[Vec3]) -> (Vec3, f64) {
+    let c = pts.iter().sum::<Vec3>() / pts.len() as f64;
+    let mut cov = nalgebra::Matrix3::zeros();
+    for p in pts {
+        let d = p - c;
+        cov += d * d.transpose();
+    }
+    let eig = nalgebra::SymmetricEigen::new(cov);
+    let mut n: Vec3 = eig.eigenvectors.column(eig.eigenvalues.imin()).into_owned();
+    if n.dot(&newell(pts)) < 0.0 {
+        n = -n;
+    }
+    (n, n.dot(&c))
+}
+
+fn is_convex(pts: &[Vec3]) -> bool {
+    let nrm = newell(pts);
+    let n = pts.len();
+    (0..n).all(|k| {
+        let a = pts[(k + 1) % n] - pts[k];
+        let b = pts[(k + 2) % n] - pts[(k + 1) % n];
+        a.cross(&b).dot(&nrm) > 0.0
+    })
+}
+
+/// A PQ / conical / circular perturbation that can be stepped and watched (one step is one
+/// penalty or SQP iteration). [`pq_perturb`] runs it to the end.
+pub struct PqPerturbation {
+    mesh: PolyMesh,
+    topo: MeshTopology,
+    terms: Terms,
+    options: PqOptions,
+    x: Vec<f64>,
+    w_fair: f64,
+    w_close: f64,
+    lm: LevenbergMarquardt,
+    sqp: Sqp,
+    phase: PqPhase,
+    iteration: usize,
+    converged: bool,
+    reason: Option<String>,
+    last: (f64, f64),
+}
+
+impl PqPerturbation {
+    /// Checks the mesh and options and sets up the problem.
+    pub fn new(mesh: &PolyMesh, options: PqOptions) -> Result<Self, PqError> {
+        let check = |name: &'static str, value: f64, ok: bool, requirement: &'static str| {
+            if ok {
+                Ok(())
+            } else {
+                Err(PqError::InvalidOption {
+                    name,
+                    value,
+                    requirement,
+                })
+            }
+        };
+        let o = &options;
+        check(
+            "closeness",
+            o.closeness,
+            o.closeness.is_finite() && o.closeness >= 0.0,
+            "must be finite and >= 0",
+        )?;
+        check(
+            "fairness",
+            o.fairness,
+            o.fairness.is_finite() && o.fairness >= 0.0,
+            "must be finite and >= 0",
+        )?;
+        check(
+            "tolerance",
+            o.tolerance,
+            o.tolerance.is_finite() && o.tolerance > 0.0,
+            "must be finite and > 0",
+        )?;
+        check(
+            "max_iterations",
+            o.max_iterations as f64,
+            o.max_iterations >= 1,
+            "must be >= 1",
+        )?;
+        let topo = MeshTopology::new(mesh)?;
+        let nv = mesh.num_vertices();
+        for &i in &o.fixed_vertices {
+            if i >= nv {
+                return Err(PqError::FixedVertexOutOfRange {
+                    index: i,
+                    vertices: nv,
+                });
+            }
+        }
+        let conical_vertices = topo.interior_valence4();
+        match o.mode {
+            PqMode::Conical if conical_vertices.is_empty() => return Err(PqError::NoConicalVertex),
+            PqMode::Circular if !mesh.faces().any(|f| f.len() == 4) => {
+                return Err(PqError::NoQuadFace);
+            }
+            _ => {}
+        }
+        let mut fixed = vec![false; nv];
+        for &i in &o.fixed_vertices {
+            fixed[i] = true;
+        }
+        let mut used = vec![false; nv];
+        for f in mesh.faces() {
+            for &v in f {
+                used[v as usize] = true;
+            }
+        }
+        let mut var_of = vec![NONE; nv];
+        let mut num_vars = 0usize;
+        for v in 0..nv {
+            if used[v] && !fixed[v] && !(o.fix_boundary && topo.is_boundary(v)) {
+                var_of[v] = num_vars as u32;
+                num_vars += 3;
+            }
+        }
+        for &(i, j) in &o.identify {
+            if i >= nv || j >= nv {
+                return Err(PqError::FixedVertexOutOfRange {
+                    index: i.max(j),
+                    vertices: nv,
+                });
+            }
+            if var_of[i] != NONE && var_of[j] != NONE {
+                var_of[j] = var_of[i];
+            } else {
+                var_of[i] = NONE;
+                var_of[j] = NONE;
+            }
+        }
+        let p = &mesh.positions;
+        let mut plane_of = vec![NONE; mesh.num_faces()];
+        let mut plane_init = Vec::new();
+        for (f, face) in mesh.faces().enumerate() {
+            if face.len() >= 4 {
+                plane_of[f] = num_vars as u32;
+                num_vars += 4;
+                let pts: Vec<Vec3> = face.iter().map(|&v| p[v as usize]).collect();
+                let (n, d) = lsq_plane(&pts);
+                plane_init.push((f, n, d));
+            }
+        }
+        let mut normals0 = vec![Vec3::zeros(); nv];
+        let mut convex = Vec::with_capacity(mesh.num_faces());
+        for f in mesh.faces() {
+            let pts: Vec<Vec3> = f.iter().map(|&v| p[v as usize]).collect();
+            let nrm = newell(&pts);
+            for &v in f {
+                normals0[v as usize] += nrm;
+            }
+            convex.push(is_convex(&pts));
+        }
+        for n in &mut normals0 {
+            *n = n.try_normalize(0.0).unwrap_or_else(Vec3::zeros);
+        }
+        let mut stencil_start = vec![0];
+        let mut stencil = Vec::new();
+        #[allow(clippy::needless_range_loop)]
+        for v in 0..nv {
+            if !used[v] {
+                continue;
+            }
+            let nb = topo.neighbors(v);
+            let k = nb.len();
+            if topo.is_boundary(v) {
+                if k >= 2 {
+                    stencil.extend([(nb[0], 1.0), (nb[k - 1], 1.0), (v as u32, -2.0)]);
+                    stencil_start.push(stencil.len());
+                }
+            } else if k % 2 == 0 {
+                for i in 0..k / 2 {
+                    stencil.extend([(nb[i], 1.0), (nb[i + k / 2], 1.0), (v as u32, -2.0)]);
+                    stencil_start.push(stencil.len());
+                }
+            } else if k > 0 {
+                stencil.extend(nb.iter().map(|&u| (u, 1.0 / k as f64)));
+                stencil.push((v as u32, -1.0));
+                stencil_start.push(stencil.len());
+            }
+        }
+        let edges = topo.edges();
+        let scale = if edges.is_empty() {
+            1.0
+        } else {
+            edges
+                .iter()
+                .map(|&(a, b)| (p[a as usize] - p[b as usize]).norm())
+                .sum::<f64>()
+                / edges.len() as f64
+        };
+        let mut x = vec![0.0; num_vars];
+        for v in 0..nv {
+            if var_of[v] != NONE {
+                let b = var_of[v] as usize;
+                x[b..b + 3].copy_from_slice(p[v].as_slice());
+            }
+        }
+        for (f, n, d) in plane_init {
+            let b = plane_of[f] as usize;
+            x[b..b + 3].copy_from_slice(n.as_slice());
+            x[b + 3] = d;
+        }
+        let scale_for_sqp = scale;
+        let terms = Terms {
+            plane_of,
+            var_of,
+            num_vars,
+            convex,
+            conical_vertices,
+            stencil_start,
+            stencil,
+            normals0,
+            positions0: p.clone(),
+            scale,
+        };
+        let mut s = PqPerturbation {
+            mesh: mesh.clone(),
+            topo,
+            terms,
+            w_fair: o.fairness,
+            w_close: o.closeness,
+            options,
+            x,
+            lm: LevenbergMarquardt::new(LmOptions {
+                decrease: 10.0,
+                ..LmOptions::default()
+            }),
+            sqp: Sqp::new(SqpOptions {
+                absolute_damping: 1e-6 / (scale_for_sqp * scale_for_sqp),
+                ..SqpOptions::default()
+            }),
+            phase: PqPhase::Penalty,
+            iteration: 0,
+            converged: false,
+            reason: None,
+            last: (f64::INFINITY, f64::INFINITY),
+        };
+        s.last = s.metrics();
+        if s.is_converged() {
+            s.phase = PqPhase::Done;
+            s.converged = true;
+        }
+        Ok(s)
+    }
+
+    fn mode_residual(&self) -> f64 {
+        match self.options.mode {
+            PqMode::Planar => 0.0,
+            PqMode::Conical => conical_residual(&self.mesh, &self.topo),
+            PqMode::Circular => circular_residual(&self.mesh),
+        }
+    }
+
+    fn metrics(&self) -> (f64, f64) {
+        (max_planarity(&self.mesh), self.mode_residual())
+    }
+
+    fn is_converged(&self) -> bool {
+        self.last.0 <= self.options.tolerance && self.last.1 <= self.options.tolerance
+    }
+
+    fn sync_mesh(&mut self) {
+        for v in 0..self.mesh.num_vertices() {
+            let b = self.terms.var_of[v];
+            if b != NONE {
+                let b = b as usize;
+                self.mesh.positions[v] = Vec3::new(self.x[b], self.x[b + 1], self.x[b + 2]);
+            }
+        }
+    }
+
+    /// The current mesh.
+    pub fn mesh(&self) -> &PolyMesh {
+        &self.mesh
+    }
+
+    /// The current phase.
+    pub fn phase(&self) -> PqPhase {
+        self.phase
+    }
+
+    /// Whether the run has finished.
+    pub fn is_done(&self) -> bool {
+        self.phase == PqPhase::Done
+    }
+
+    /// One iteration (no-op once done).
+    pub fn step(&mut self) -> PqStepInfo {
+        if self.phase != PqPhase::Done {
+            self.iterate();
+        }
+        PqStepInfo {
+            iteration: self.iteration,
+            phase: self.phase,
+            max_planarity: self.last.0,
+            mode_residual: self.last.1,
+        }
+    }
+
+    fn iterate(&mut self) {
+        let problem = Problem {
+            mesh: &self.mesh,
+            topo: &self.topo,
+            terms: &self.terms,
+            mode: self.options.mode,
+            determinant_terms: self.options.determinant_terms,
+            w_fair: self.w_fair,
+            w_close: self.w_close,
+        };
+        let mut x = self.x.clone();
+        let outcome = match self.phase {
+            PqPhase::Penalty => self.lm.step(&problem, &mut x).map(|_| ()),
+            _ if self.options.refinement == Refinement::GaussNewton => {
+                self.lm.step(&Feasibility(&problem), &mut x).map(|_| ())
+            }
+            _ => match self.sqp.step(&problem, &mut x) {
+                Ok(_) => Ok(()),
+                // Fall back to a damped penalty step when SQP finds no descent.
+                Err(_) => self.lm.step(&problem, &mut x).map(|_| ()),
+            },
+        };
+        self.iteration += 1;
+        if self.phase == PqPhase::Penalty {
+            self.w_fair *= 0.5;
+            self.w_close *= 0.5;
+            self.lm.invalidate();
+        }
+        let before = self.last;
+        match outcome {
+            Ok(()) => {
+                let old = std::mem::replace(&mut self.x, x);
+                self.sync_mesh();
+                self.last = self.metrics();
+                // Keep the best mesh: reject a step that made both measures worse.
+                if self.last.0.max(self.last.1) > 10.0 * before.0.max(before.1) {
+                    self.x = old;
+                    self.sync_mesh();
+                    self.last = before;
+                }
+            }
+            Err(e) => {
+                if self.phase == PqPhase::Penalty {
+                    self.enter_refinement();
+                } else {
+                    self.phase = PqPhase::Done;
+                    self.reason = Some(format!("solver stalled: {e}"));
+                    return;
+                }
+            }
+        }
+        if self.is_converged() {
+            self.phase = PqPhase::Done;
+            self.converged = true;
+        } else if self.iteration >= self.options.max_iterations {
+            self.phase = PqPhase::Done;
+            self.reason = Some(format!(
+                "iteration cap {} reached (max_planarity {:.3e}, mode residual {:.3e})",
+                self.options.max_iterations, self.last.0, self.last.1
+            ));
+        } else if self.phase == PqPhase::Penalty
+            && (self.iteration >= self.options.penalty_iterations
+                || self.last.0.max(self.last.1) < 1e-4)
+        {
+            self.enter_refinement();
+        }
+    }
+
+    fn enter_refinement(&mut self) {
+        self.phase = PqPhase::Sqp;
+        self.lm.invalidate();
+        self.lm.set_damping(1e-6);
+    }
+
+    /// Runs to the end and returns the result.
+    pub fn finish(mut self) -> PqResult {
+        while !self.is_done() {
+            self.step();
+        }
+        let max_move = self
+            .mesh
+            .positions
+            .iter()
+            .zip(&self.terms.positions0)
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f64::max);
+        PqResult {
+            conical_residual: (self.options.mode == PqMode::Conical).then_some(self.last.1),
+            circular_residual: (self.options.mode == PqMode::Circular).then_some(self.last.1),
+            max_planarity: self.last.0,
+            iterations: self.iteration,
+            converged: self.converged,
+            reason: self.reason,
+            max_move,
+            mesh: self.mesh,
+        }
+    }
+}
+
+/// One-shot PQ / conical / circular perturbation of `mesh` (see the module documentation).
+pub fn pq_perturb(mesh: &PolyMesh, options: PqOptions) -> Result<PqResult, PqError> {
+    Ok(PqPerturbation::new(mesh, options)?.finish())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pq_scenes::{skew_quad_grid, torus_centroid_dual};
+
+    fn run(mesh: &PolyMesh, options: PqOptions) -> PqResult {
+        let r = pq_perturb(mesh, options).unwrap();
+        eprintln!(
+            "iterations {} converged {} planarity {:.3e} move {:.3e} {:?}",
+            r.iterations, r.converged, r.max_planarity, r.max_move, r.reason
+        );
+        r
+    }
+
+    #[test]
+    fn skew_grid_becomes_planar() {
+        let m = skew_quad_grid(30, 30.0);
+        assert!(max_planarity(&m) > 1e-3);
+        let r = run(&m, PqOptions::default());
+        assert!(r.converged);
+        assert!(max_planarity(&r.mesh) <= 1e-10);
+    }
+
+    #[test]
+    fn torus_dual_hexagons_become_planar() {
+        let m = torus_centroid_dual(48, 24, 3.0, 1.0);
+        assert_eq!(m.num_faces(), 1152);
+        assert!(max_planarity(&m) > 1e-3);
+        let r = run(&m, PqOptions::default());
+        assert!(r.converged);
+        assert!(max_planarity(&r.mesh) <= 1e-10);
+    }
+}
