@@ -9,6 +9,7 @@ mod common;
 mod offset;
 mod planarize;
 mod pq;
+mod surface_info;
 
 /// Planar-panel geometry for architecture.
 #[derive(Parser)]
@@ -26,6 +27,8 @@ enum Command {
     Offset(offset::OffsetArgs),
     /// Build a PQ scene of the conical paper (see --list-scenes).
     Pq(pq::PqArgs),
+    /// Position, normal and curvature of a library surface at (U, V), as JSON.
+    SurfaceInfo(surface_info::SurfaceInfoArgs),
 }
 
 fn run(cli: Cli) -> Result<(), common::CliError> {
@@ -33,6 +36,7 @@ fn run(cli: Cli) -> Result<(), common::CliError> {
         Command::Planarize(a) => planarize::run(a),
         Command::Offset(a) => offset::run(a),
         Command::Pq(a) => pq::run(a),
+        Command::SurfaceInfo(args) => surface_info::run(args),
     }
 }
 

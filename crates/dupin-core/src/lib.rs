@@ -6,17 +6,32 @@
 //!
 //! The modules are private; this page lists the public API (spade's style: a small, flat
 //! surface chosen by `pub use`). See `ARCHITECTURE.md` for layering rules.
+//!
+//! ## Surfaces, curvature and Dupin duality (P-Hex paper, sections 3 to 5.1)
+//! - [`Surface`] and the library ([`surface_by_name`], [`surface_catalog`]), [`MeshSurface`];
+//! - [`Curvature`], [`PointType`], [`CurvatureTolerance`] (section 3);
+//! - [`DupinIndicatrix`], [`DupinConic`], conjugate and asymptotic directions (sections 3, 4.2);
+//! - [`dupin_center`], [`tangent_dual_point`], [`TriangleStar`] (section 4, Propositions 3-5);
+//! - [`ideal_triangle`] (section 5.1); [`is_simple_polygon`] (exact predicates).
+
+// `!(x > t)` is used on purpose throughout: unlike `x <= t` it also rejects NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 mod circular;
 mod conical;
+mod curvature;
 mod developable_strip;
 mod discrete_terms;
+mod dupin_center;
+mod dupin_indicatrix;
+mod ideal_triangle;
 mod math;
 mod mesh;
 mod mesh_topology;
 mod obj;
 mod offset;
 mod planarity;
+mod polygon;
 mod pq_perturbation;
 mod pq_scenes;
 mod principal_quad_mesh;
@@ -25,14 +40,26 @@ mod solver;
 mod subdivision;
 mod support_structure;
 mod surface;
+mod tangent_duality;
+mod triangle_star;
 
 pub use circular::{circular_residual, quad_circularity};
 pub use conical::{
     VertexType, angle_balance, cone_axes, conical_residual, face_normals, focal_points,
     spherical_image, vertex_type,
 };
+pub use curvature::{Curvature, CurvatureError, CurvatureTolerance, PointType, TangentFrame};
 pub use developable_strip::{
     PqStrip, StripClosure, StripRule, developable_subdivision, trefoil_moebius,
+};
+pub use dupin_center::{
+    DupinCenterError, DupinCenterMethod, approximate_dupin_center, dupin_center, dupin_center_3d,
+    dupin_conic_through,
+};
+pub use dupin_indicatrix::{DupinConic, DupinIndicatrix, IndicatrixError};
+pub use ideal_triangle::{
+    IdealTriangle, IdealTriangleError, ideal_apex_3d, ideal_triangle,
+    is_affine_quasi_regular_hexagon, is_affine_regular_hexagon,
 };
 pub use math::{Vec2, Vec3};
 pub use mesh::{MeshError, PolyMesh};
@@ -40,6 +67,7 @@ pub use mesh_topology::{MeshTopology, TopologyError};
 pub use obj::{ObjError, parse_obj, write_obj};
 pub use offset::{OffsetError, offset_mesh};
 pub use planarity::{face_planarity, max_planarity};
+pub use polygon::{PolygonError, is_simple_polygon, segments_intersect, strictly_inside_triangle};
 pub use pq_perturbation::{
     PqError, PqMode, PqOptions, PqPerturbation, PqPhase, PqResult, PqStepInfo, Refinement,
     pq_perturb,
@@ -55,4 +83,12 @@ pub use solver::{
 };
 pub use subdivision::{catmull_clark, chaikin, doo_sabin, lane_riesenfeld_cubic};
 pub use support_structure::support_structure;
-pub use surface::{Domain, Surface, SurfaceDerivatives, Torus};
+pub use surface::{
+    BSplinePatch, BSplinePatchError, Catenoid, ClosestPoint, ClosestPointError, Cylinder, Domain,
+    DupinCyclide, Ellipsoid, Enneper, FundamentalForms, HyperbolicParaboloid, Hyperboloid,
+    MeshClosestPoint, MeshSurface, MeshSurfaceError, ParamSpec, RegistryError, Sphere, Surface,
+    SurfaceDerivatives, SurfaceSpec, Torus, Vase, VertexCurvature, parse_assignment,
+    surface_by_name, surface_catalog,
+};
+pub use tangent_duality::{TangentDualPoint, TangentDualityError, tangent_dual_point};
+pub use triangle_star::{DupinHexagon, TriangleStar, TriangleStarError};

@@ -3,16 +3,16 @@
 
 use super::SolverError;
 use faer::Side;
-use faer::linalg::solvers::Solve;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
 };
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
-use faer::{Conj, Par};
 use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
+use faer::{Conj, Par};
 
 /// Which factorisation a cached pattern feeds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -8,6 +8,8 @@ use std::f64::consts::TAU;
 ///
 /// `major` is R (distance from the axis to the tube centre), `minor` is r (tube radius).
 /// K > 0 on the outer half (cos v > 0), K < 0 on the inner half, parabolic circles at v = +-pi/2.
+///
+/// (P-Hex paper, section 5.3, Figs. 3, 17 right and 19.)
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Torus {
     /// R, the distance from the axis to the centre of the tube.
@@ -65,6 +67,23 @@ mod tests {
             assert!((duu - d.puu).norm() < 1e-7);
             assert!((duv - d.puv).norm() < 1e-7);
             assert!((dvv - d.pvv).norm() < 1e-7);
+        }
+    }
+
+    #[test]
+    fn curvature_matches_closed_forms() {
+        use crate::surface::test_support::check_curvature;
+        let (big, r) = (2.0, 0.7);
+        let t = Torus {
+            major: big,
+            minor: r,
+        };
+        for i in 0..80 {
+            let u = 0.079 * i as f64;
+            let v = 0.013 + 0.0787 * i as f64;
+            // k along the parallels -cos v / (R + r cos v), along the meridians -1/r.
+            let (ku, kv) = (-v.cos() / (big + r * v.cos()), -1.0 / r);
+            check_curvature(&t, u, v, ku.max(kv), ku.min(kv), 1e-9);
         }
     }
 

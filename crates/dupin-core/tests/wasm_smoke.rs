@@ -1,0 +1,84 @@
+//! The toolkit's key guarantees, run natively and on wasm32 (through wasm-bindgen-test): the
+//! core must behave identically in the browser (P-Hex paper, sections 3 to 5.1).
+
+#[cfg(target_arch = "wasm32")]
+use wasm_bindgen_test::wasm_bindgen_test as test;
+
+use dupin_core::{
+    DupinIndicatrix, TriangleStar, Vec2, dupin_center, ideal_triangle,
+    is_affine_quasi_regular_hexagon, is_affine_regular_hexagon, surface_by_name, surface_catalog,
+};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+#[test]
+fn every_library_surface_has_finite_curvature() {
+    for spec in surface_catalog() {
+        let s = surface_by_name(spec.name, &[]).unwrap();
+        let d = s.domain();
+        let c = s
+            .curvature(0.5 * (d.u.0 + d.u.1) + 0.1, 0.5 * (d.v.0 + d.v.1) + 0.1)
+            .unwrap();
+        assert!(
+            c.k1.is_finite() && c.k2.is_finite() && c.k1 >= c.k2,
+            "{}",
+            spec.name
+        );
+    }
+    let t = surface_by_name("torus", &[("R", 2.0), ("r", 0.5)]).unwrap();
+    let c = t.curvature(0.0, 0.0).unwrap();
+    assert!((c.k1 + 1.0 / 2.5).abs() < 1e-12 && (c.k2 + 2.0).abs() < 1e-12);
+}
+
+#[test]
+fn propositions_4_and_5_conditions_agree() {
+    let mut rng = ChaCha8Rng::seed_from_u64(99);
+    for sign in [1.0, -1.0] {
+        let mut n = 0;
+        while n < 5_000 {
+            let ind = DupinIndicatrix::new(
+                rng.random_range(0.1..3.0),
+                sign * rng.random_range(0.1..3.0),
+            )
+            .unwrap();
+            let mut p = || Vec2::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+            let Ok(star) = TriangleStar::new(p(), p(), p()) else {
+                continue;
+            };
+            n += 1;
+            let c1 = star.is_valid(&ind).unwrap();
+            let (c2, c3) = if sign > 0.0 {
+                (
+                    star.dupin_center_inside(&ind).unwrap(),
+                    star.edges_not_enclosed_by_conjugate_pair(&ind).unwrap(),
+                )
+            } else {
+                (
+                    star.vertices_on_different_branches(&ind).unwrap(),
+                    star.edges_not_in_one_asymptotic_range(&ind).unwrap(),
+                )
+            };
+            assert!(c1 == c2 && c1 == c3);
+        }
+    }
+}
+
+#[test]
+fn ideal_triangles_are_ideal() {
+    for (k1, k2) in [(1.3, 0.4), (1.3, -0.4)] {
+        let ind = DupinIndicatrix::new(k1, k2).unwrap();
+        let (a, b) = (Vec2::new(0.1, 0.2), Vec2::new(0.9, -0.1));
+        let t = ideal_triangle(&ind, &a, &b).unwrap();
+        let o = dupin_center(&ind, &t.a, &t.b, &t.c).unwrap();
+        assert!((o - t.ideal_dupin_center(&ind)).norm() < 1e-12);
+        let h = TriangleStar::new(a, b, t.c)
+            .unwrap()
+            .dupin_hexagon(&ind)
+            .unwrap();
+        if k2 > 0.0 {
+            assert!(is_affine_regular_hexagon(&h.vertices, &a, 1e-9));
+        } else {
+            assert!(is_affine_quasi_regular_hexagon(&h.vertices, &a, 1e-9));
+        }
+    }
+}
