@@ -1,0 +1,113 @@
+//! The hexagonal mesh dual to a triangulation (P-Hex paper, section 6, initialisation; the
+//! tangent duality of section 4.1, Fig. 6).
+//!
+//! Input: a [`Triangulation`] with unit normals at its vertices. Output: a polygon mesh with one
+//! vertex per triangle and one face per interior triangulation vertex (the cycle of its
+//! incident triangles): hexagons at valence-6 vertices, pentagons at valence 5, and so on.
+//!
+//! Each dual vertex is the point of the three tangent planes of its triangle closest to the
+//! triangle's centroid: the intersection point when the planes are well conditioned (tangent
+//! duality, section 4.1), the minimum-norm least-squares point otherwise (parallel rulings on
+//! developable surfaces, near-parabolic triangles), computed with nalgebra's SVD. Every face of
+//! the dual then lies in the tangent plane of its triangulation vertex whenever the three planes
+//! of each of its triangles are consistent, so the initial mesh is already planar up to the
+//! conditioning of those planes; the Gauss-Newton pass of `planarity_optimisation` removes the
+//! rest.
+
+use super::PhexError;
+use super::triangulation::Triangulation;
+use crate::{PolyMesh, Vec3};
+use nalgebra::Matrix3;
+
+/// Relative singular-value cut-off of the tangent-plane system (below it the direction is
+/// treated as free and the centroid's component is kept).
+const RANK_TOL: f64 = 1e-3;
+
+/// The dual polygon mesh of a triangulation plus, for every face, its triangulation vertex.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DualMesh {
+    /// The polygon mesh (one vertex per triangle, one face per interior vertex).
+    pub mesh: PolyMesh,
+    /// For every face, the triangulation vertex it is dual to.
+    pub face_vertex: Vec<u32>,
+    /// For every dual vertex, surface parameters near it (a start for closest-point queries).
+    pub vertex_uv: Vec<crate::Vec2>,
+}
+
+/// Tangent-plane dual point of one triangle (see the module docs).
+pub fn tangent_plane_point(p: [Vec3; 3], n: [Vec3; 3]) -> Vec3 {
+    let c = (p[0] + p[1] + p[2]) / 3.0;
+    let a = Matrix3::from_rows(&[n[0].transpose(), n[1].transpose(), n[2].transpose()]);
+    let rhs = Vec3::new(
+        n[0].dot(&(p[0] - c)),
+        n[1].dot(&(p[1] - c)),
+        n[2].dot(&(p[2] - c)),
+    );
+    let svd = a.svd(true, true);
+    let smax = svd.singular_values.max();
+    match svd.solve(&rhs, RANK_TOL * smax) {
+        Ok(x) if x.iter().all(|v| v.is_finite()) => c + x,
+        _ => c,
+    }
+}
+
+/// Builds the dual polygon mesh of `t` (section 6 initialisation by tangent duality).
+///
+/// Errors: [`PhexError::NoValidTriangulation`] when no interior vertex exists.
+pub fn dual_mesh(t: &Triangulation) -> Result<DualMesh, PhexError> {
+    let nv = t.positions.len();
+    let positions: Vec<Vec3> = t
+        .triangles
+        .iter()
+        .map(|tr| {
+            let p = tr.map(|i| t.positions[i as usize]);
+            let n = tr.map(|i| t.normals[i as usize]);
+            tangent_plane_point(p, n)
+        })
+        .collect();
+    // Star of every vertex: for a CCW triangle (a, b, c), vertex a sees the edge b -> c.
+    let mut star: Vec<Vec<(u32, u32, u32)>> = vec![vec![]; nv];
+    for (ti, tr) in t.triangles.iter().enumerate() {
+        for k in 0..3 {
+            star[tr[k] as usize].push((tr[(k + 1) % 3], tr[(k + 2) % 3], ti as u32));
+        }
+    }
+    let mut faces: Vec<Vec<u32>> = vec![];
+    let mut face_vertex = vec![];
+    for (v, st) in star.iter().enumerate() {
+        if st.len() < 3 {
+            continue;
+        }
+        // Follow b -> c links; interior iff it closes after visiting every triangle.
+        let mut face = Vec::with_capacity(st.len());
+        let mut cur = st[0];
+        let mut ok = true;
+        for _ in 0..st.len() {
+            face.push(cur.2);
+            match st.iter().find(|e| e.0 == cur.1) {
+                Some(&e) => cur = e,
+                None => {
+                    ok = false;
+                    break;
+                }
+            }
+        }
+        if ok && cur == st[0] && face.len() == st.len() {
+            faces.push(face);
+            face_vertex.push(v as u32);
+        }
+    }
+    if faces.is_empty() {
+        return Err(PhexError::NoValidTriangulation(
+            "the triangulation has no interior vertex: make the size smaller".into(),
+        ));
+    }
+    let mesh = PolyMesh::new(positions, &faces)
+        .map_err(|e| PhexError::NoValidTriangulation(format!("dual mesh: {e}")))?;
+    let vertex_uv = t.triangles.iter().map(|tr| t.uv[tr[0] as usize]).collect();
+    Ok(DualMesh {
+        mesh,
+        face_vertex,
+        vertex_uv,
+    })
+}
