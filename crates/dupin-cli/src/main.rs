@@ -7,6 +7,7 @@ use std::process::ExitCode;
 
 mod common;
 mod offset;
+mod phex;
 mod planarize;
 mod pq;
 mod surface_info;
@@ -25,6 +26,8 @@ enum Command {
     Planarize(planarize::PlanarizeArgs),
     /// Offset a conical mesh by a face distance, with its support structure.
     Offset(offset::OffsetArgs),
+    /// Build a P-Hex mesh (planar hexagons) from a scene or a library surface.
+    Phex(phex::PhexArgs),
     /// Build a PQ scene of the conical paper (see --list-scenes).
     Pq(pq::PqArgs),
     /// Position, normal and curvature of a library surface at (U, V), as JSON.
@@ -35,6 +38,7 @@ fn run(cli: Cli) -> Result<(), common::CliError> {
     match cli.command {
         Command::Planarize(a) => planarize::run(a),
         Command::Offset(a) => offset::run(a),
+        Command::Phex(a) => phex::run(a),
         Command::Pq(a) => pq::run(a),
         Command::SurfaceInfo(args) => surface_info::run(args),
     }

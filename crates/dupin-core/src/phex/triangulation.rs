@@ -483,7 +483,18 @@ fn layer_step(
         }
     }
     if hs.is_empty() {
-        return prev;
+        // Section 5.3: re-use the previous step across a parabolic stretch; on a base curve
+        // that is itself parabolic, start with the equilateral height sqrt(3)/2 |AB|.
+        return prev.or_else(|| {
+            let a = to_uv(spec.swap, along[0], across);
+            let b = to_uv(spec.swap, along[0] + ds, across);
+            let m = (a + b) / 2.0;
+            let d = s.derivatives(m.x, m.y);
+            let across_len = if spec.swap { d.pu.norm() } else { d.pv.norm() };
+            let ab = (s.position(b.x, b.y) - s.position(a.x, a.y)).norm();
+            let h = 0.75f64.sqrt() * ab / across_len;
+            (h.is_finite() && h > 0.0).then_some(h)
+        });
     }
     hs.sort_by(|a, b| a.total_cmp(b));
     let h = hs[hs.len() / 2];
