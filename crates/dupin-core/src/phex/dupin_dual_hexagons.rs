@@ -19,9 +19,9 @@ use super::triangulation::Triangulation;
 use crate::{PolyMesh, Vec3};
 use nalgebra::Matrix3;
 
-/// Relative singular-value cut-off of the tangent-plane system (below it the direction is
-/// treated as free and the centroid's component is kept).
-const RANK_TOL: f64 = 1e-3;
+/// Cut-off of the smallest singular value of the tangent-plane system relative to the middle
+/// one (below it the direction is treated as free and the centroid's component is kept).
+const RANK_TOL: f64 = 3e-2;
 
 /// The dual polygon mesh of a triangulation plus, for every face, its triangulation vertex.
 #[derive(Debug, Clone, PartialEq)]
@@ -44,11 +44,24 @@ pub fn tangent_plane_point(p: [Vec3; 3], n: [Vec3; 3]) -> Vec3 {
         n[2].dot(&(p[2] - c)),
     );
     let svd = a.svd(true, true);
-    let smax = svd.singular_values.max();
-    match svd.solve(&rhs, RANK_TOL * smax) {
-        Ok(x) if x.iter().all(|v| v.is_finite()) => c + x,
-        _ => c,
+    let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
+        return c;
+    };
+    let sv = svd.singular_values;
+    // The normals of a small triangle are nearly parallel: the two smaller singular values are
+    // both of order (edge x curvature). The smallest one is dropped only when it is small
+    // against the middle one (normals varying in one direction only: parabolic points, rulings).
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&i, &j| sv[j].total_cmp(&sv[i]));
+    let tol = RANK_TOL * sv[order[1]];
+    let mut x = Vec3::zeros();
+    for &i in &order {
+        if sv[i] > tol && sv[i] > 1e-14 * sv[order[0]] {
+            let coef = u.column(i).dot(&rhs) / sv[i];
+            x += vt.row(i).transpose() * coef;
+        }
     }
+    if x.iter().all(|v| v.is_finite()) { c + x } else { c }
 }
 
 /// Builds the dual polygon mesh of `t` (section 6 initialisation by tangent duality).
