@@ -148,7 +148,14 @@ fn build_surface(config: &PhexConfig) -> Result<Box<dyn Surface>, PhexError> {
         .iter()
         .map(|(k, v)| (k.as_str(), *v))
         .collect();
-    let s = surface_by_name(&config.surface, &params)?;
+    let s: Box<dyn Surface> = if config.surface == super::scenes::FREEFORM {
+        Box::new(super::scenes::FreeformSurface {
+            amplitude: 0.4,
+            curl: 0.3,
+        })
+    } else {
+        surface_by_name(&config.surface, &params)?
+    };
     if !config.twist.is_finite() {
         return Err(PhexError::BadParameter("twist must be finite".into()));
     }

@@ -38,8 +38,8 @@ pub struct PlanarityOptions {
 impl Default for PlanarityOptions {
     fn default() -> Self {
         PlanarityOptions {
-            fairness: 1e-4,
-            distance: 1e-2,
+            fairness: 1e-6,
+            distance: 1e-4,
             tolerance: 1e-10,
             max_iterations: 10,
         }

@@ -111,7 +111,7 @@ pub fn phex_scene(name: &str) -> Result<PhexScene, PhexError> {
             true,
         ),
         "vase-bottom-up" => (
-            cfg("vase", &[], Prescribed, ideal, false, (0.0, 3.0), None, 0.12),
+            cfg("vase", &[], Prescribed, ideal, false, (0.1, 3.0), None, 0.12),
             true,
         ),
         "vase-longitudinal" => (
@@ -131,7 +131,7 @@ pub fn phex_scene(name: &str) -> Result<PhexScene, PhexError> {
             true,
         ),
         "freeform-parabolic" => (
-            cfg("bspline", &[], Prescribed, ideal, false, (0.0, 5.0), Some((0.0, 5.0)), 0.15),
+            cfg(FREEFORM, &[], Prescribed, ideal, false, (-1.5, 1.5), Some((-2.0, 2.0)), 0.08),
             true,
         ),
         "cylinder-developable" => (
@@ -151,6 +151,44 @@ pub fn phex_scene(name: &str) -> Result<PhexScene, PhexError> {
         config,
         expect_valid,
     })
+}
+
+/// Name of the scene-only freeform surface of `freeform-parabolic` (see [`FreeformSurface`]).
+pub const FREEFORM: &str = "freeform-translational";
+
+/// The translational freeform surface of the `freeform-parabolic` scene (Fig. 22 stand-in):
+/// P(u, v) = (u, v, amplitude sin(u) + curl v^2), u in [-2, 2], v in [-1.5, 1.5]. Its parameter
+/// lines are conjugate (translational surface), K > 0 for u < 0, K < 0 for u > 0, with the
+/// parabolic line u = 0 crossing every base curve.
+pub struct FreeformSurface {
+    /// Amplitude of the sine profile.
+    pub amplitude: f64,
+    /// Coefficient of v^2.
+    pub curl: f64,
+}
+
+impl Surface for FreeformSurface {
+    fn domain(&self) -> Domain {
+        Domain {
+            u: (-2.0, 2.0),
+            v: (-1.5, 1.5),
+            periodic_u: false,
+            periodic_v: false,
+        }
+    }
+
+    fn derivatives(&self, u: f64, v: f64) -> SurfaceDerivatives {
+        let (su, cu) = u.sin_cos();
+        let (a, b) = (self.amplitude, self.curl);
+        SurfaceDerivatives {
+            p: crate::Vec3::new(u, v, a * su + b * v * v),
+            pu: crate::Vec3::new(1.0, 0.0, a * cu),
+            pv: crate::Vec3::new(0.0, 1.0, 2.0 * b * v),
+            puu: crate::Vec3::new(0.0, 0.0, -a * su),
+            puv: crate::Vec3::zeros(),
+            pvv: crate::Vec3::new(0.0, 0.0, 2.0 * b),
+        }
+    }
 }
 
 /// A surface re-parametrised as P(u + twist v, v): its v-lines become spirals (used for the

@@ -13,6 +13,14 @@
 use super::PhexError;
 use crate::{Surface, Vec2, Vec3, ideal_apex_3d};
 
+/// Above this |CM|/|AB| the ideal triangle is taken as degenerate (the base is nearly along a
+/// parabolic direction) and the previous step is re-used (section 5.3).
+pub const MAX_RATIO: f64 = 4.0;
+
+/// The same limit where K > 0 (the ideal ratio there is sqrt(3)/2 sqrt(k_AB / k_conj), which
+/// only grows large next to a parabolic curve).
+pub const MAX_RATIO_ELLIPTIC: f64 = 1.5;
+
 /// Which triangulation method of section 5.2 to run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TriangulationMethod {
@@ -109,7 +117,12 @@ fn ideal_ratio(s: &dyn Surface, a: Vec2, b: Vec2) -> Option<f64> {
     let c = ideal_apex_3d(&curv, &pa, &pb).ok()?;
     let ab = (pb - pa).norm();
     let r = (c - (pa + pb) / 2.0).norm() / ab;
-    (r.is_finite() && r > 0.0).then_some(r)
+    let limit = if curv.gaussian > 0.0 {
+        MAX_RATIO_ELLIPTIC
+    } else {
+        MAX_RATIO
+    };
+    (r.is_finite() && r > 0.0 && r < limit).then_some(r)
 }
 
 /// Builds a triangulation of `s` per `spec` (section 5.2; section 5.3 at parabolic curves).
@@ -358,7 +371,7 @@ impl<'a> Builder<'a> {
                 let r = match spec.rule {
                     LayerRule::Fixed(r) => r,
                     LayerRule::Ideal { bound } => match ideal_ratio(s, ua, ub) {
-                        Some(r) if r < 4.0 => bounded_ratio(r, bound),
+                        Some(r) if r < MAX_RATIO => bounded_ratio(r, bound),
                         // Section 5.3: re-use the previous step across the parabolic curve.
                         _ => prev_ratio.unwrap_or(0.866),
                     },
@@ -469,7 +482,7 @@ fn layer_step(
         let r = match spec.rule {
             LayerRule::Fixed(r) => Some(r),
             LayerRule::Ideal { bound } => match ideal_ratio(s, a, b) {
-                Some(r) if r < 4.0 => Some(bounded_ratio(r, bound)),
+                Some(r) if r < MAX_RATIO => Some(bounded_ratio(r, bound)),
                 _ => None,
             },
         };
