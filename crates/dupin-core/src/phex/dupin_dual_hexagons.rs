@@ -124,3 +124,67 @@ pub fn dual_mesh(t: &Triangulation) -> Result<DualMesh, PhexError> {
         vertex_uv,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn unit(rng: &mut ChaCha8Rng) -> Vec3 {
+        Vec3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        )
+        .normalize()
+    }
+
+    #[test]
+    fn well_conditioned_point_is_on_all_three_tangent_planes() {
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        for _ in 0..200 {
+            let p = [unit(&mut rng), unit(&mut rng), unit(&mut rng)];
+            let n = [unit(&mut rng), unit(&mut rng), unit(&mut rng)];
+            if n[0].dot(&n[1].cross(&n[2])).abs() < 0.2 {
+                continue;
+            }
+            let x = tangent_plane_point(p, n);
+            for k in 0..3 {
+                assert!((x - p[k]).dot(&n[k]).abs() < 1e-9, "plane {k}");
+            }
+        }
+    }
+
+    #[test]
+    fn rulings_give_the_point_of_the_common_line_nearest_the_centroid() {
+        // Three tangent planes of a cylinder all contain the z axis direction: the point is on
+        // all planes (consistent rank-2 system) at the centroid's height.
+        let ang = [0.0f64, 0.3, 0.15];
+        let p = ang.map(|a| Vec3::new(a.cos(), a.sin(), a));
+        let n = ang.map(|a| Vec3::new(a.cos(), a.sin(), 0.0));
+        // Make the system consistent: two points on one ruling share a normal.
+        let p = [p[0], Vec3::new(p[0].x, p[0].y, 0.5), p[1]];
+        let n = [n[0], n[0], n[1]];
+        let x = tangent_plane_point(p, n);
+        for k in 0..3 {
+            assert!((x - p[k]).dot(&n[k]).abs() < 1e-12);
+        }
+        let cz = (p[0].z + p[1].z + p[2].z) / 3.0;
+        assert!((x.z - cz).abs() < 1e-12);
+    }
+
+    #[test]
+    fn every_dual_face_lies_in_the_tangent_plane_of_its_vertex() {
+        let r = crate::phex_run(crate::phex_scene("torus-bound").unwrap().config).unwrap();
+        let t = &r.triangulation;
+        let d = dual_mesh(t).unwrap();
+        for (f, &v) in d.face_vertex.iter().enumerate() {
+            let (p, n) = (t.positions[v as usize], t.normals[v as usize]);
+            let e = d.mesh.face_mean_edge(f);
+            for &i in d.mesh.face(f) {
+                assert!((d.mesh.positions[i as usize] - p).dot(&n).abs() < 1e-9 * e);
+            }
+        }
+    }
+}

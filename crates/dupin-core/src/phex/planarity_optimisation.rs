@@ -267,3 +267,72 @@ impl PlanarityOptimiser {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{phex_run, phex_scene};
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    #[test]
+    fn perturbed_mesh_returns_to_planarity_within_ten_iterations() {
+        for (name, seed) in [("sphere-radial", 1u64), ("hyperboloid-valid", 2)] {
+            let scene = phex_scene(name).unwrap();
+            let mut cfg = scene.config.clone();
+            cfg.optimize = false;
+            let r = phex_run(cfg).unwrap();
+            let mut mesh = r.mesh.clone();
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let e = (0..mesh.num_faces()).map(|i| mesh.face_mean_edge(i)).sum::<f64>()
+                / mesh.num_faces() as f64;
+            for p in mesh.positions.iter_mut() {
+                for k in 0..3 {
+                    p[k] += rng.random_range(-1.0..1.0) * 0.002 * e;
+                }
+            }
+            let before = max_planarity(&mesh);
+            assert!(before > 1e-4);
+            let surface = crate::surface_by_name(
+                &scene.config.surface,
+                &[],
+            )
+            .unwrap();
+            let min_edge = |m: &PolyMesh| {
+                m.faces()
+                    .flat_map(|f| {
+                        (0..f.len()).map(move |k| (f[k], f[(k + 1) % f.len()]))
+                    })
+                    .map(|(a, b)| (m.positions[a as usize] - m.positions[b as usize]).norm())
+                    .fold(f64::INFINITY, f64::min)
+            };
+            let min_before = min_edge(&mesh);
+            let mut opt = PlanarityOptimiser::new(&mesh, None, PlanarityOptions::default()).unwrap();
+            while !opt.done() {
+                opt.step(&mut mesh, surface.as_ref()).unwrap();
+            }
+            assert!(
+                opt.max_planarity() <= 1e-10,
+                "{name}: {:e} after {}",
+                opt.max_planarity(),
+                opt.iteration()
+            );
+            assert!(opt.iteration() <= 10);
+            // No edge collapses (the volume energy alone would allow it).
+            assert!(min_edge(&mesh) > 0.5 * min_before, "{name}: edge collapse");
+        }
+    }
+
+    #[test]
+    fn bad_options_are_typed_errors() {
+        let r = phex_run(phex_scene("sphere-radial").unwrap().config).unwrap();
+        let o = PlanarityOptions {
+            tolerance: f64::NAN,
+            ..PlanarityOptions::default()
+        };
+        assert!(matches!(
+            PlanarityOptimiser::new(&r.mesh, None, o),
+            Err(PhexError::BadParameter(_))
+        ));
+    }
+}

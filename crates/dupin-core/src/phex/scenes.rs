@@ -220,6 +220,9 @@ impl Surface for TwistedSurface {
 }
 
 #[cfg(test)]
+pub(crate) use tests::acceptance as acceptance_for_tests;
+
+#[cfg(test)]
 mod tests {
     use super::*;
     use crate::{PhexPipeline, PhexReport, phex_run};

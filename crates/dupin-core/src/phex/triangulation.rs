@@ -559,3 +559,126 @@ fn plan_closed_steps(
     out.iter_mut().for_each(|h| *h *= period / sum);
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{PhexConfig, phex_run, surface_by_name};
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    #[test]
+    fn parabolic_bound_is_at_least_b_smooth_and_identity_above_2b() {
+        let b = 0.3;
+        for i in 0..200 {
+            let r = i as f64 * 0.005;
+            let rp = bounded_ratio(r, b);
+            assert!(rp >= b && rp >= r - 1e-15, "r {r} -> {rp}");
+            if r >= 2.0 * b {
+                assert_eq!(rp, r);
+            }
+        }
+        // Continuous with continuous slope at r = 2b.
+        let e = 1e-7;
+        let (lo, hi) = (bounded_ratio(2.0 * b - e, b), bounded_ratio(2.0 * b + e, b));
+        assert!((hi - lo).abs() < 3e-7);
+        let slope_lo = (bounded_ratio(2.0 * b - e, b) - bounded_ratio(2.0 * b - 2.0 * e, b)) / e;
+        assert!((slope_lo - 1.0).abs() < 1e-5);
+        assert_eq!(bounded_ratio(0.1, 0.0), 0.1);
+    }
+
+    #[test]
+    fn bad_sizes_are_typed_errors() {
+        let s = surface_by_name("torus", &[]).unwrap();
+        let mut spec = TriangulationSpec {
+            method: TriangulationMethod::Prescribed,
+            rule: LayerRule::Ideal { bound: 0.3 },
+            samples: 3,
+            swap: false,
+            start: 0.0,
+            end: 1.0,
+            along: (0.0, std::f64::consts::TAU),
+            max_layers: 100,
+        };
+        assert!(matches!(
+            triangulate(s.as_ref(), &spec),
+            Err(PhexError::BadSize(_))
+        ));
+        spec.samples = 40;
+        spec.along = (1.0, 1.0);
+        assert!(matches!(
+            triangulate(s.as_ref(), &spec),
+            Err(PhexError::BadParameter(_))
+        ));
+        for size in [-1.0, 0.0, f64::NAN, 1e-9, 100.0] {
+            let c = PhexConfig::for_surface("torus", &[], TriangulationMethod::Prescribed, Some(size));
+            assert!(phex_run(c).is_err(), "size {size}");
+        }
+        let c = PhexConfig::for_surface("no-such", &[], TriangulationMethod::Prescribed, None);
+        assert!(matches!(phex_run(c), Err(PhexError::Surface(_))));
+    }
+
+    #[test]
+    fn prescribed_layers_stay_on_conjugate_parameter_lines_at_the_ideal_height() {
+        // Method 2 on a surface of revolution: every layer is a parameter line and the layer
+        // height matches the ideal ratio of section 5.1 to within the per-layer median.
+        let s = surface_by_name("sphere", &[]).unwrap();
+        let spec = TriangulationSpec {
+            method: TriangulationMethod::Prescribed,
+            rule: LayerRule::Ideal { bound: 0.0 },
+            samples: 60,
+            swap: false,
+            start: -0.5,
+            end: 0.5,
+            along: (0.0, std::f64::consts::TAU),
+            max_layers: 100,
+        };
+        let t = triangulate(s.as_ref(), &spec).unwrap();
+        for l in &t.layers {
+            let v0 = t.uv[l[0] as usize].y;
+            assert!(l.iter().all(|&i| (t.uv[i as usize].y - v0).abs() < 1e-12));
+        }
+        // On the unit sphere the ideal triangle is equilateral: |CM| = sqrt(3)/2 |AB|.
+        let tri = t.triangles[0].map(|i| t.positions[i as usize]);
+        let e: Vec<f64> = (0..3).map(|k| (tri[k] - tri[(k + 1) % 3]).norm()).collect();
+        let mean = e.iter().sum::<f64>() / 3.0;
+        assert!(e.iter().all(|x| (x - mean).abs() < 0.05 * mean), "{e:?}");
+    }
+
+    /// Property test: seeded random parameters of each surface family; the whole pipeline meets
+    /// the acceptance thresholds.
+    #[test]
+    fn random_surface_parameters_meet_acceptance() {
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        for _ in 0..3 {
+            let big_r = rng.random_range(1.5..3.0);
+            let r = rng.random_range(0.3..0.6) * big_r;
+            let a = rng.random_range(0.7..1.5);
+            let c = rng.random_range(0.7..1.5);
+            let radius = rng.random_range(0.5..2.0);
+            let cases: Vec<(&str, Vec<(String, f64)>, Option<(f64, f64)>)> = vec![
+                (
+                    "torus",
+                    vec![("R".into(), big_r), ("r".into(), r)],
+                    None,
+                ),
+                (
+                    "hyperboloid",
+                    vec![("a".into(), a), ("c".into(), c), ("vmax".into(), 1.0)],
+                    None,
+                ),
+                ("sphere", vec![("radius".into(), radius)], Some((0.0, 1.1))),
+            ];
+            for (name, params, across) in cases {
+                let mut cfg =
+                    PhexConfig::for_surface(name, &params, TriangulationMethod::Prescribed, None);
+                if across.is_some() {
+                    cfg.across = across;
+                }
+                let res = phex_run(cfg).unwrap_or_else(|e| panic!("{name} {params:?}: {e}"));
+                let bad = crate::phex::scenes::acceptance_for_tests(&res.report);
+                assert!(bad.is_empty(), "{name} {params:?}: {bad:?}");
+            }
+        }
+    }
+}
