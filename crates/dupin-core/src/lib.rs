@@ -13,6 +13,13 @@
 //! - [`DupinIndicatrix`], [`DupinConic`], conjugate and asymptotic directions (sections 3, 4.2);
 //! - [`dupin_center`], [`tangent_dual_point`], [`TriangleStar`] (section 4, Propositions 3-5);
 //! - [`ideal_triangle`] (section 5.1); [`is_simple_polygon`] (exact predicates).
+//!
+//! ## P-Hex meshes (P-Hex paper, sections 5 to 7)
+//! - [`triangulate`] (methods 1 and 2 of section 5.2, parabolic rules of 5.3, [`bounded_ratio`]);
+//! - [`dual_mesh`] (section 6 initialisation, tangent duality), [`PlanarityOptimiser`]
+//!   (section 6 Gauss-Newton planarity);
+//! - [`PhexPipeline`] (stepper), [`phex_run`] (one shot), [`phex_scene`] / [`PHEX_SCENES`],
+//!   [`phex_report`] / [`face_info`] (contract report and per-face data).
 
 // `!(x > t)` is used on purpose throughout: unlike `x <= t` it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -68,7 +75,7 @@ pub use mesh_topology::{MeshTopology, TopologyError};
 pub use obj::{ObjError, parse_obj, write_obj};
 pub use offset::{OffsetError, offset_mesh};
 pub use phex::{
-    DualMesh, FaceInfo, LayerRule, PHEX_SCENES, PhexConfig, PhexError, PhexMetrics, PhexPhase,
+    DualMesh, FREEFORM, FaceInfo, FreeformSurface, LayerRule, PHEX_SCENES, PhexConfig, PhexError, PhexMetrics, PhexPhase,
     PhexPipeline, PhexReport, PhexResult, PhexScene, PlanarityOptimiser, PlanarityOptions,
     PlanarityStep, Triangulation, TriangulationMethod, TriangulationSpec, TwistedSurface,
     bounded_ratio, dual_mesh, face_info, phex_report, phex_run, phex_scene, tangent_plane_point,

@@ -13,7 +13,7 @@ pub use dupin_dual_hexagons::{DualMesh, dual_mesh, tangent_plane_point};
 pub use pipeline::{PhexConfig, PhexMetrics, PhexPhase, PhexPipeline, PhexResult, phex_run};
 pub use planarity_optimisation::{PlanarityOptimiser, PlanarityOptions, PlanarityStep};
 pub use report::{FaceInfo, PhexReport, face_info, phex_report};
-pub use scenes::{PHEX_SCENES, PhexScene, TwistedSurface, phex_scene};
+pub use scenes::{FREEFORM, FreeformSurface, PHEX_SCENES, PhexScene, TwistedSurface, phex_scene};
 pub use triangulation::{
     LayerRule, Triangulation, TriangulationMethod, TriangulationSpec, bounded_ratio, triangulate,
 };

@@ -13,7 +13,7 @@ use super::triangulation::{
 };
 use crate::{PolyMesh, Surface, max_planarity, surface_by_name};
 
-/// Everything a run needs. Build it from a scene ([`super::phex_scene`]) or with
+/// Everything a run needs. Build it from a scene ([`crate::phex_scene`]) or with
 /// [`PhexConfig::for_surface`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct PhexConfig {
