@@ -3,8 +3,7 @@
 use crate::common::{CliError, write_report, write_text};
 use clap::Args;
 use dupin_core::{
-    PHEX_SCENES, PhexConfig, TriangulationMethod, parse_assignment, phex_run, phex_scene,
-    write_obj,
+    PHEX_SCENES, PhexConfig, TriangulationMethod, parse_assignment, phex_run, phex_scene, write_obj,
 };
 use serde_json::json;
 use std::path::PathBuf;

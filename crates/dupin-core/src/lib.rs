@@ -75,11 +75,11 @@ pub use mesh_topology::{MeshTopology, TopologyError};
 pub use obj::{ObjError, parse_obj, write_obj};
 pub use offset::{OffsetError, offset_mesh};
 pub use phex::{
-    DualMesh, FREEFORM, FaceInfo, FreeformSurface, LayerRule, PHEX_SCENES, PhexConfig, PhexError, PhexMetrics, PhexPhase,
-    PhexPipeline, PhexReport, PhexResult, PhexScene, PlanarityOptimiser, PlanarityOptions,
-    PlanarityStep, Triangulation, TriangulationMethod, TriangulationSpec, TwistedSurface,
-    bounded_ratio, dual_mesh, face_info, phex_report, phex_run, phex_scene, tangent_plane_point,
-    triangulate,
+    DualMesh, FREEFORM, FaceInfo, FreeformSurface, LayerRule, PHEX_SCENES, PhexConfig, PhexError,
+    PhexMetrics, PhexPhase, PhexPipeline, PhexReport, PhexResult, PhexScene, PlanarityOptimiser,
+    PlanarityOptions, PlanarityStep, Triangulation, TriangulationMethod, TriangulationSpec,
+    TwistedSurface, bounded_ratio, dual_mesh, face_info, phex_report, phex_run, phex_scene,
+    tangent_plane_point, triangulate,
 };
 pub use planarity::{face_planarity, max_planarity};
 pub use polygon::{PolygonError, is_simple_polygon, segments_intersect, strictly_inside_triangle};

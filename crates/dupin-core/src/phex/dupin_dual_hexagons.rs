@@ -61,7 +61,11 @@ pub fn tangent_plane_point(p: [Vec3; 3], n: [Vec3; 3]) -> Vec3 {
             x += vt.row(i).transpose() * coef;
         }
     }
-    if x.iter().all(|v| v.is_finite()) { c + x } else { c }
+    if x.iter().all(|v| v.is_finite()) {
+        c + x
+    } else {
+        c
+    }
 }
 
 /// Builds the dual polygon mesh of `t` (section 6 initialisation by tangent duality).

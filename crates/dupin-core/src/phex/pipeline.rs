@@ -417,12 +417,13 @@ pub fn phex_run(config: PhexConfig) -> Result<PhexResult, PhexError> {
     while !p.done() {
         p.step()?;
     }
-    let report = p.report().ok_or_else(|| {
-        PhexError::NoValidTriangulation("no hexagonal mesh was produced".into())
-    })?;
-    let dual = p.dual.take().ok_or_else(|| {
-        PhexError::NoValidTriangulation("no hexagonal mesh was produced".into())
-    })?;
+    let report = p
+        .report()
+        .ok_or_else(|| PhexError::NoValidTriangulation("no hexagonal mesh was produced".into()))?;
+    let dual = p
+        .dual
+        .take()
+        .ok_or_else(|| PhexError::NoValidTriangulation("no hexagonal mesh was produced".into()))?;
     Ok(PhexResult {
         mesh: dual.mesh,
         triangulation: p.tri,

@@ -63,7 +63,13 @@ impl NonlinearLeastSquares for Problem<'_> {
     }
 
     fn evaluate(&self, x: &[f64], out: &mut SparseSystem) {
-        let p = |i: u32| Vec3::new(x[3 * i as usize], x[3 * i as usize + 1], x[3 * i as usize + 2]);
+        let p = |i: u32| {
+            Vec3::new(
+                x[3 * i as usize],
+                x[3 * i as usize + 1],
+                x[3 * i as usize + 2],
+            )
+        };
         for (fi, f) in self.mesh.faces().enumerate() {
             let n = f.len();
             if n < 4 {
@@ -152,8 +158,7 @@ impl PlanarityOptimiser {
         start_uv: Option<&[Vec2]>,
         options: PlanarityOptions,
     ) -> Result<Self, PhexError> {
-        if !(options.tolerance > 0.0) || !(options.fairness >= 0.0) || !(options.distance >= 0.0)
-        {
+        if !(options.tolerance > 0.0) || !(options.fairness >= 0.0) || !(options.distance >= 0.0) {
             return Err(PhexError::BadParameter(
                 "planarity tolerance must be > 0 and weights >= 0".into(),
             ));
@@ -241,7 +246,11 @@ impl PlanarityOptimiser {
             sqrt_mu: self.mu.sqrt(),
             edge: self.edge,
         };
-        let mut x: Vec<f64> = mesh.positions.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
+        let mut x: Vec<f64> = mesh
+            .positions
+            .iter()
+            .flat_map(|p| [p.x, p.y, p.z])
+            .collect();
         self.lm.invalidate();
         let res = self.lm.step(&problem, &mut x);
         self.iteration += 1;
@@ -284,7 +293,9 @@ mod tests {
             let r = phex_run(cfg).unwrap();
             let mut mesh = r.mesh.clone();
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            let e = (0..mesh.num_faces()).map(|i| mesh.face_mean_edge(i)).sum::<f64>()
+            let e = (0..mesh.num_faces())
+                .map(|i| mesh.face_mean_edge(i))
+                .sum::<f64>()
                 / mesh.num_faces() as f64;
             for p in mesh.positions.iter_mut() {
                 for k in 0..3 {
@@ -293,21 +304,16 @@ mod tests {
             }
             let before = max_planarity(&mesh);
             assert!(before > 1e-4);
-            let surface = crate::surface_by_name(
-                &scene.config.surface,
-                &[],
-            )
-            .unwrap();
+            let surface = crate::surface_by_name(&scene.config.surface, &[]).unwrap();
             let min_edge = |m: &PolyMesh| {
                 m.faces()
-                    .flat_map(|f| {
-                        (0..f.len()).map(move |k| (f[k], f[(k + 1) % f.len()]))
-                    })
+                    .flat_map(|f| (0..f.len()).map(move |k| (f[k], f[(k + 1) % f.len()])))
                     .map(|(a, b)| (m.positions[a as usize] - m.positions[b as usize]).norm())
                     .fold(f64::INFINITY, f64::min)
             };
             let min_before = min_edge(&mesh);
-            let mut opt = PlanarityOptimiser::new(&mesh, None, PlanarityOptions::default()).unwrap();
+            let mut opt =
+                PlanarityOptimiser::new(&mesh, None, PlanarityOptions::default()).unwrap();
             while !opt.done() {
                 opt.step(&mut mesh, surface.as_ref()).unwrap();
             }

@@ -56,7 +56,11 @@ fn project(pts: &[Vec3]) -> (Vec<Vec2>, Vec3) {
         n += (pts[i] - c).cross(&(pts[(i + 1) % pts.len()] - c));
     }
     let n = n.try_normalize(0.0).unwrap_or(Vec3::z());
-    let e1 = if n.x.abs() < 0.9 { Vec3::x() } else { Vec3::y() };
+    let e1 = if n.x.abs() < 0.9 {
+        Vec3::x()
+    } else {
+        Vec3::y()
+    };
     let e1 = (e1 - n * n.dot(&e1)).normalize();
     let e2 = n.cross(&e1);
     (
@@ -95,9 +99,7 @@ pub fn face_info(mesh: &PolyMesh, i: usize, gaussian: f64) -> FaceInfo {
                 .fold(0.0, f64::max)
                 / scale
         } else {
-            let sym = (0..3)
-                .map(|k| (r[k] + r[k + 3]).norm())
-                .fold(0.0, f64::max);
+            let sym = (0..3).map(|k| (r[k] + r[k + 3]).norm()).fold(0.0, f64::max);
             let best = (0..6)
                 .map(|k| (r[(k + 1) % 6] - (r[k] + r[(k + 2) % 6]) / 4.0).norm())
                 .fold(f64::INFINITY, f64::min);

@@ -42,6 +42,7 @@ pub struct PhexScene {
 /// The section 5.3 lower bound b used by the scenes.
 pub const DEFAULT_BOUND: f64 = 0.3;
 
+#[allow(clippy::too_many_arguments)] // a table row: one argument per column
 fn cfg(
     surface: &str,
     params: &[(&str, f64)],
@@ -78,64 +79,199 @@ pub fn phex_scene(name: &str) -> Result<PhexScene, PhexError> {
     };
     let (config, expect_valid) = match name {
         "cyclide-architecture" => (
-            cfg("dupin-cyclide", &[], Prescribed, ideal, false, (-1.2, 1.2), None, 0.12),
+            cfg(
+                "dupin-cyclide",
+                &[],
+                Prescribed,
+                ideal,
+                false,
+                (-1.2, 1.2),
+                None,
+                0.12,
+            ),
             true,
         ),
         "sphere-radial" => (
-            cfg("sphere", &[], Progressive, ideal, false, (0.0, 1.2), None, 0.1),
+            cfg(
+                "sphere",
+                &[],
+                Progressive,
+                ideal,
+                false,
+                (0.0, 1.2),
+                None,
+                0.1,
+            ),
             true,
         ),
         "sphere-diverging" => (
-            cfg("sphere", &[], Progressive, ideal, false, (1.1, -0.9), None, 0.08),
+            cfg(
+                "sphere",
+                &[],
+                Progressive,
+                ideal,
+                false,
+                (1.1, -0.9),
+                None,
+                0.08,
+            ),
             true,
         ),
         "sphere-spiral" => {
-            let mut c = cfg("sphere", &[], Prescribed, ideal, false, (-1.1, 1.1), None, 0.1);
+            let mut c = cfg(
+                "sphere",
+                &[],
+                Prescribed,
+                ideal,
+                false,
+                (-1.1, 1.1),
+                None,
+                0.1,
+            );
             c.twist = 0.3;
             (c, true)
         }
         "hyperboloid-invalid" => (
-            cfg("hyperboloid", &[], Prescribed, Fixed(0.2), false, (-1.0, 1.0), None, 0.25),
+            cfg(
+                "hyperboloid",
+                &[],
+                Prescribed,
+                Fixed(0.2),
+                false,
+                (-1.0, 1.0),
+                None,
+                0.25,
+            ),
             false,
         ),
         "hyperboloid-valid" => (
-            cfg("hyperboloid", &[], Prescribed, ideal, false, (-1.0, 1.0), None, 0.15),
+            cfg(
+                "hyperboloid",
+                &[],
+                Prescribed,
+                ideal,
+                false,
+                (-1.0, 1.0),
+                None,
+                0.15,
+            ),
             true,
         ),
         "cyclide-progressive" => (
-            cfg("dupin-cyclide", &[], Progressive, ideal, false, (-0.8, 0.8), None, 0.12),
+            cfg(
+                "dupin-cyclide",
+                &[],
+                Progressive,
+                ideal,
+                false,
+                (-0.8, 0.8),
+                None,
+                0.12,
+            ),
             true,
         ),
         "cyclide-prescribed" => (
-            cfg("dupin-cyclide", &[], Prescribed, ideal, false, (0.0, TAU), None, 0.12),
+            cfg(
+                "dupin-cyclide",
+                &[],
+                Prescribed,
+                ideal,
+                false,
+                (0.0, TAU),
+                None,
+                0.12,
+            ),
             true,
         ),
         "vase-bottom-up" => (
-            cfg("vase", &[], Prescribed, ideal, false, (0.1, 3.0), None, 0.12),
+            cfg(
+                "vase",
+                &[],
+                Prescribed,
+                ideal,
+                false,
+                (0.1, 3.0),
+                None,
+                0.12,
+            ),
             true,
         ),
         "vase-longitudinal" => (
-            cfg("vase", &[], Prescribed, ideal, true, (0.0, TAU), Some((0.0, 3.0)), 0.12),
+            cfg(
+                "vase",
+                &[],
+                Prescribed,
+                ideal,
+                true,
+                (0.0, TAU),
+                Some((0.0, 3.0)),
+                0.12,
+            ),
             true,
         ),
         "torus-no-bound" => (
-            cfg("torus", &[], Prescribed, Ideal { bound: 0.0 }, false, (0.0, PI), None, 0.15),
+            cfg(
+                "torus",
+                &[],
+                Prescribed,
+                Ideal { bound: 0.0 },
+                false,
+                (0.0, PI),
+                None,
+                0.15,
+            ),
             false,
         ),
         "torus-bound" => (
-            cfg("torus", &[], Prescribed, ideal, false, (0.0, TAU), None, 0.15),
+            cfg(
+                "torus",
+                &[],
+                Prescribed,
+                ideal,
+                false,
+                (0.0, TAU),
+                None,
+                0.15,
+            ),
             true,
         ),
         "minimal-surface" => (
-            cfg("enneper", &[], Prescribed, ideal, false, (-1.0, 1.0), Some((-1.0, 1.0)), 0.08),
+            cfg(
+                "enneper",
+                &[],
+                Prescribed,
+                ideal,
+                false,
+                (-1.0, 1.0),
+                Some((-1.0, 1.0)),
+                0.08,
+            ),
             true,
         ),
         "freeform-parabolic" => (
-            cfg(FREEFORM, &[], Prescribed, ideal, false, (-1.5, 1.5), Some((-2.0, 2.0)), 0.08),
+            cfg(
+                FREEFORM,
+                &[],
+                Prescribed,
+                ideal,
+                false,
+                (-1.5, 1.5),
+                Some((-2.0, 2.0)),
+                0.08,
+            ),
             true,
         ),
         "cylinder-developable" => (
-            cfg("cylinder", &[], Prescribed, Fixed(0.866), true, (0.0, TAU), Some((0.0, 2.0)), 0.12),
+            cfg(
+                "cylinder",
+                &[],
+                Prescribed,
+                Fixed(0.866),
+                true,
+                (0.0, TAU),
+                Some((0.0, 2.0)),
+                0.12,
+            ),
             true,
         ),
         _ => {
@@ -145,7 +281,11 @@ pub fn phex_scene(name: &str) -> Result<PhexScene, PhexError> {
             });
         }
     };
-    let name = PHEX_SCENES.iter().find(|n| **n == name).copied().unwrap_or("");
+    let name = PHEX_SCENES
+        .iter()
+        .find(|n| **n == name)
+        .copied()
+        .unwrap_or("");
     Ok(PhexScene {
         name,
         config,
@@ -259,10 +399,16 @@ mod tests {
         let wrong = rep
             .per_face
             .iter()
-            .filter(|f| f.gaussian.abs() > 0.0 && f.gaussian.abs() >= AWAY * kmax && (f.gaussian > 0.0) != f.convex)
+            .filter(|f| {
+                f.gaussian.abs() > 0.0
+                    && f.gaussian.abs() >= AWAY * kmax
+                    && (f.gaussian > 0.0) != f.convex
+            })
             .count();
         if wrong > 0 {
-            bad.push(format!("{wrong} faces with the wrong convexity for the sign of K"));
+            bad.push(format!(
+                "{wrong} faces with the wrong convexity for the sign of K"
+            ));
         }
         bad
     }

@@ -229,7 +229,7 @@ impl<'a> Builder<'a> {
     }
 
     fn along_at(&self, j: usize, i: usize) -> f64 {
-        let off = if j % 2 == 1 { 0.5 } else { 0.0 };
+        let off = if !j.is_multiple_of(2) { 0.5 } else { 0.0 };
         self.spec.along.0 + (i as f64 + off) * self.ds
     }
 
@@ -237,7 +237,7 @@ impl<'a> Builder<'a> {
         let n = self.spec.samples;
         if self.closed {
             n
-        } else if j % 2 == 0 {
+        } else if j.is_multiple_of(2) {
             n + 1
         } else {
             n
@@ -294,7 +294,7 @@ impl<'a> Builder<'a> {
             let (k, m) = (prev.len(), new_layer.len());
             if self.closed {
                 for i in 0..k {
-                    if j % 2 == 0 {
+                    if j.is_multiple_of(2) {
                         // New point i sits over the segment (i, i+1).
                         self.tri(prev[i], prev[(i + 1) % k], new_layer[i]);
                         self.tri(new_layer[i], prev[(i + 1) % k], new_layer[(i + 1) % m]);
@@ -304,7 +304,7 @@ impl<'a> Builder<'a> {
                         self.tri(new_layer[i], prev[i], new_layer[(i + 1) % m]);
                     }
                 }
-            } else if j % 2 == 0 {
+            } else if j.is_multiple_of(2) {
                 for i in 0..k - 1 {
                     self.tri(prev[i], prev[i + 1], new_layer[i]);
                     if i + 1 < m {
@@ -455,11 +455,19 @@ impl<'a> Builder<'a> {
 }
 
 fn period_along(dom: &crate::Domain, swap: bool) -> f64 {
-    if swap { dom.v.1 - dom.v.0 } else { dom.u.1 - dom.u.0 }
+    if swap {
+        dom.v.1 - dom.v.0
+    } else {
+        dom.u.1 - dom.u.0
+    }
 }
 
 fn period_across(dom: &crate::Domain, swap: bool) -> f64 {
-    if swap { dom.u.1 - dom.u.0 } else { dom.v.1 - dom.v.0 }
+    if swap {
+        dom.u.1 - dom.u.0
+    } else {
+        dom.v.1 - dom.v.0
+    }
 }
 
 /// Across-parameter step of the next layer for method 2: the median over the layer of the ideal
@@ -611,7 +619,8 @@ mod tests {
             Err(PhexError::BadParameter(_))
         ));
         for size in [-1.0, 0.0, f64::NAN, 1e-9, 100.0] {
-            let c = PhexConfig::for_surface("torus", &[], TriangulationMethod::Prescribed, Some(size));
+            let c =
+                PhexConfig::for_surface("torus", &[], TriangulationMethod::Prescribed, Some(size));
             assert!(phex_run(c).is_err(), "size {size}");
         }
         let c = PhexConfig::for_surface("no-such", &[], TriangulationMethod::Prescribed, None);
@@ -656,12 +665,9 @@ mod tests {
             let a = rng.random_range(0.7..1.5);
             let c = rng.random_range(0.7..1.5);
             let radius = rng.random_range(0.5..2.0);
-            let cases: Vec<(&str, Vec<(String, f64)>, Option<(f64, f64)>)> = vec![
-                (
-                    "torus",
-                    vec![("R".into(), big_r), ("r".into(), r)],
-                    None,
-                ),
+            type Case = (&'static str, Vec<(String, f64)>, Option<(f64, f64)>);
+            let cases: Vec<Case> = vec![
+                ("torus", vec![("R".into(), big_r), ("r".into(), r)], None),
                 (
                     "hyperboloid",
                     vec![("a".into(), a), ("c".into(), c), ("vmax".into(), 1.0)],
