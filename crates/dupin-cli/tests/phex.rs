@@ -36,6 +36,7 @@ fn lists_every_contract_scene() {
         "torus-no-bound",
         "torus-bound",
         "minimal-surface",
+        "convex-loop",
         "freeform-parabolic",
         "cylinder-developable",
     ] {

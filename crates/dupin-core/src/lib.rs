@@ -78,8 +78,8 @@ pub use phex::{
     DualMesh, FREEFORM, FaceInfo, FreeformSurface, LayerRule, PHEX_SCENES, PhexConfig, PhexError,
     PhexMetrics, PhexPhase, PhexPipeline, PhexReport, PhexResult, PhexScene, PlanarityOptimiser,
     PlanarityOptions, PlanarityStep, Triangulation, TriangulationMethod, TriangulationSpec,
-    TwistedSurface, bounded_ratio, dual_mesh, face_info, phex_report, phex_run, phex_scene,
-    tangent_plane_point, triangulate,
+    TwistedSurface, bounded_ratio, convex_loop_triangulation, dual_mesh, face_info, loop_subdivide,
+    phex_report, phex_run, phex_scene, tangent_plane_point, triangulate,
 };
 pub use planarity::{face_planarity, max_planarity};
 pub use polygon::{PolygonError, is_simple_polygon, segments_intersect, strictly_inside_triangle};

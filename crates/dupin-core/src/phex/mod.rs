@@ -3,6 +3,7 @@
 //! function ([`phex_run`]) and a stateful stepper ([`PhexPipeline`]).
 
 mod dupin_dual_hexagons;
+mod loop_subdivision;
 mod pipeline;
 mod planarity_optimisation;
 mod report;
@@ -10,6 +11,7 @@ mod scenes;
 mod triangulation;
 
 pub use dupin_dual_hexagons::{DualMesh, dual_mesh, tangent_plane_point};
+pub use loop_subdivision::{convex_loop_triangulation, loop_subdivide};
 pub use pipeline::{PhexConfig, PhexMetrics, PhexPhase, PhexPipeline, PhexResult, phex_run};
 pub use planarity_optimisation::{PlanarityOptimiser, PlanarityOptions, PlanarityStep};
 pub use report::{FaceInfo, PhexReport, face_info, phex_report};

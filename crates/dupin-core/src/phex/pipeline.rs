@@ -39,6 +39,9 @@ pub struct PhexConfig {
     pub iterations: usize,
     /// Run the planarity optimisation.
     pub optimize: bool,
+    /// Triangulate by Loop subdivision of an icosahedron projected onto the surface instead of
+    /// layers (Fig. 21; the surface must be the `ellipsoid`).
+    pub loop_subdivision: bool,
 }
 
 impl PhexConfig {
@@ -65,6 +68,7 @@ impl PhexConfig {
             size,
             iterations: 10,
             optimize: true,
+            loop_subdivision: false,
         }
     }
 }
@@ -184,6 +188,9 @@ impl PhexPipeline {
             )));
         }
         let surface = build_surface(&config)?;
+        if config.loop_subdivision {
+            return Self::from_loop(config, surface);
+        }
         let dom = surface.domain();
         let (along_dom, across_dom) = if config.swap {
             (dom.v, dom.u)
@@ -264,6 +271,53 @@ impl PhexPipeline {
             config,
             tri,
             layer_triangles,
+            shown: 0,
+            dual: None,
+            optimiser: None,
+            phase: PhexPhase::Triangulation,
+            metrics: PhexMetrics {
+                phase: PhexPhase::Triangulation,
+                layer: 0,
+                iteration: 0,
+                faces: 0,
+                vertices: 0,
+                max_planarity: 0.0,
+                invalid_faces: 0,
+            },
+        })
+    }
+
+    fn from_loop(config: PhexConfig, surface: Box<dyn Surface>) -> Result<Self, PhexError> {
+        if config.surface != "ellipsoid" {
+            return Err(PhexError::BadParameter(
+                "Loop subdivision (convex genus 0) needs --surface ellipsoid".into(),
+            ));
+        }
+        let get = |k: &str, d: f64| {
+            config
+                .params
+                .iter()
+                .rev()
+                .find(|(n, _)| n == k)
+                .map_or(d, |p| p.1)
+        };
+        let axes = (get("a", 1.5), get("b", 1.0), get("c", 0.8));
+        // Icosahedron edge ~1.05 x the mean semi-axis; every level halves it.
+        let mean_axis = (axes.0 + axes.1 + axes.2) / 3.0;
+        let size = config.size.unwrap_or(mean_axis / 12.0);
+        if !(size.is_finite() && size > 0.0) {
+            return Err(PhexError::BadSize(format!(
+                "size {size} must be a positive length"
+            )));
+        }
+        let levels = (1.05 * mean_axis / size).log2().ceil().max(1.0) as usize;
+        let tri = super::loop_subdivision::convex_loop_triangulation(axes, levels)?;
+        let n = tri.triangles.len();
+        Ok(PhexPipeline {
+            surface,
+            config,
+            tri,
+            layer_triangles: vec![n],
             shown: 0,
             dual: None,
             optimiser: None,

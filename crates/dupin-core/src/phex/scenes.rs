@@ -22,6 +22,7 @@ pub const PHEX_SCENES: &[&str] = &[
     "torus-no-bound",
     "torus-bound",
     "minimal-surface",
+    "convex-loop",
     "freeform-parabolic",
     "cylinder-developable",
 ];
@@ -65,6 +66,7 @@ fn cfg(
         size: Some(size),
         iterations: 10,
         optimize: true,
+        loop_subdivision: false,
     }
 }
 
@@ -248,6 +250,20 @@ pub fn phex_scene(name: &str) -> Result<PhexScene, PhexError> {
             ),
             true,
         ),
+        "convex-loop" => {
+            let mut c = cfg(
+                "ellipsoid",
+                &[],
+                Prescribed,
+                ideal,
+                false,
+                (0.0, 1.0),
+                None,
+                0.06,
+            );
+            c.loop_subdivision = true;
+            (c, true)
+        }
         "freeform-parabolic" => (
             cfg(
                 FREEFORM,
@@ -475,6 +491,18 @@ mod tests {
         let one = phex_run(scene.config).unwrap();
         assert_eq!(p.mesh(), one.mesh);
         assert_eq!(p.metrics().faces, one.report.faces);
+    }
+
+    #[test]
+    fn convex_loop_has_twelve_pentagons_more_than_heptagons() {
+        let r = phex_run(phex_scene("convex-loop").unwrap().config).unwrap();
+        let sizes = &r.report.face_sizes;
+        let f5 = *sizes.get(&5).unwrap_or(&0) as i64;
+        let f7 = *sizes.get(&7).unwrap_or(&0) as i64;
+        // F5 - F7 = 12 (1 - g), genus 0.
+        assert_eq!(f5 - f7, 12);
+        assert!(sizes.get(&6).copied().unwrap_or(0) > 100);
+        assert_eq!(r.report.faces, r.triangulation.positions.len());
     }
 
     #[test]
