@@ -68,11 +68,26 @@ pub fn tangent_plane_point(p: [Vec3; 3], n: [Vec3; 3]) -> Vec3 {
     }
 }
 
-/// Builds the dual polygon mesh of `t` (section 6 initialisation by tangent duality).
+/// How the dual vertices are placed (section 6 initialisation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Initialisation {
+    /// Tangent duality (section 4.1): the point of the three tangent planes nearest the
+    /// centroid. Faces start planar wherever the planes are well conditioned.
+    #[default]
+    TangentDuality,
+    /// Approximate Dupin duality (section 6, steps 1 to 4: per-vertex Dupin centers averaged,
+    /// the centroid in parabolic regions, see [`crate::approximate_dupin_center`]). Faces start
+    /// non-planar; the Gauss-Newton optimisation makes them planar.
+    DupinDuality,
+}
+
+/// Parabolic threshold on |K| for [`Initialisation::DupinDuality`] (the paper's 1e-8).
+pub const PARABOLIC_THRESHOLD: f64 = 1e-8;
+
+/// Builds the dual polygon mesh of `t` by tangent duality (section 6 initialisation).
 ///
 /// Errors: [`PhexError::NoValidTriangulation`] when no interior vertex exists.
 pub fn dual_mesh(t: &Triangulation) -> Result<DualMesh, PhexError> {
-    let nv = t.positions.len();
     let positions: Vec<Vec3> = t
         .triangles
         .iter()
@@ -82,6 +97,53 @@ pub fn dual_mesh(t: &Triangulation) -> Result<DualMesh, PhexError> {
             tangent_plane_point(p, n)
         })
         .collect();
+    dual_from_points(t, positions)
+}
+
+/// Builds the dual polygon mesh of `t` with the chosen [`Initialisation`]; `surface` gives the
+/// curvature at the triangulation vertices for the Dupin duality.
+///
+/// Errors: [`PhexError::NoValidTriangulation`] when no interior vertex exists.
+pub fn dual_mesh_with(
+    t: &Triangulation,
+    surface: &dyn crate::Surface,
+    init: Initialisation,
+) -> Result<DualMesh, PhexError> {
+    match init {
+        Initialisation::TangentDuality => dual_mesh(t),
+        Initialisation::DupinDuality => {
+            let curv: Vec<Option<crate::Curvature>> =
+                t.uv.iter()
+                    .zip(&t.positions)
+                    .map(|(uv, p)| {
+                        surface.curvature(uv.x, uv.y).ok().map(|mut c| {
+                            // The vertex itself (the parameters may be unwrapped).
+                            c.point = *p;
+                            c
+                        })
+                    })
+                    .collect();
+            let positions = t
+                .triangles
+                .iter()
+                .map(|tr| {
+                    let centroid = tr.iter().map(|&i| t.positions[i as usize]).sum::<Vec3>() / 3.0;
+                    match tr.map(|i| curv[i as usize].as_ref()) {
+                        [Some(a), Some(b), Some(c)] => {
+                            crate::approximate_dupin_center([a, b, c], PARABOLIC_THRESHOLD)
+                                .map_or(centroid, |r| r.0)
+                        }
+                        _ => centroid,
+                    }
+                })
+                .collect();
+            dual_from_points(t, positions)
+        }
+    }
+}
+
+fn dual_from_points(t: &Triangulation, positions: Vec<Vec3>) -> Result<DualMesh, PhexError> {
+    let nv = t.positions.len();
     // Star of every vertex: for a CCW triangle (a, b, c), vertex a sees the edge b -> c.
     let mut star: Vec<Vec<(u32, u32, u32)>> = vec![vec![]; nv];
     for (ti, tr) in t.triangles.iter().enumerate() {

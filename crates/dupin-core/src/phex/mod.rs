@@ -10,7 +10,9 @@ mod report;
 mod scenes;
 mod triangulation;
 
-pub use dupin_dual_hexagons::{DualMesh, dual_mesh, tangent_plane_point};
+pub use dupin_dual_hexagons::{
+    DualMesh, Initialisation, PARABOLIC_THRESHOLD, dual_mesh, dual_mesh_with, tangent_plane_point,
+};
 pub use loop_subdivision::{convex_loop_triangulation, loop_subdivide};
 pub use pipeline::{PhexConfig, PhexMetrics, PhexPhase, PhexPipeline, PhexResult, phex_run};
 pub use planarity_optimisation::{PlanarityOptimiser, PlanarityOptions, PlanarityStep};

@@ -4,7 +4,7 @@
 //! web page); [`phex_run`] the one-shot function (for the CLI).
 
 use super::PhexError;
-use super::dupin_dual_hexagons::{DualMesh, dual_mesh};
+use super::dupin_dual_hexagons::{DualMesh, dual_mesh_with};
 use super::planarity_optimisation::{PlanarityOptimiser, PlanarityOptions};
 use super::report::{PhexReport, phex_report};
 use super::scenes::TwistedSurface;
@@ -42,6 +42,8 @@ pub struct PhexConfig {
     /// Triangulate by Loop subdivision of an icosahedron projected onto the surface instead of
     /// layers (Fig. 21; the surface must be the `ellipsoid`).
     pub loop_subdivision: bool,
+    /// How the hexagon vertices are initialised (section 6).
+    pub initialisation: super::Initialisation,
 }
 
 impl PhexConfig {
@@ -69,6 +71,7 @@ impl PhexConfig {
             iterations: 10,
             optimize: true,
             loop_subdivision: false,
+            initialisation: super::Initialisation::TangentDuality,
         }
     }
 }
@@ -413,7 +416,8 @@ impl PhexPipeline {
                 }
             }
             PhexPhase::Hexagons => {
-                let d = dual_mesh(&self.tri)?;
+                let d =
+                    dual_mesh_with(&self.tri, self.surface.as_ref(), self.config.initialisation)?;
                 self.metrics.faces = d.mesh.num_faces();
                 self.metrics.vertices = d.mesh.num_vertices();
                 self.metrics.max_planarity = max_planarity(&d.mesh);
