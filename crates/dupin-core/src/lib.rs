@@ -75,12 +75,12 @@ pub use mesh_topology::{MeshTopology, TopologyError};
 pub use obj::{ObjError, parse_obj, write_obj};
 pub use offset::{OffsetError, offset_mesh};
 pub use phex::{
-    DualMesh, FREEFORM, FaceInfo, FreeformSurface, Initialisation, LayerRule, PHEX_SCENES,
-    PhexConfig, PhexError, PhexMetrics, PhexPhase, PhexPipeline, PhexReport, PhexResult, PhexScene,
-    PlanarityOptimiser, PlanarityOptions, PlanarityStep, Triangulation, TriangulationMethod,
-    TriangulationSpec, TwistedSurface, bounded_ratio, convex_loop_triangulation, dual_mesh,
-    dual_mesh_with, face_info, loop_subdivide, phex_report, phex_run, phex_scene,
-    tangent_plane_point, triangulate,
+    DualMesh, FREEFORM, FaceInfo, FreeformSurface, Initialisation, LayerRule, PARABOLIC_THRESHOLD,
+    PHEX_SCENES, PhexConfig, PhexError, PhexMetrics, PhexPhase, PhexPipeline, PhexReport,
+    PhexResult, PhexScene, PlanarityOptimiser, PlanarityOptions, PlanarityStep, Triangulation,
+    TriangulationMethod, TriangulationSpec, TwistedSurface, bounded_ratio,
+    convex_loop_triangulation, dual_mesh, dual_mesh_with, face_info, loop_subdivide, phex_report,
+    phex_run, phex_scene, tangent_plane_point, triangulate,
 };
 pub use planarity::{face_planarity, max_planarity};
 pub use polygon::{PolygonError, is_simple_polygon, segments_intersect, strictly_inside_triangle};
