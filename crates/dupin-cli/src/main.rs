@@ -8,6 +8,7 @@ use std::process::ExitCode;
 mod common;
 mod hexdelaunay;
 mod offset;
+mod phex;
 mod planarize;
 mod pq;
 mod surface_info;
@@ -30,6 +31,8 @@ enum Command {
     Planarize(planarize::PlanarizeArgs),
     /// Offset a conical mesh by a face distance, with its support structure.
     Offset(offset::OffsetArgs),
+    /// Build a P-Hex mesh (planar hexagons) from a scene or a library surface.
+    Phex(phex::PhexArgs),
     /// Build a PQ scene of the conical paper (see --list-scenes).
     Pq(pq::PqArgs),
 }
@@ -40,6 +43,7 @@ fn run(cli: Cli) -> Result<(), common::CliError> {
         Command::Hexdelaunay(args) => hexdelaunay::run(args),
         Command::Planarize(a) => planarize::run(a),
         Command::Offset(a) => offset::run(a),
+        Command::Phex(a) => phex::run(a),
         Command::Pq(a) => pq::run(a),
     }
 }

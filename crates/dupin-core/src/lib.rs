@@ -13,6 +13,12 @@
 //! - [`DupinIndicatrix`], [`DupinConic`], conjugate and asymptotic directions (sections 3, 4.2);
 //! - [`dupin_center`], [`tangent_dual_point`], [`TriangleStar`] (section 4, Propositions 3-5);
 //! - [`ideal_triangle`] (section 5.1); [`is_simple_polygon`] (exact predicates).
+//! ## P-Hex meshes (P-Hex paper, sections 5 to 7)
+//! - [`triangulate`] (methods 1 and 2 of section 5.2, parabolic rules of 5.3, [`bounded_ratio`]);
+//! - [`dual_mesh`] (section 6 initialisation, tangent duality), [`PlanarityOptimiser`]
+//!   (section 6 Gauss-Newton planarity);
+//! - [`PhexPipeline`] (stepper), [`phex_run`] (one shot), [`phex_scene`] / [`PHEX_SCENES`],
+//!   [`phex_report`] / [`face_info`] (contract report and per-face data).
 
 // `!(x > t)` is used on purpose throughout: unlike `x <= t` it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -31,6 +37,7 @@ mod mesh;
 mod mesh_topology;
 mod obj;
 mod offset;
+mod phex;
 mod planarity;
 mod point_set;
 mod polygon;
@@ -73,6 +80,14 @@ pub use mesh::{MeshError, PolyMesh};
 pub use mesh_topology::{MeshTopology, TopologyError};
 pub use obj::{ObjError, parse_obj, write_obj};
 pub use offset::{OffsetError, offset_mesh};
+pub use phex::{
+    DualMesh, FREEFORM, FaceInfo, FreeformSurface, Initialisation, LayerRule, PARABOLIC_THRESHOLD,
+    PHEX_SCENES, PhexConfig, PhexError, PhexMetrics, PhexPhase, PhexPipeline, PhexReport,
+    PhexResult, PhexScene, PlanarityOptimiser, PlanarityOptions, PlanarityStep, Triangulation,
+    TriangulationMethod, TriangulationSpec, TwistedSurface, bounded_ratio,
+    convex_loop_triangulation, dual_mesh, dual_mesh_with, face_info, loop_subdivide, phex_report,
+    phex_run, phex_scene, tangent_plane_point, triangulate,
+};
 pub use planarity::{face_planarity, max_planarity};
 pub use point_set::{PointSetError, parse_points, parse_segments};
 pub use polygon::{PolygonError, is_simple_polygon, segments_intersect, strictly_inside_triangle};

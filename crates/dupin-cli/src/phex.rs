@@ -1,0 +1,140 @@
+//! `dupin phex`: P-Hex meshes from a scene or a library surface (P-Hex paper, sections 5-7).
+
+use crate::common::{CliError, write_report, write_text};
+use clap::Args;
+use dupin_core::{
+    PHEX_SCENES, PhexConfig, TriangulationMethod, parse_assignment, phex_run, phex_scene, write_obj,
+};
+use serde_json::json;
+use std::path::PathBuf;
+
+/// Arguments of `dupin phex`.
+#[derive(Debug, Args)]
+pub struct PhexArgs {
+    /// Scene name (see --list-scenes).
+    #[arg(long, conflicts_with = "surface")]
+    pub scene: Option<String>,
+    /// Library surface name (see `dupin surface-info --list`).
+    #[arg(long)]
+    pub surface: Option<String>,
+    /// Surface parameter KEY=VALUE (repeatable).
+    #[arg(long = "set")]
+    pub set: Vec<String>,
+    /// Triangulation method: progressive (method 1) or prescribed (method 2).
+    #[arg(long)]
+    pub method: Option<String>,
+    /// Target edge length of the base curve.
+    #[arg(long)]
+    pub size: Option<f64>,
+    /// Largest number of Gauss-Newton iterations.
+    #[arg(long)]
+    pub iterations: Option<usize>,
+    /// Skip the planarity optimisation.
+    #[arg(long)]
+    pub no_optimize: bool,
+    /// Print the scene names, one a line.
+    #[arg(long)]
+    pub list_scenes: bool,
+    /// Output OBJ.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// JSON report file.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+}
+
+/// Runs `dupin phex`.
+pub fn run(args: PhexArgs) -> Result<(), CliError> {
+    if args.list_scenes {
+        for s in PHEX_SCENES {
+            println!("{s}");
+        }
+        return Ok(());
+    }
+    let out = args
+        .out
+        .clone()
+        .ok_or_else(|| CliError::Input("--out is required".into()))?;
+    let method = match args.method.as_deref() {
+        None => None,
+        Some("progressive") => Some(TriangulationMethod::Progressive),
+        Some("prescribed") => Some(TriangulationMethod::Prescribed),
+        Some(m) => {
+            return Err(CliError::Input(format!(
+                "unknown --method '{m}'; use progressive or prescribed"
+            )));
+        }
+    };
+    let mut config = match (&args.scene, &args.surface) {
+        (Some(name), None) => {
+            if !args.set.is_empty() {
+                return Err(CliError::Input(
+                    "--set applies to --surface, not to --scene".into(),
+                ));
+            }
+            phex_scene(name).map_err(|e| CliError::input("", e))?.config
+        }
+        (None, Some(name)) => {
+            let mut params = vec![];
+            for s in &args.set {
+                let (k, v) = parse_assignment(s).map_err(|e| CliError::input("--set", e))?;
+                params.push((k, v));
+            }
+            PhexConfig::for_surface(
+                name,
+                &params,
+                method.unwrap_or(TriangulationMethod::Prescribed),
+                None,
+            )
+        }
+        _ => {
+            return Err(CliError::Input(
+                "give exactly one of --scene NAME or --surface NAME".into(),
+            ));
+        }
+    };
+    if let Some(m) = method {
+        config.method = m;
+    }
+    if let Some(h) = args.size {
+        config.size = Some(h);
+    }
+    if let Some(n) = args.iterations {
+        config.iterations = n;
+    }
+    if args.no_optimize {
+        config.optimize = false;
+    }
+    let label = args
+        .scene
+        .clone()
+        .or(args.surface.clone())
+        .unwrap_or_default();
+    let start = std::time::Instant::now();
+    let r = phex_run(config).map_err(|e| CliError::input("", e))?;
+    let seconds = start.elapsed().as_secs_f64();
+    write_text(&out, &write_obj(&r.mesh))?;
+    let rep = &r.report;
+    let sizes: serde_json::Map<String, serde_json::Value> = rep
+        .face_sizes
+        .iter()
+        .map(|(k, v)| (k.to_string(), json!(v)))
+        .collect();
+    let report = json!({
+        "vertices": rep.vertices,
+        "faces": rep.faces,
+        "face_sizes": sizes,
+        "max_planarity": rep.max_planarity,
+        "invalid_faces": rep.invalid_faces,
+        "iterations": rep.iterations,
+        "max_surface_distance": rep.max_surface_distance,
+        "bbox_diagonal": rep.bbox_diagonal,
+        "seconds": seconds,
+    });
+    write_report(args.report.as_deref(), &report)?;
+    println!(
+        "phex {label}: {} faces, max_planarity {:.3e}, {} invalid faces, {} iterations, {:.3} s",
+        rep.faces, rep.max_planarity, rep.invalid_faces, rep.iterations, seconds
+    );
+    Ok(())
+}

@@ -1,0 +1,88 @@
+//! P-Hex pipeline benchmarks (issue 4): triangulation, initialisation (dual hexagons),
+//! optimisation and the whole pipeline for about 1k, 10k and 50k faces on the torus-bound
+//! scene (ideal triangulation with the parabolic bound, both regions of K).
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use dupin_core::{
+    PhexConfig, PlanarityOptimiser, PlanarityOptions, TriangulationMethod, TriangulationSpec,
+    dual_mesh, phex_run, phex_scene, surface_by_name, triangulate,
+};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::hint::black_box;
+
+/// Base-curve edge lengths that give about 1k, 10k and 50k hexagons on the default torus.
+const SIZES: [(&str, f64); 3] = [("1k", 0.49), ("10k", 0.155), ("50k", 0.069)];
+
+fn config(size: f64) -> PhexConfig {
+    let mut c = phex_scene("torus-bound").unwrap().config;
+    c.size = Some(size);
+    c
+}
+
+fn spec(size: f64) -> TriangulationSpec {
+    let s = surface_by_name("torus", &[]).unwrap();
+    let len = 2.0 * std::f64::consts::PI * (2.0 + 0.7);
+    let _ = s;
+    TriangulationSpec {
+        method: TriangulationMethod::Prescribed,
+        rule: dupin_core::LayerRule::Ideal { bound: 0.3 },
+        samples: (len / size).round() as usize,
+        swap: false,
+        start: 0.0,
+        end: std::f64::consts::TAU,
+        along: (0.0, std::f64::consts::TAU),
+        max_layers: 4000,
+    }
+}
+
+fn bench(c: &mut Criterion) {
+    let torus = surface_by_name("torus", &[]).unwrap();
+    for (label, size) in SIZES {
+        let r = phex_run(config(size)).unwrap();
+        eprintln!(
+            "phex torus-bound {label}: {} faces, {} vertices, max_planarity {:.2e}, iterations {}",
+            r.report.faces, r.report.vertices, r.report.max_planarity, r.report.iterations
+        );
+        let sp = spec(size);
+        let mut g = c.benchmark_group(format!("phex_{label}"));
+        g.sample_size(10);
+        g.bench_function("triangulation", |b| {
+            b.iter(|| black_box(triangulate(torus.as_ref(), &sp).unwrap()))
+        });
+        let tri = triangulate(torus.as_ref(), &sp).unwrap();
+        g.bench_function("initialisation", |b| {
+            b.iter(|| black_box(dual_mesh(&tri).unwrap()))
+        });
+        // Optimisation from a perturbed start (the pipeline's start is already planar): run
+        // to max_planarity <= 1e-10.
+        let d = dual_mesh(&tri).unwrap();
+        let mut noisy = d.mesh.clone();
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let e = noisy.face_mean_edge(0);
+        for p in noisy.positions.iter_mut() {
+            for k in 0..3 {
+                p[k] += rng.random_range(-1.0..1.0) * 1e-3 * e;
+            }
+        }
+        g.bench_function("optimisation", |b| {
+            b.iter(|| {
+                let mut m = noisy.clone();
+                let mut o =
+                    PlanarityOptimiser::new(&m, Some(&d.vertex_uv), PlanarityOptions::default())
+                        .unwrap();
+                while !o.done() {
+                    o.step(&mut m, torus.as_ref()).unwrap();
+                }
+                black_box(o.max_planarity())
+            })
+        });
+        g.bench_function("pipeline", |b| {
+            b.iter(|| black_box(phex_run(config(size)).unwrap()))
+        });
+        g.finish();
+    }
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

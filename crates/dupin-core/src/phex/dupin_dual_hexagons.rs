@@ -1,0 +1,256 @@
+//! The hexagonal mesh dual to a triangulation (P-Hex paper, section 6, initialisation; the
+//! tangent duality of section 4.1, Fig. 6).
+//!
+//! Input: a [`Triangulation`] with unit normals at its vertices. Output: a polygon mesh with one
+//! vertex per triangle and one face per interior triangulation vertex (the cycle of its
+//! incident triangles): hexagons at valence-6 vertices, pentagons at valence 5, and so on.
+//!
+//! Each dual vertex is the point of the three tangent planes of its triangle closest to the
+//! triangle's centroid: the intersection point when the planes are well conditioned (tangent
+//! duality, section 4.1), the minimum-norm least-squares point otherwise (parallel rulings on
+//! developable surfaces, near-parabolic triangles), computed with nalgebra's SVD. Every face of
+//! the dual then lies in the tangent plane of its triangulation vertex whenever the three planes
+//! of each of its triangles are consistent, so the initial mesh is already planar up to the
+//! conditioning of those planes; the Gauss-Newton pass of `planarity_optimisation` removes the
+//! rest.
+
+use super::PhexError;
+use super::triangulation::Triangulation;
+use crate::{PolyMesh, Vec3};
+use nalgebra::Matrix3;
+
+/// Cut-off of the smallest singular value of the tangent-plane system relative to the middle
+/// one (below it the direction is treated as free and the centroid's component is kept).
+const RANK_TOL: f64 = 3e-2;
+
+/// The dual polygon mesh of a triangulation plus, for every face, its triangulation vertex.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DualMesh {
+    /// The polygon mesh (one vertex per triangle, one face per interior vertex).
+    pub mesh: PolyMesh,
+    /// For every face, the triangulation vertex it is dual to.
+    pub face_vertex: Vec<u32>,
+    /// For every dual vertex, surface parameters near it (a start for closest-point queries).
+    pub vertex_uv: Vec<crate::Vec2>,
+}
+
+/// Tangent-plane dual point of one triangle (see the module docs).
+pub fn tangent_plane_point(p: [Vec3; 3], n: [Vec3; 3]) -> Vec3 {
+    let c = (p[0] + p[1] + p[2]) / 3.0;
+    let a = Matrix3::from_rows(&[n[0].transpose(), n[1].transpose(), n[2].transpose()]);
+    let rhs = Vec3::new(
+        n[0].dot(&(p[0] - c)),
+        n[1].dot(&(p[1] - c)),
+        n[2].dot(&(p[2] - c)),
+    );
+    let svd = a.svd(true, true);
+    let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
+        return c;
+    };
+    let sv = svd.singular_values;
+    // The normals of a small triangle are nearly parallel: the two smaller singular values are
+    // both of order (edge x curvature). The smallest one is dropped only when it is small
+    // against the middle one (normals varying in one direction only: parabolic points, rulings).
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&i, &j| sv[j].total_cmp(&sv[i]));
+    let tol = RANK_TOL * sv[order[1]];
+    let mut x = Vec3::zeros();
+    for &i in &order {
+        if sv[i] > tol && sv[i] > 1e-14 * sv[order[0]] {
+            let coef = u.column(i).dot(&rhs) / sv[i];
+            x += vt.row(i).transpose() * coef;
+        }
+    }
+    if x.iter().all(|v| v.is_finite()) {
+        c + x
+    } else {
+        c
+    }
+}
+
+/// How the dual vertices are placed (section 6 initialisation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Initialisation {
+    /// Tangent duality (section 4.1): the point of the three tangent planes nearest the
+    /// centroid. Faces start planar wherever the planes are well conditioned.
+    #[default]
+    TangentDuality,
+    /// Approximate Dupin duality (section 6, steps 1 to 4: per-vertex Dupin centers averaged,
+    /// the centroid in parabolic regions, see [`crate::approximate_dupin_center`]). Faces start
+    /// non-planar; the Gauss-Newton optimisation makes them planar.
+    DupinDuality,
+}
+
+/// Parabolic threshold on |K| for [`Initialisation::DupinDuality`] (the paper's 1e-8).
+pub const PARABOLIC_THRESHOLD: f64 = 1e-8;
+
+/// Builds the dual polygon mesh of `t` by tangent duality (section 6 initialisation).
+///
+/// Errors: [`PhexError::NoValidTriangulation`] when no interior vertex exists.
+pub fn dual_mesh(t: &Triangulation) -> Result<DualMesh, PhexError> {
+    let positions: Vec<Vec3> = t
+        .triangles
+        .iter()
+        .map(|tr| {
+            let p = tr.map(|i| t.positions[i as usize]);
+            let n = tr.map(|i| t.normals[i as usize]);
+            tangent_plane_point(p, n)
+        })
+        .collect();
+    dual_from_points(t, positions)
+}
+
+/// Builds the dual polygon mesh of `t` with the chosen [`Initialisation`]; `surface` gives the
+/// curvature at the triangulation vertices for the Dupin duality.
+///
+/// Errors: [`PhexError::NoValidTriangulation`] when no interior vertex exists.
+pub fn dual_mesh_with(
+    t: &Triangulation,
+    surface: &dyn crate::Surface,
+    init: Initialisation,
+) -> Result<DualMesh, PhexError> {
+    match init {
+        Initialisation::TangentDuality => dual_mesh(t),
+        Initialisation::DupinDuality => {
+            let curv: Vec<Option<crate::Curvature>> =
+                t.uv.iter()
+                    .zip(&t.positions)
+                    .map(|(uv, p)| {
+                        surface.curvature(uv.x, uv.y).ok().map(|mut c| {
+                            // The vertex itself (the parameters may be unwrapped).
+                            c.point = *p;
+                            c
+                        })
+                    })
+                    .collect();
+            let positions = t
+                .triangles
+                .iter()
+                .map(|tr| {
+                    let centroid = tr.iter().map(|&i| t.positions[i as usize]).sum::<Vec3>() / 3.0;
+                    match tr.map(|i| curv[i as usize].as_ref()) {
+                        [Some(a), Some(b), Some(c)] => {
+                            crate::approximate_dupin_center([a, b, c], PARABOLIC_THRESHOLD)
+                                .map_or(centroid, |r| r.0)
+                        }
+                        _ => centroid,
+                    }
+                })
+                .collect();
+            dual_from_points(t, positions)
+        }
+    }
+}
+
+fn dual_from_points(t: &Triangulation, positions: Vec<Vec3>) -> Result<DualMesh, PhexError> {
+    let nv = t.positions.len();
+    // Star of every vertex: for a CCW triangle (a, b, c), vertex a sees the edge b -> c.
+    let mut star: Vec<Vec<(u32, u32, u32)>> = vec![vec![]; nv];
+    for (ti, tr) in t.triangles.iter().enumerate() {
+        for k in 0..3 {
+            star[tr[k] as usize].push((tr[(k + 1) % 3], tr[(k + 2) % 3], ti as u32));
+        }
+    }
+    let mut faces: Vec<Vec<u32>> = vec![];
+    let mut face_vertex = vec![];
+    for (v, st) in star.iter().enumerate() {
+        if st.len() < 3 {
+            continue;
+        }
+        // Follow b -> c links; interior iff it closes after visiting every triangle.
+        let mut face = Vec::with_capacity(st.len());
+        let mut cur = st[0];
+        let mut ok = true;
+        for _ in 0..st.len() {
+            face.push(cur.2);
+            match st.iter().find(|e| e.0 == cur.1) {
+                Some(&e) => cur = e,
+                None => {
+                    ok = false;
+                    break;
+                }
+            }
+        }
+        if ok && cur == st[0] && face.len() == st.len() {
+            faces.push(face);
+            face_vertex.push(v as u32);
+        }
+    }
+    if faces.is_empty() {
+        return Err(PhexError::NoValidTriangulation(
+            "the triangulation has no interior vertex: make the size smaller".into(),
+        ));
+    }
+    let mesh = PolyMesh::new(positions, &faces)
+        .map_err(|e| PhexError::NoValidTriangulation(format!("dual mesh: {e}")))?;
+    let vertex_uv = t.triangles.iter().map(|tr| t.uv[tr[0] as usize]).collect();
+    Ok(DualMesh {
+        mesh,
+        face_vertex,
+        vertex_uv,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn unit(rng: &mut ChaCha8Rng) -> Vec3 {
+        Vec3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        )
+        .normalize()
+    }
+
+    #[test]
+    fn well_conditioned_point_is_on_all_three_tangent_planes() {
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        for _ in 0..200 {
+            let p = [unit(&mut rng), unit(&mut rng), unit(&mut rng)];
+            let n = [unit(&mut rng), unit(&mut rng), unit(&mut rng)];
+            if n[0].dot(&n[1].cross(&n[2])).abs() < 0.2 {
+                continue;
+            }
+            let x = tangent_plane_point(p, n);
+            for k in 0..3 {
+                assert!((x - p[k]).dot(&n[k]).abs() < 1e-9, "plane {k}");
+            }
+        }
+    }
+
+    #[test]
+    fn rulings_give_the_point_of_the_common_line_nearest_the_centroid() {
+        // Three tangent planes of a cylinder all contain the z axis direction: the point is on
+        // all planes (consistent rank-2 system) at the centroid's height.
+        let ang = [0.0f64, 0.3, 0.15];
+        let p = ang.map(|a| Vec3::new(a.cos(), a.sin(), a));
+        let n = ang.map(|a| Vec3::new(a.cos(), a.sin(), 0.0));
+        // Make the system consistent: two points on one ruling share a normal.
+        let p = [p[0], Vec3::new(p[0].x, p[0].y, 0.5), p[1]];
+        let n = [n[0], n[0], n[1]];
+        let x = tangent_plane_point(p, n);
+        for k in 0..3 {
+            assert!((x - p[k]).dot(&n[k]).abs() < 1e-12);
+        }
+        let cz = (p[0].z + p[1].z + p[2].z) / 3.0;
+        assert!((x.z - cz).abs() < 1e-12);
+    }
+
+    #[test]
+    fn every_dual_face_lies_in_the_tangent_plane_of_its_vertex() {
+        let r = crate::phex_run(crate::phex_scene("torus-bound").unwrap().config).unwrap();
+        let t = &r.triangulation;
+        let d = dual_mesh(t).unwrap();
+        for (f, &v) in d.face_vertex.iter().enumerate() {
+            let (p, n) = (t.positions[v as usize], t.normals[v as usize]);
+            let e = d.mesh.face_mean_edge(f);
+            for &i in d.mesh.face(f) {
+                assert!((d.mesh.positions[i as usize] - p).dot(&n).abs() < 1e-9 * e);
+            }
+        }
+    }
+}

@@ -1,0 +1,490 @@
+//! The P-Hex pipeline (P-Hex paper, sections 5 to 7): triangulation layer after layer, the dual
+//! hexagonal mesh, then Gauss-Newton planarity iterations until the contract's `max_planarity`
+//! tolerance. [`PhexPipeline`] is the stateful stepper (one observable step per call, for the
+//! web page); [`phex_run`] the one-shot function (for the CLI).
+
+use super::PhexError;
+use super::dupin_dual_hexagons::{DualMesh, dual_mesh_with};
+use super::planarity_optimisation::{PlanarityOptimiser, PlanarityOptions};
+use super::report::{PhexReport, phex_report};
+use super::scenes::TwistedSurface;
+use super::triangulation::{
+    LayerRule, Triangulation, TriangulationMethod, TriangulationSpec, triangulate,
+};
+use crate::{PolyMesh, Surface, max_planarity, surface_by_name};
+
+/// Everything a run needs. Build it from a scene ([`crate::phex_scene`]) or with
+/// [`PhexConfig::for_surface`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct PhexConfig {
+    /// Library surface name (see `surface_catalog`).
+    pub surface: String,
+    /// Surface parameters.
+    pub params: Vec<(String, f64)>,
+    /// Shear of the parametrisation, P(u + twist v, v) (0 for none).
+    pub twist: f64,
+    /// Triangulation method (section 5.2).
+    pub method: TriangulationMethod,
+    /// Layer height rule (ideal with bound b, or fixed).
+    pub rule: LayerRule,
+    /// Base curve along v instead of u.
+    pub swap: bool,
+    /// Across-parameter range (start, end); `None`: the whole domain.
+    pub across: Option<(f64, f64)>,
+    /// Along-parameter range; `None`: the whole domain.
+    pub along: Option<(f64, f64)>,
+    /// Target edge length of the base curve (`None`: 1/48 of the base curve's length).
+    pub size: Option<f64>,
+    /// Largest number of Gauss-Newton iterations.
+    pub iterations: usize,
+    /// Run the planarity optimisation.
+    pub optimize: bool,
+    /// Triangulate by Loop subdivision of an icosahedron projected onto the surface instead of
+    /// layers (Fig. 21; the surface must be the `ellipsoid`).
+    pub loop_subdivision: bool,
+    /// How the hexagon vertices are initialised (section 6).
+    pub initialisation: super::Initialisation,
+}
+
+impl PhexConfig {
+    /// A configuration for a library surface with the whole domain (the sphere and ellipsoid
+    /// stop at latitude +-1.2 to avoid the singular poles), lower bound b = 0.3.
+    pub fn for_surface(
+        surface: &str,
+        params: &[(String, f64)],
+        method: TriangulationMethod,
+        size: Option<f64>,
+    ) -> PhexConfig {
+        let across = matches!(surface, "sphere" | "ellipsoid").then_some((-1.2, 1.2));
+        PhexConfig {
+            surface: surface.to_string(),
+            params: params.to_vec(),
+            twist: 0.0,
+            method,
+            rule: LayerRule::Ideal {
+                bound: super::scenes::DEFAULT_BOUND,
+            },
+            swap: false,
+            across,
+            along: None,
+            size,
+            iterations: 10,
+            optimize: true,
+            loop_subdivision: false,
+            initialisation: super::Initialisation::TangentDuality,
+        }
+    }
+}
+
+/// Which phase the pipeline is in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PhexPhase {
+    /// Revealing triangulation layers.
+    Triangulation,
+    /// The dual hexagonal mesh was just built.
+    Hexagons,
+    /// Gauss-Newton planarity iterations.
+    Optimisation,
+    /// Finished.
+    Done,
+}
+
+impl PhexPhase {
+    /// Lower-case name (`triangulation`, `hexagons`, `optimisation`, `done`).
+    pub fn name(self) -> &'static str {
+        match self {
+            PhexPhase::Triangulation => "triangulation",
+            PhexPhase::Hexagons => "hexagons",
+            PhexPhase::Optimisation => "optimisation",
+            PhexPhase::Done => "done",
+        }
+    }
+}
+
+/// What the page shows after every step (maps to the contract's JS `metrics()`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PhexMetrics {
+    /// Current phase.
+    pub phase: PhexPhase,
+    /// Triangulation layers shown.
+    pub layer: usize,
+    /// Gauss-Newton iterations done.
+    pub iteration: usize,
+    /// Faces of the current mesh (triangles during triangulation).
+    pub faces: usize,
+    /// Vertices of the current mesh.
+    pub vertices: usize,
+    /// `max_planarity` of the current mesh (0 for triangles).
+    pub max_planarity: f64,
+    /// Self-intersecting faces of the current mesh.
+    pub invalid_faces: usize,
+}
+
+/// The stateful P-Hex pipeline.
+///
+/// The triangulation is computed when the pipeline is created (it is cheap and its errors must
+/// surface at once); [`PhexPipeline::step`] then reveals it one layer per step, builds the dual
+/// mesh, and runs one Gauss-Newton iteration per step.
+pub struct PhexPipeline {
+    surface: Box<dyn Surface>,
+    config: PhexConfig,
+    tri: Triangulation,
+    /// Number of triangles complete after each layer.
+    layer_triangles: Vec<usize>,
+    shown: usize,
+    dual: Option<DualMesh>,
+    optimiser: Option<PlanarityOptimiser>,
+    phase: PhexPhase,
+    metrics: PhexMetrics,
+}
+
+/// Result of [`phex_run`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct PhexResult {
+    /// The P-Hex mesh.
+    pub mesh: PolyMesh,
+    /// The triangulation it is dual to.
+    pub triangulation: Triangulation,
+    /// Report (contract fields plus per-face data).
+    pub report: PhexReport,
+}
+
+fn build_surface(config: &PhexConfig) -> Result<Box<dyn Surface>, PhexError> {
+    let params: Vec<(&str, f64)> = config
+        .params
+        .iter()
+        .map(|(k, v)| (k.as_str(), *v))
+        .collect();
+    let s: Box<dyn Surface> = if config.surface == super::scenes::FREEFORM {
+        Box::new(super::scenes::FreeformSurface {
+            amplitude: 0.4,
+            curl: 0.3,
+        })
+    } else {
+        surface_by_name(&config.surface, &params)?
+    };
+    if !config.twist.is_finite() {
+        return Err(PhexError::BadParameter("twist must be finite".into()));
+    }
+    Ok(if config.twist != 0.0 {
+        Box::new(TwistedSurface {
+            inner: s,
+            twist: config.twist,
+        })
+    } else {
+        s
+    })
+}
+
+impl PhexPipeline {
+    /// Validates `config`, builds the surface and the triangulation.
+    ///
+    /// Errors: unknown surface or bad parameters ([`PhexError::Surface`]), a size too large or
+    /// too small ([`PhexError::BadSize`]), iterations outside 0..=1000
+    /// ([`PhexError::BadParameter`]), no valid triangulation
+    /// ([`PhexError::NoValidTriangulation`]).
+    pub fn new(config: PhexConfig) -> Result<Self, PhexError> {
+        if config.iterations > 1000 {
+            return Err(PhexError::BadParameter(format!(
+                "{} iterations; use at most 1000",
+                config.iterations
+            )));
+        }
+        let surface = build_surface(&config)?;
+        if config.loop_subdivision {
+            return Self::from_loop(config, surface);
+        }
+        let dom = surface.domain();
+        let (along_dom, across_dom) = if config.swap {
+            (dom.v, dom.u)
+        } else {
+            (dom.u, dom.v)
+        };
+        let along = config.along.unwrap_or(along_dom);
+        let across = config.across.unwrap_or(across_dom);
+        // Base curve length, to turn the target edge length into a sample count.
+        let base_len: f64 = (0..256)
+            .map(|i| {
+                let t = |k: f64| along.0 + (along.1 - along.0) * k / 256.0;
+                let uv = |a: f64| {
+                    if config.swap {
+                        (across.0, a)
+                    } else {
+                        (a, across.0)
+                    }
+                };
+                let (u0, v0) = uv(t(i as f64));
+                let (u1, v1) = uv(t(i as f64 + 1.0));
+                (surface.position(u1, v1) - surface.position(u0, v0)).norm()
+            })
+            .sum();
+        if !(base_len.is_finite() && base_len > 0.0) {
+            return Err(PhexError::NoValidTriangulation(
+                "the base curve has zero or non-finite length: change the region".into(),
+            ));
+        }
+        let size = config.size.unwrap_or(base_len / 48.0);
+        if !(size.is_finite() && size > 0.0) {
+            return Err(PhexError::BadSize(format!(
+                "size {size} must be a positive length"
+            )));
+        }
+        let samples_f = (base_len / size).round();
+        if !(6.0..=4000.0).contains(&samples_f) {
+            return Err(PhexError::BadSize(format!(
+                "size {size} gives {samples_f} samples on a base curve of length {base_len:.3}; \
+                 use a size between {:.3e} and {:.3e}",
+                base_len / 4000.0,
+                base_len / 6.0
+            )));
+        }
+        let spec = TriangulationSpec {
+            method: config.method,
+            rule: config.rule,
+            samples: samples_f as usize,
+            swap: config.swap,
+            start: across.0,
+            end: across.1,
+            along,
+            max_layers: 4000,
+        };
+        let tri = triangulate(surface.as_ref(), &spec)?;
+        if tri.triangles.len() > 4_000_000 {
+            return Err(PhexError::BadSize(format!(
+                "{} triangles; use a larger size",
+                tri.triangles.len()
+            )));
+        }
+        let mut layer_of = vec![0usize; tri.positions.len()];
+        for (j, l) in tri.layers.iter().enumerate().rev() {
+            for &v in l {
+                layer_of[v as usize] = j;
+            }
+        }
+        let mut layer_triangles = vec![0usize; tri.layers.len()];
+        for t in &tri.triangles {
+            let j = t.iter().map(|&v| layer_of[v as usize]).max().unwrap_or(0);
+            layer_triangles[j] += 1;
+        }
+        for j in 1..layer_triangles.len() {
+            layer_triangles[j] += layer_triangles[j - 1];
+        }
+        Ok(PhexPipeline {
+            surface,
+            config,
+            tri,
+            layer_triangles,
+            shown: 0,
+            dual: None,
+            optimiser: None,
+            phase: PhexPhase::Triangulation,
+            metrics: PhexMetrics {
+                phase: PhexPhase::Triangulation,
+                layer: 0,
+                iteration: 0,
+                faces: 0,
+                vertices: 0,
+                max_planarity: 0.0,
+                invalid_faces: 0,
+            },
+        })
+    }
+
+    fn from_loop(config: PhexConfig, surface: Box<dyn Surface>) -> Result<Self, PhexError> {
+        if config.surface != "ellipsoid" {
+            return Err(PhexError::BadParameter(
+                "Loop subdivision (convex genus 0) needs --surface ellipsoid".into(),
+            ));
+        }
+        let get = |k: &str, d: f64| {
+            config
+                .params
+                .iter()
+                .rev()
+                .find(|(n, _)| n == k)
+                .map_or(d, |p| p.1)
+        };
+        let axes = (get("a", 1.5), get("b", 1.0), get("c", 0.8));
+        // Icosahedron edge ~1.05 x the mean semi-axis; every level halves it.
+        let mean_axis = (axes.0 + axes.1 + axes.2) / 3.0;
+        let size = config.size.unwrap_or(mean_axis / 12.0);
+        if !(size.is_finite() && size > 0.0) {
+            return Err(PhexError::BadSize(format!(
+                "size {size} must be a positive length"
+            )));
+        }
+        let levels = (1.05 * mean_axis / size).log2().ceil().max(1.0) as usize;
+        let tri = super::loop_subdivision::convex_loop_triangulation(axes, levels)?;
+        let n = tri.triangles.len();
+        Ok(PhexPipeline {
+            surface,
+            config,
+            tri,
+            layer_triangles: vec![n],
+            shown: 0,
+            dual: None,
+            optimiser: None,
+            phase: PhexPhase::Triangulation,
+            metrics: PhexMetrics {
+                phase: PhexPhase::Triangulation,
+                layer: 0,
+                iteration: 0,
+                faces: 0,
+                vertices: 0,
+                max_planarity: 0.0,
+                invalid_faces: 0,
+            },
+        })
+    }
+
+    /// The surface being meshed.
+    pub fn surface(&self) -> &dyn Surface {
+        self.surface.as_ref()
+    }
+
+    /// The full triangulation.
+    pub fn triangulation(&self) -> &Triangulation {
+        &self.tri
+    }
+
+    /// Whether the run has finished.
+    pub fn done(&self) -> bool {
+        self.phase == PhexPhase::Done
+    }
+
+    /// Metrics after the last step.
+    pub fn metrics(&self) -> PhexMetrics {
+        self.metrics
+    }
+
+    /// The current mesh: the triangles of the layers shown so far, then the hexagonal mesh.
+    pub fn mesh(&self) -> PolyMesh {
+        match &self.dual {
+            Some(d) => d.mesh.clone(),
+            None => {
+                let k = if self.shown == 0 {
+                    0
+                } else {
+                    self.layer_triangles[self.shown - 1]
+                };
+                PolyMesh::new(self.tri.positions.clone(), &self.tri.triangles[..k])
+                    .unwrap_or_default()
+            }
+        }
+    }
+
+    fn face_gaussian(&self, d: &DualMesh) -> Vec<f64> {
+        d.face_vertex
+            .iter()
+            .map(|&v| {
+                let uv = self.tri.uv[v as usize];
+                self.surface
+                    .curvature(uv.x, uv.y)
+                    .map(|c| c.gaussian)
+                    .unwrap_or(0.0)
+            })
+            .collect()
+    }
+
+    /// The report of the current hexagonal mesh (`None` before it exists).
+    pub fn report(&self) -> Option<PhexReport> {
+        let d = self.dual.as_ref()?;
+        Some(phex_report(
+            &d.mesh,
+            self.surface.as_ref(),
+            &self.face_gaussian(d),
+            &d.vertex_uv,
+            self.optimiser.as_ref().map_or(0, |o| o.iteration()),
+        ))
+    }
+
+    /// Advances one observable step and returns the metrics.
+    ///
+    /// Errors: [`PhexError::NoValidTriangulation`] when the dual mesh cannot be formed,
+    /// [`PhexError::Solver`] when an optimisation step fails.
+    pub fn step(&mut self) -> Result<PhexMetrics, PhexError> {
+        match self.phase {
+            PhexPhase::Triangulation => {
+                self.shown += 1;
+                let k = self.layer_triangles[self.shown - 1];
+                let verts: usize = self.tri.layers[..self.shown].iter().map(|l| l.len()).sum();
+                self.metrics.layer = self.shown;
+                self.metrics.faces = k;
+                self.metrics.vertices = verts;
+                if self.shown == self.tri.layers.len() {
+                    self.phase = PhexPhase::Hexagons;
+                }
+            }
+            PhexPhase::Hexagons => {
+                let d =
+                    dual_mesh_with(&self.tri, self.surface.as_ref(), self.config.initialisation)?;
+                self.metrics.faces = d.mesh.num_faces();
+                self.metrics.vertices = d.mesh.num_vertices();
+                self.metrics.max_planarity = max_planarity(&d.mesh);
+                self.metrics.invalid_faces = count_invalid(&d.mesh);
+                let opt = PlanarityOptimiser::new(
+                    &d.mesh,
+                    Some(&d.vertex_uv),
+                    PlanarityOptions {
+                        max_iterations: self.config.iterations,
+                        ..PlanarityOptions::default()
+                    },
+                )?;
+                self.phase = if self.config.optimize && !opt.done() {
+                    PhexPhase::Optimisation
+                } else {
+                    PhexPhase::Done
+                };
+                self.optimiser = Some(opt);
+                self.dual = Some(d);
+            }
+            PhexPhase::Optimisation => {
+                let (Some(opt), Some(d)) = (self.optimiser.as_mut(), self.dual.as_mut()) else {
+                    self.phase = PhexPhase::Done;
+                    return Ok(self.metrics);
+                };
+                let s = opt.step(&mut d.mesh, self.surface.as_ref())?;
+                self.metrics.iteration = s.iteration;
+                self.metrics.max_planarity = s.max_planarity;
+                self.metrics.invalid_faces = count_invalid(&d.mesh);
+                if opt.done() {
+                    self.phase = PhexPhase::Done;
+                }
+            }
+            PhexPhase::Done => {}
+        }
+        self.metrics.phase = self.phase;
+        Ok(self.metrics)
+    }
+}
+
+fn count_invalid(mesh: &PolyMesh) -> usize {
+    (0..mesh.num_faces())
+        .filter(|&i| !super::report::face_info(mesh, i, 0.0).simple)
+        .count()
+}
+
+/// One-shot P-Hex run: triangulation, dual mesh, planarity optimisation, report.
+///
+/// Errors: see [`PhexPipeline::new`] and [`PhexPipeline::step`].
+pub fn phex_run(config: PhexConfig) -> Result<PhexResult, PhexError> {
+    let mut p = PhexPipeline::new(config)?;
+    // Skip the layer-by-layer reveal.
+    p.shown = p.tri.layers.len();
+    p.phase = PhexPhase::Hexagons;
+    while !p.done() {
+        p.step()?;
+    }
+    let report = p
+        .report()
+        .ok_or_else(|| PhexError::NoValidTriangulation("no hexagonal mesh was produced".into()))?;
+    let dual = p
+        .dual
+        .take()
+        .ok_or_else(|| PhexError::NoValidTriangulation("no hexagonal mesh was produced".into()))?;
+    Ok(PhexResult {
+        mesh: dual.mesh,
+        triangulation: p.tri,
+        report,
+    })
+}

@@ -1,0 +1,162 @@
+//! Per-face diagnostics of a P-Hex mesh and the contract's report (P-Hex paper, sections 4.2
+//! and 7): planarity, validity (simple polygon), convexity and the shape deviation from the
+//! affine regular (K > 0) or affine quasi-regular (K < 0) hexagon, plus the surface distance.
+
+use crate::{PolyMesh, Surface, Vec2, Vec3, face_planarity, is_simple_polygon};
+use std::collections::BTreeMap;
+
+/// Diagnostics of one face.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FaceInfo {
+    /// [`face_planarity`]: largest distance from the least-squares plane over mean edge.
+    pub planarity: f64,
+    /// Whether the face, projected to its plane, is a simple polygon (not self-intersecting).
+    pub simple: bool,
+    /// Whether the projected face is strictly convex.
+    pub convex: bool,
+    /// Gaussian curvature of the surface at the face's triangulation vertex.
+    pub gaussian: f64,
+    /// Hexagons only: relative deviation from the affine regular hexagon (K >= 0:
+    /// max_i |h_(i+1) - h_i - h_(i+2)|) or the affine quasi-regular one (K < 0:
+    /// min_k max of |h_(k+1) - (h_k + h_(k+2))/4| and the central-symmetry defects), over the
+    /// largest |h_i| (vertices h_i relative to the centroid); `None` for other sizes.
+    pub shape_deviation: Option<f64>,
+}
+
+/// The contract's P-Hex report plus per-face data.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PhexReport {
+    /// Number of vertices.
+    pub vertices: usize,
+    /// Number of faces.
+    pub faces: usize,
+    /// Polygon size -> count.
+    pub face_sizes: BTreeMap<usize, usize>,
+    /// Contract `max_planarity`.
+    pub max_planarity: f64,
+    /// Faces that are not simple polygons.
+    pub invalid_faces: usize,
+    /// Gauss-Newton iterations run.
+    pub iterations: usize,
+    /// Largest vertex distance to the surface.
+    pub max_surface_distance: f64,
+    /// Bounding-box diagonal of the mesh.
+    pub bbox_diagonal: f64,
+    /// Shortest edge over the mean edge (degeneracy check).
+    pub min_edge_ratio: f64,
+    /// Per-face diagnostics, in face order.
+    pub per_face: Vec<FaceInfo>,
+}
+
+/// Projects a face onto its Newell-normal plane; returns the 2D points and the normal.
+fn project(pts: &[Vec3]) -> (Vec<Vec2>, Vec3) {
+    let c = pts.iter().sum::<Vec3>() / pts.len() as f64;
+    let mut n = Vec3::zeros();
+    for i in 0..pts.len() {
+        n += (pts[i] - c).cross(&(pts[(i + 1) % pts.len()] - c));
+    }
+    let n = n.try_normalize(0.0).unwrap_or(Vec3::z());
+    let e1 = if n.x.abs() < 0.9 {
+        Vec3::x()
+    } else {
+        Vec3::y()
+    };
+    let e1 = (e1 - n * n.dot(&e1)).normalize();
+    let e2 = n.cross(&e1);
+    (
+        pts.iter()
+            .map(|p| Vec2::new((p - c).dot(&e1), (p - c).dot(&e2)))
+            .collect(),
+        n,
+    )
+}
+
+fn cross2(a: &Vec2, b: &Vec2) -> f64 {
+    a.x * b.y - a.y * b.x
+}
+
+/// Diagnostics of face `i` of `mesh`, with `gaussian` the curvature there.
+pub fn face_info(mesh: &PolyMesh, i: usize, gaussian: f64) -> FaceInfo {
+    let pts: Vec<Vec3> = mesh
+        .face(i)
+        .iter()
+        .map(|&v| mesh.positions[v as usize])
+        .collect();
+    let (q, _) = project(&pts);
+    let n = q.len();
+    let simple = is_simple_polygon(&q).unwrap_or(false);
+    let turns: Vec<f64> = (0..n)
+        .map(|k| cross2(&(q[(k + 1) % n] - q[k]), &(q[(k + 2) % n] - q[(k + 1) % n])))
+        .collect();
+    let convex = simple && (turns.iter().all(|&t| t > 0.0) || turns.iter().all(|&t| t < 0.0));
+    let shape_deviation = (n == 6).then(|| {
+        let c = q.iter().sum::<Vec2>() / 6.0;
+        let r: Vec<Vec2> = q.iter().map(|p| p - c).collect();
+        let scale = r.iter().map(|v| v.norm()).fold(0.0, f64::max).max(1e-300);
+        if gaussian >= 0.0 {
+            (0..6)
+                .map(|k| (r[(k + 1) % 6] - r[k] - r[(k + 2) % 6]).norm())
+                .fold(0.0, f64::max)
+                / scale
+        } else {
+            let sym = (0..3).map(|k| (r[k] + r[k + 3]).norm()).fold(0.0, f64::max);
+            let best = (0..6)
+                .map(|k| (r[(k + 1) % 6] - (r[k] + r[(k + 2) % 6]) / 4.0).norm())
+                .fold(f64::INFINITY, f64::min);
+            sym.max(best) / scale
+        }
+    });
+    FaceInfo {
+        planarity: face_planarity(mesh, i),
+        simple,
+        convex,
+        gaussian,
+        shape_deviation,
+    }
+}
+
+/// Builds the report of `mesh` on `surface`. `face_gaussian[i]` is the Gaussian curvature at
+/// face i's triangulation vertex; `start_uv` seeds the closest-point searches.
+pub fn phex_report(
+    mesh: &PolyMesh,
+    surface: &dyn Surface,
+    face_gaussian: &[f64],
+    start_uv: &[Vec2],
+    iterations: usize,
+) -> PhexReport {
+    let per_face: Vec<FaceInfo> = (0..mesh.num_faces())
+        .map(|i| face_info(mesh, i, face_gaussian.get(i).copied().unwrap_or(0.0)))
+        .collect();
+    let max_surface_distance = mesh
+        .positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            surface
+                .closest_point(p, start_uv.get(i).copied())
+                .map(|c| c.distance)
+                .unwrap_or(f64::INFINITY)
+        })
+        .fold(0.0, f64::max);
+    let mut edges = vec![];
+    for f in mesh.faces() {
+        for k in 0..f.len() {
+            let (a, b) = (f[k], f[(k + 1) % f.len()]);
+            edges.push((mesh.positions[a as usize] - mesh.positions[b as usize]).norm());
+        }
+    }
+    let mean = edges.iter().sum::<f64>() / edges.len().max(1) as f64;
+    let min = edges.iter().copied().fold(f64::INFINITY, f64::min);
+    PhexReport {
+        vertices: mesh.num_vertices(),
+        faces: mesh.num_faces(),
+        face_sizes: mesh.face_sizes(),
+        max_planarity: per_face.iter().map(|f| f.planarity).fold(0.0, f64::max),
+        invalid_faces: per_face.iter().filter(|f| !f.simple).count(),
+        iterations,
+        max_surface_distance,
+        bbox_diagonal: mesh.bbox_diagonal(),
+        min_edge_ratio: if mean > 0.0 { min / mean } else { 0.0 },
+        per_face,
+    }
+}
