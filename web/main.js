@@ -1,6 +1,6 @@
 // Dupin configurator: a thin shell. Geometry and rendering live in Rust (../crates/dupin-web);
 // this file wires DOM events, the URL hash and the frame loop.
-import init, { Viewer, torusMesh } from './pkg/dupin_web.js';
+import init, { Session, Viewer, sceneNames, torusMesh } from './pkg/dupin_web.js';
 
 const $ = (id) => document.querySelector(`[data-testid="${id}"]`) ?? document.getElementById(id);
 const statusEl = $('status');
@@ -17,7 +17,9 @@ const SCENES = {
 };
 
 let viewer = null;
-let mesh = null;
+let mesh = null;        // MeshData on screen
+let session = null;     // Session of a stepped scene (null for the surface preview)
+let playing = false;
 let dirty = true;
 
 function showStatus(text, isError = false) {
@@ -30,8 +32,9 @@ function showMetrics(m) {
   metricsEl.dataset.iteration = String(m.iteration);
   metricsEl.dataset.faces = String(m.faces);
   metricsEl.dataset.maxPlanarity = String(m.maxPlanarity);
-  const rows = [['phase', m.phase], ['iteration', m.iteration], ['faces', m.faces], ['vertices', m.vertices],
-    ['max planarity', m.maxPlanarity.toExponential(2)]];
+  const rows = [['phase', m.phase], ['layer', m.layer ?? 0], ['iteration', m.iteration], ['faces', m.faces],
+    ['vertices', m.vertices], ['max planarity', m.maxPlanarity.toExponential(2)],
+    ['invalid faces', m.invalidFaces ?? 0], ['step time', m.ms === undefined ? '–' : `${m.ms.toFixed(1)} ms`]];
   metricsEl.replaceChildren(...rows.flatMap(([k, v]) => {
     const dt = document.createElement('dt'); dt.textContent = k;
     const dd = document.createElement('dd'); dd.textContent = String(v);
@@ -42,9 +45,10 @@ function showMetrics(m) {
 // ---- configuration <-> URL hash -------------------------------------------------------------
 function readHash() {
   const h = new URLSearchParams(location.hash.slice(1));
-  const scene = SCENES[h.get('scene')] ? h.get('scene') : 'torus';
+  const name = h.get('scene');
+  const scene = SCENES[name] || STEPPED.includes(name) ? name : 'torus';
   const params = {};
-  for (const [k, spec] of Object.entries(SCENES[scene].params)) {
+  for (const [k, spec] of Object.entries(SCENES[scene]?.params ?? {})) {
     const v = Number(h.get(k));
     params[k] = h.has(k) && Number.isFinite(v) ? v : spec.value;
   }
@@ -57,15 +61,17 @@ function writeHash(cfg) {
   history.replaceState(null, '', '#' + h.toString());
 }
 
-let config = readHash();
+let config = { scene: 'torus', params: {}, backend: 'auto' };
 
 function buildControls() {
   const select = $('scene-select');
-  select.replaceChildren(...Object.entries(SCENES).map(([name, s]) => new Option(s.label, name)));
+  const preview = Object.entries(SCENES).map(([name, s]) => new Option(s.label, name));
+  const stepped = STEPPED.map((name) => new Option(name, name));
+  select.replaceChildren(...preview, ...stepped);
   select.value = config.scene;
   const box = document.getElementById('params');
   box.replaceChildren();
-  for (const [k, spec] of Object.entries(SCENES[config.scene].params)) {
+  for (const [k, spec] of Object.entries(SCENES[config.scene]?.params ?? {})) {
     const label = document.createElement('label');
     label.textContent = spec.label;
     const input = document.createElement('input');
@@ -85,25 +91,88 @@ function buildControls() {
   }
 }
 
+function showError(e) {
+  showStatus(`${viewer.backend} · ${e.message ?? e}`, true);
+}
+
+function showMesh(next, reframe) {
+  viewer.setMesh(next, reframe);
+  mesh?.free();
+  mesh = next;
+  dirty = true;
+}
+
+// Selecting a scene starts it from its first step; the surface preview is computed at once.
 function loadScene(reframe) {
+  setPlaying(false);
+  session?.free();
+  session = null;
+  lastFaces = 0;
+  lastPhase = '';
+  userMoved = false;
   try {
-    const next = SCENES[config.scene].build(config.params);
-    viewer.setMesh(next, reframe);
-    mesh?.free();
-    mesh = next;
-    showMetrics({ phase: 'done', iteration: 0, faces: mesh.triangleCount, vertices: mesh.vertexCount, maxPlanarity: 0 });
+    if (SCENES[config.scene]) {
+      showMesh(SCENES[config.scene].build(config.params), reframe);
+      showMetrics({ phase: 'done', iteration: 0, faces: mesh.triangleCount, vertices: mesh.vertexCount, maxPlanarity: 0 });
+    } else {
+      session = new Session({ scene: config.scene });
+      step(reframe);
+    }
     showStatus(viewer.backend);
-    dirty = true;
   } catch (e) {
-    showStatus(`${viewer.backend} · ${e.message ?? e}`, true);
+    showError(e);
   }
+  updateButtons();
+}
+
+function step(reframe = false) {
+  if (!session) return;
+  try {
+    const t = performance.now();
+    const m = session.step();
+    m.ms = performance.now() - t;
+    // Frame the growing mesh at its first step and once more when its last layer is in, unless
+    // the user has taken the camera.
+    const grown = lastPhase === 'triangulation' && m.phase !== 'triangulation';
+    showMesh(session.mesh(), reframe || lastFaces === 0 || (grown && !userMoved));
+    lastFaces = m.faces;
+    lastPhase = m.phase;
+    showMetrics(m);
+  } catch (e) {
+    setPlaying(false);
+    showError(e);
+  }
+  updateButtons();
+}
+let lastFaces = 0;
+let lastPhase = '';
+let userMoved = false;
+
+function setPlaying(on) {
+  playing = on && !!session && !session.done();
+  $('play').textContent = playing ? 'Pause' : 'Play';
+  if (playing) setTimeout(playLoop, 0);
+}
+
+function playLoop() {
+  if (!playing) return;
+  step();
+  if (session?.done()) setPlaying(false);
+  else setTimeout(playLoop, 30);
+}
+
+function updateButtons() {
+  const stepped = !!session;
+  $('step').disabled = !stepped || session.done();
+  $('play').disabled = !stepped || session.done();
+  $('reset').disabled = !stepped;
 }
 
 // ---- orbit: mouse drag, wheel, touch (one finger orbits, two pinch) --------------------------
 function wireInput() {
   const pointers = new Map();
   let pinch = 0;
-  canvas.addEventListener('pointerdown', (e) => { canvas.setPointerCapture(e.pointerId); pointers.set(e.pointerId, e); });
+  canvas.addEventListener('pointerdown', (e) => { canvas.setPointerCapture(e.pointerId); pointers.set(e.pointerId, e); userMoved = true; });
   canvas.addEventListener('pointermove', (e) => {
     const prev = pointers.get(e.pointerId);
     if (!prev) return;
@@ -121,7 +190,7 @@ function wireInput() {
   const up = (e) => { pointers.delete(e.pointerId); pinch = 0; };
   canvas.addEventListener('pointerup', up);
   canvas.addEventListener('pointercancel', up);
-  canvas.addEventListener('wheel', (e) => { e.preventDefault(); viewer.zoom(Math.exp(e.deltaY * 0.001)); dirty = true; }, { passive: false });
+  canvas.addEventListener('wheel', (e) => { e.preventDefault(); userMoved = true; viewer.zoom(Math.exp(e.deltaY * 0.001)); dirty = true; }, { passive: false });
 }
 
 function frame() {
@@ -166,9 +235,13 @@ function download(name, data, type) {
   setTimeout(() => URL.revokeObjectURL(url), 1000);
 }
 
+let STEPPED = [];
+
 async function main() {
   try {
     await init();
+    STEPPED = sceneNames();
+    config = readHash();
     canvas.width = Math.max(1, canvas.clientWidth);
     canvas.height = Math.max(1, canvas.clientHeight);
     viewer = await Viewer.create(canvas, config.backend === 'webgl2');
@@ -179,16 +252,20 @@ async function main() {
   buildControls();
   $('scene-select').addEventListener('change', (e) => {
     config = { scene: e.target.value, params: {}, backend: config.backend };
-    for (const [k, s] of Object.entries(SCENES[config.scene].params)) config.params[k] = s.value;
+    for (const [k, s] of Object.entries(SCENES[config.scene]?.params ?? {})) config.params[k] = s.value;
     writeHash(config);
     buildControls();
     loadScene(true);
   });
   window.addEventListener('hashchange', () => { config = readHash(); buildControls(); loadScene(true); });
-  // Stepping arrives with the P-Hex pipeline; the torus preview is computed in one go.
-  for (const id of ['step', 'play', 'reset']) { $(id).disabled = true; $(id).title = 'Stepping arrives with the P-Hex and PQ scenes'; }
+  $('step').addEventListener('click', () => { setPlaying(false); step(); });
+  $('play').addEventListener('click', () => setPlaying(!playing));
+  $('reset').addEventListener('click', () => loadScene(true));
   $('export-obj').addEventListener('click', () => {
-    if (mesh) download(`${config.scene}.obj`, mesh.toObj(), 'text/plain');
+    try {
+      const text = session ? session.exportObj() : mesh?.toObj();
+      if (text) download(`${config.scene}.obj`, text, 'text/plain');
+    } catch (e) { showError(e); }
   });
   $('screenshot').addEventListener('click', async () => {
     try { download(`${config.scene}@2x.png`, await snapshotPng(2)); } catch (e) { showStatus(`${viewer.backend} · ${e.message ?? e}`, true); }

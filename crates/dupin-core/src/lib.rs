@@ -99,7 +99,7 @@ pub use pq_scenes::{
     PQ_SCENES, PqSceneError, PqSceneResult, pq_scene, skew_quad_grid, torus_centroid_dual,
 };
 pub use principal_quad_mesh::{SurfaceOfRevolution, principal_quad_mesh};
-pub use render_buffers::{TriangleBuffers, sample_surface};
+pub use render_buffers::{TriangleBuffers, polymesh_buffers, polymesh_edges, sample_surface};
 pub use solver::{
     ConstrainedLeastSquares, JacobianEntry, LevenbergMarquardt, LmOptions, LmStep,
     NonlinearLeastSquares, SolverError, SparseSystem, Sqp, SqpOptions, SqpStep,

@@ -6,11 +6,13 @@
 //! Errors cross the boundary as JS `Error`s carrying the Rust message.
 
 mod mesh_data;
+mod session;
 // The canvas viewer needs wgpu's browser backends, which exist only on wasm32.
 #[cfg(target_arch = "wasm32")]
 mod viewer;
 
 pub use mesh_data::{MeshData, torus_mesh};
+pub use session::{Session, scene_names};
 #[cfg(target_arch = "wasm32")]
 pub use viewer::Viewer;
 

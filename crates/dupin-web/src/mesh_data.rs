@@ -1,6 +1,9 @@
 //! Triangle buffers handed to JavaScript as typed arrays.
 
-use dupin_core::{PolyMesh, Torus, TriangleBuffers, Vec3, sample_surface, write_obj};
+use dupin_core::{
+    PolyMesh, Torus, TriangleBuffers, Vec3, polymesh_buffers, polymesh_edges, sample_surface,
+    write_obj,
+};
 use wasm_bindgen::prelude::*;
 
 /// A triangle mesh as typed arrays: `positions` and `normals` (3 floats a vertex), `indices`
@@ -8,6 +11,35 @@ use wasm_bindgen::prelude::*;
 #[wasm_bindgen]
 pub struct MeshData {
     pub(crate) buffers: TriangleBuffers,
+    /// Linear RGB per vertex (empty: the viewer's default colour).
+    pub(crate) colors: Vec<f32>,
+    /// Panel edges as segment endpoint pairs (empty: none drawn).
+    pub(crate) edges: Vec<f32>,
+    /// The polygon mesh behind the triangles, when there is one (OBJ export keeps its faces).
+    pub(crate) panels: Option<PolyMesh>,
+}
+
+impl MeshData {
+    /// A smooth surface preview without colours or edges.
+    pub(crate) fn smooth(buffers: TriangleBuffers) -> Self {
+        MeshData {
+            buffers,
+            colors: Vec::new(),
+            edges: Vec::new(),
+            panels: None,
+        }
+    }
+
+    /// Flat panels of `mesh`, coloured per face, with their edges.
+    pub(crate) fn panels(mesh: PolyMesh, face_colors: &[[f32; 3]]) -> Self {
+        let (buffers, colors) = polymesh_buffers(&mesh, Some(face_colors));
+        MeshData {
+            buffers,
+            colors,
+            edges: polymesh_edges(&mesh),
+            panels: Some(mesh),
+        }
+    }
 }
 
 #[wasm_bindgen]
@@ -42,9 +74,12 @@ impl MeshData {
         self.buffers.triangle_count()
     }
 
-    /// The mesh as OBJ text (the outside contract's format).
+    /// The mesh as OBJ text (the outside contract's format; panels keep their true size).
     #[wasm_bindgen(js_name = toObj)]
     pub fn to_obj(&self) -> Result<String, JsError> {
+        if let Some(mesh) = &self.panels {
+            return Ok(write_obj(mesh));
+        }
         let positions = self
             .buffers
             .positions
@@ -77,5 +112,5 @@ pub fn torus_mesh(major: f64, minor: f64, nu: u32, nv: u32) -> Result<MeshData, 
         }
     }
     let buffers = sample_surface(&Torus { major, minor }, nu as usize, nv as usize);
-    Ok(MeshData { buffers })
+    Ok(MeshData::smooth(buffers))
 }

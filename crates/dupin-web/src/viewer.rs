@@ -83,9 +83,16 @@ impl Viewer {
     /// Shows `mesh`; with `reframe`, the camera is reset to frame it.
     #[wasm_bindgen(js_name = setMesh)]
     pub fn set_mesh(&mut self, mesh: &MeshData, reframe: bool) -> Result<(), JsError> {
+        let colors = (!mesh.colors.is_empty()).then_some(mesh.colors.as_slice());
         self.renderer
-            .set_mesh(&self.device, &self.queue, &mesh.buffers, None)
+            .set_mesh(&self.device, &self.queue, &mesh.buffers, colors)
             .map_err(|e| JsError::new(&e.to_string()))?;
+        if mesh.edges.is_empty() {
+            self.renderer.clear_lines();
+        } else {
+            self.renderer
+                .set_lines(&self.device, &self.queue, &mesh.edges, [0.06, 0.06, 0.07]);
+        }
         if reframe {
             self.camera = OrbitCamera::framing_points(&mesh.buffers.positions);
         }
