@@ -62,6 +62,18 @@ impl MeshData {
         js_sys::Uint32Array::from(self.buffers.indices.as_slice())
     }
 
+    /// Linear RGB per vertex (empty for the default colour).
+    #[wasm_bindgen(getter)]
+    pub fn colors(&self) -> js_sys::Float32Array {
+        js_sys::Float32Array::from(self.colors.as_slice())
+    }
+
+    /// Panel edges: x y z of both endpoints per edge.
+    #[wasm_bindgen(getter)]
+    pub fn edges(&self) -> js_sys::Float32Array {
+        js_sys::Float32Array::from(self.edges.as_slice())
+    }
+
     /// Number of vertices.
     #[wasm_bindgen(getter, js_name = vertexCount)]
     pub fn vertex_count(&self) -> usize {

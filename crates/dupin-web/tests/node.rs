@@ -35,3 +35,47 @@ fn bad_torus_parameters_are_errors() {
     assert!(torus_mesh(2.0, f64::NAN, 40, 20).is_err());
     assert!(torus_mesh(2.0, 0.5, 1, 20).is_err());
 }
+
+#[wasm_bindgen_test]
+fn session_steps_a_phex_scene_to_planar_hexagons() {
+    use dupin_web::Session;
+    let config = js_sys::JSON::parse(r#"{"scene":"sphere-spiral"}"#).unwrap();
+    let mut s = Session::new(config).unwrap();
+    let mut steps = 0;
+    while !s.done() {
+        s.step().unwrap();
+        steps += 1;
+        assert!(steps < 10_000, "the session never finishes");
+    }
+    assert!(steps > 2, "a P-Hex run has several observable steps");
+    let m = s.metrics().unwrap();
+    let get = |k: &str| js_sys::Reflect::get(&m, &k.into()).unwrap();
+    assert_eq!(get("phase").as_string().as_deref(), Some("done"));
+    assert!(get("maxPlanarity").as_f64().unwrap() <= 1e-10);
+    assert_eq!(get("invalidFaces").as_f64(), Some(0.0));
+    let faces = get("faces").as_f64().unwrap() as usize;
+    let obj = s.export_obj();
+    assert_eq!(obj.lines().filter(|l| l.starts_with("f ")).count(), faces);
+    assert!(s.mesh().edges().length() > 0);
+}
+
+#[wasm_bindgen_test]
+fn bad_session_configs_throw_readable_errors() {
+    use dupin_web::Session;
+    for (json, needle) in [
+        (r#"{"scene":"no-such-scene"}"#, "no-such-scene"),
+        (r#"{"surface":"torus","method":"sideways"}"#, "method"),
+        (r#"{}"#, "scene"),
+        (r#"{"scene":1}"#, "bad session config"),
+    ] {
+        let err = match Session::new(js_sys::JSON::parse(json).unwrap()) {
+            Err(e) => wasm_bindgen::JsValue::from(e),
+            Ok(_) => panic!("accepted {json}"),
+        };
+        let msg: String = js_sys::Reflect::get(&err, &"message".into())
+            .unwrap()
+            .as_string()
+            .unwrap();
+        assert!(msg.contains(needle), "{json}: {msg}");
+    }
+}
