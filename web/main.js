@@ -203,7 +203,10 @@ function frame() {
     dirty = false;
     try {
       viewer.render();
-      document.body.dataset.ready = 'true';
+      if (document.body.dataset.ready !== 'true') {
+        document.body.dataset.firstFrameMs = performance.now().toFixed(0);
+        document.body.dataset.ready = 'true';
+      }
     } catch (e) {
       showStatus(`${viewer.backend} · ${e.message ?? e}`, true);
     }
