@@ -440,7 +440,9 @@ impl NonlinearLeastSquares for Problem<'_> {
     /// which for hexagons costs more fill than the 4 unknowns save (torus dual: 0.22 s
     /// instead of 0.14 s).
     fn local_blocks(&self) -> Option<(usize, usize)> {
-        self.terms.eliminate_planes.then_some((self.terms.first_plane, 4))
+        self.terms
+            .eliminate_planes
+            .then_some((self.terms.first_plane, 4))
     }
 }
 

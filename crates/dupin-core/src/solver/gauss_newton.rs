@@ -139,7 +139,7 @@ impl LevenbergMarquardt {
     /// [`Self::damped_step`].
     fn assemble(&mut self, n: usize, blocks: Option<(usize, usize)>) -> (Vec<f64>, Vec<f64>) {
         let blocks = blocks.filter(|&(first, size)| {
-            (1..=4).contains(&size) && first > 0 && first < n && (n - first) % size == 0
+            (1..=4).contains(&size) && first > 0 && first < n && (n - first).is_multiple_of(size)
         });
         // Same Jacobian pattern as last time: push the values only, in the cached order.
         let same_jacobian = self.last_pattern.0 == self.sys.residuals.len()
@@ -488,7 +488,11 @@ mod tests {
                     }
                 }
                 for k in 0..size {
-                    a.push((m, (global + blk * size + k) as u32, rng.random::<f64>() - 0.5));
+                    a.push((
+                        m,
+                        (global + blk * size + k) as u32,
+                        rng.random::<f64>() - 0.5,
+                    ));
                 }
                 m += 1;
             }

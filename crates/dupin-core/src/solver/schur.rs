@@ -47,7 +47,7 @@ impl BlockSchur {
         size: usize,
         pm: &mut PatternMatrix,
     ) -> Option<Vec<f64>> {
-        debug_assert!((1..=4).contains(&size) && first <= n && (n - first) % size == 0);
+        debug_assert!((1..=4).contains(&size) && first <= n && (n - first).is_multiple_of(size));
         self.first = first;
         self.size = size;
         let nb = (n - first) / size;
