@@ -216,6 +216,12 @@ struct Terms {
     var_of: Vec<u32>,
     /// Per face: first of its 4 plane variables (unit normal n, offset d), or NONE.
     plane_of: Vec<u32>,
+    /// Per face: the initial centroid, origin of the face's plane offset.
+    centers: Vec<Vec3>,
+    /// Index of the first plane variable (all vertex variables come before).
+    first_plane: usize,
+    /// Whether the solver should eliminate the plane unknowns (all planar faces are quads).
+    eliminate_planes: bool,
     num_vars: usize,
     convex: Vec<bool>,
     conical_vertices: Vec<usize>,
@@ -302,7 +308,10 @@ impl Problem<'_> {
         }
     }
 
-    /// Face-plane terms of face `f`: `(n·v - d) / L` per vertex and `|n|² - 1`.
+    /// Face-plane terms of face `f`: `(n·(v - c) - d) / L` per vertex and `|n|² - 1`, with `c`
+    /// the face's initial centroid (so the offset `d` stays near 0 and the derivatives in `n`
+    /// are of the face's size rather than of its distance to the origin: far better
+    /// conditioned normal equations).
     fn planes(&self, x: &[f64], f: usize, out: &mut SparseSystem) {
         let pb = self.terms.plane_of[f];
         if pb == NONE {
@@ -312,8 +321,9 @@ impl Problem<'_> {
         let n = Vec3::new(x[b], x[b + 1], x[b + 2]);
         let d = x[b + 3];
         let inv = 1.0 / self.terms.scale;
+        let c = self.terms.centers[f];
         for &v in self.mesh.face(f) {
-            let p = self.pos(x, v);
+            let p = self.pos(x, v) - c;
             let r = out.push_residual((n.dot(&p) - d) * inv);
             self.emit(out, r, v, n * inv);
             for k in 0..3u32 {
@@ -424,6 +434,16 @@ impl NonlinearLeastSquares for Problem<'_> {
         }
         self.fairness_closeness(x, out);
     }
+    /// The 4 plane unknowns of a face are seen by that face's plane residuals only: the
+    /// solver eliminates them and factors a matrix on the vertex unknowns. Done for quad
+    /// meshes only: eliminating the plane of an n-gon couples all its 3n vertex unknowns,
+    /// which for hexagons costs more fill than the 4 unknowns save (torus dual: 0.22 s
+    /// instead of 0.14 s).
+    fn local_blocks(&self) -> Option<(usize, usize)> {
+        self.terms
+            .eliminate_planes
+            .then_some((self.terms.first_plane, 4))
+    }
 }
 
 impl ConstrainedLeastSquares for Problem<'_> {
@@ -486,6 +506,9 @@ impl NonlinearLeastSquares for Feasibility<'_, '_> {
     }
     fn evaluate(&self, x: &[f64], out: &mut SparseSystem) {
         self.0.constraints(x, out);
+    }
+    fn local_blocks(&self) -> Option<(usize, usize)> {
+        NonlinearLeastSquares::local_blocks(self.0)
     }
 }
 
@@ -634,6 +657,8 @@ impl PqPerturbation {
             }
         }
         let p = &mesh.positions;
+        let first_plane = num_vars;
+        let mut centers = vec![Vec3::zeros(); mesh.num_faces()];
         let mut plane_of = vec![NONE; mesh.num_faces()];
         let mut plane_init = Vec::new();
         for (f, face) in mesh.faces().enumerate() {
@@ -641,7 +666,17 @@ impl PqPerturbation {
                 plane_of[f] = num_vars as u32;
                 num_vars += 4;
                 let pts: Vec<Vec3> = face.iter().map(|&v| p[v as usize]).collect();
-                let (n, d) = lsq_plane(&pts);
+                // The Newell normal through the centroid: as good a start as the least-squares
+                // plane for the near-planar faces met here, without an eigen-solve per face.
+                let c = pts.iter().sum::<Vec3>() / pts.len() as f64;
+                centers[f] = c;
+                let (n, d) = match newell(&pts).try_normalize(1e-300) {
+                    Some(n) => (n, 0.0),
+                    None => {
+                        let (n, d) = lsq_plane(&pts);
+                        (n, d - n.dot(&c))
+                    }
+                };
                 plane_init.push((f, n, d));
             }
         }
@@ -708,6 +743,9 @@ impl PqPerturbation {
         let scale_for_sqp = scale;
         let terms = Terms {
             plane_of,
+            first_plane,
+            centers,
+            eliminate_planes: mesh.faces().all(|f| f.len() <= 4),
             var_of,
             num_vars,
             convex,

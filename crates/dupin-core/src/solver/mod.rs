@@ -18,6 +18,7 @@
 
 mod gauss_newton;
 mod pattern;
+mod schur;
 mod sqp;
 
 pub use gauss_newton::{LevenbergMarquardt, LmOptions, LmStep, NonlinearLeastSquares};

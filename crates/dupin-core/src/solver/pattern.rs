@@ -11,7 +11,7 @@ use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
 };
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
-use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
+use faer::sparse::{Pair, SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, Par};
 
 /// Which factorisation a cached pattern feeds.
@@ -40,7 +40,11 @@ pub(crate) struct PatternMatrix {
     n: usize,
     /// The pattern the cache was built for.
     pairs: Vec<(u32, u32)>,
-    cached: Option<(SymbolicSparseColMat<u32>, Argsort<u32>, Symbolic)>,
+    /// Cached analysis: the CSC pattern, the CSC slot of every assembled entry (so assembly
+    /// is a scatter-add without re-sorting or allocating) and the symbolic factorisation.
+    cached: Option<(SymbolicSparseColMat<u32>, Vec<u32>, Symbolic)>,
+    /// CSC values of the matrix being factored.
+    csc_values: Vec<f64>,
     /// Pairs of the matrix being assembled.
     pub new_pairs: Vec<(u32, u32)>,
     /// Values of the matrix being assembled, aligned with `new_pairs`.
@@ -56,6 +60,7 @@ impl PatternMatrix {
             n: 0,
             pairs: Vec::new(),
             cached: None,
+            csc_values: Vec::new(),
             new_pairs: Vec::new(),
             values: Vec::new(),
             same_pattern: false,
@@ -77,6 +82,31 @@ impl PatternMatrix {
     /// Adds the next value of a values-only assembly.
     #[inline]
     pub(crate) fn add_value(&mut self, value: f64) {
+        self.values.push(value);
+    }
+
+    /// Number of values assembled so far.
+    pub(crate) fn len(&self) -> usize {
+        self.values.len()
+    }
+
+    /// Drops the values (and, while the pattern is being built, the positions) after the
+    /// first `len`, so the tail of an assembly can be redone (e.g. for a new damping).
+    pub(crate) fn truncate(&mut self, len: usize) {
+        self.values.truncate(len);
+        if !self.same_pattern {
+            self.new_pairs.truncate(len);
+        }
+    }
+
+    /// Adds the next entry in either mode: its position is recorded only while the pattern
+    /// is being built (after [`Self::begin`]); in values-only mode it must follow the cached
+    /// order.
+    #[inline]
+    pub(crate) fn push(&mut self, row: u32, col: u32, value: f64) {
+        if !self.same_pattern {
+            self.new_pairs.push((row, col));
+        }
         self.values.push(value);
     }
 
@@ -102,12 +132,47 @@ impl PatternMatrix {
     pub(crate) fn solve(&mut self, rhs: &mut [f64]) -> Result<(), SolverError> {
         let n = self.n;
         let fe = |e: &dyn std::fmt::Debug| SolverError::Factorization(format!("{e:?}"));
-        let reuse = self.cached.is_some()
+        let mut reuse = self.cached.is_some()
             && if self.same_pattern {
                 self.values.len() == self.pairs.len()
             } else {
                 self.pairs == self.new_pairs
             };
+        // A Cholesky pattern contained in the cached one (e.g. the constraints-only phase after
+        // the penalty phase) reuses its symbolic factorisation: the missing entries are zeros.
+        if !reuse
+            && !self.same_pattern
+            && self.kind == Factor::CholeskyUpper
+            && let Some((sym, slots, _)) = self.cached.as_mut()
+        {
+            let (col_ptr, row_idx) = (sym.col_ptr(), sym.row_idx());
+            let mut new_slots = Vec::with_capacity(self.new_pairs.len());
+            for &(r, c) in &self.new_pairs {
+                if c as usize >= n {
+                    break;
+                }
+                let range = col_ptr[c as usize] as usize..col_ptr[c as usize + 1] as usize;
+                match row_idx[range.clone()].binary_search(&r) {
+                    Ok(at) => new_slots.push((range.start + at) as u32),
+                    Err(_) => break,
+                }
+            }
+            // Only when the new pattern fills most of the cached one: a much sparser matrix
+            // (e.g. without the fairness couplings) is cheaper to factor with its own analysis.
+            let filled = if new_slots.len() == self.new_pairs.len() {
+                let mut seen = vec![false; row_idx.len()];
+                new_slots.iter().for_each(|&k| seen[k as usize] = true);
+                seen.iter().filter(|&&b| b).count()
+            } else {
+                0
+            };
+            if 10 * filled >= 9 * row_idx.len() {
+                *slots = new_slots;
+                std::mem::swap(&mut self.pairs, &mut self.new_pairs);
+                self.new_pairs.clear();
+                reuse = true;
+            }
+        }
         if !reuse {
             if self.same_pattern {
                 return Err(SolverError::Factorization(
@@ -119,8 +184,21 @@ impl PatternMatrix {
                 .iter()
                 .map(|&(r, c)| Pair::new(r, c))
                 .collect();
-            let (sym, argsort) =
+            let (sym, _) =
                 SymbolicSparseColMat::try_new_from_indices(n, n, &idx).map_err(|e| fe(&e))?;
+            // The CSC position of every entry (rows are sorted within each column).
+            let (col_ptr, row_idx) = (sym.col_ptr(), sym.row_idx());
+            let slots = self
+                .new_pairs
+                .iter()
+                .map(|&(r, c)| {
+                    let range = col_ptr[c as usize] as usize..col_ptr[c as usize + 1] as usize;
+                    let at = row_idx[range.clone()]
+                        .binary_search(&r)
+                        .expect("every entry is in the pattern built from the entries");
+                    (range.start + at) as u32
+                })
+                .collect();
             let symbolic = match self.kind {
                 Factor::CholeskyUpper => {
                     let symbolic = factorize_symbolic_cholesky(
@@ -144,16 +222,20 @@ impl PatternMatrix {
                 }
                 Factor::Lu => Symbolic::Lu(SymbolicLu::try_new(sym.as_ref()).map_err(|e| fe(&e))?),
             };
-            self.cached = Some((sym, argsort, symbolic));
+            self.cached = Some((sym, slots, symbolic));
             std::mem::swap(&mut self.pairs, &mut self.new_pairs);
             self.new_pairs.clear();
         }
         // The values now follow the cached pattern: further solves with changed values (e.g.
         // damping retries) reuse it without comparing.
         self.same_pattern = true;
-        let (sym, argsort, symbolic) = self.cached.as_mut().expect("cache built above");
-        let mat = SparseColMat::<u32, f64>::new_from_argsort(sym.clone(), argsort, &self.values)
-            .map_err(|e| fe(&e))?;
+        let (sym, slots, symbolic) = self.cached.as_mut().expect("cache built above");
+        self.csc_values.clear();
+        self.csc_values.resize(sym.row_idx().len(), 0.0);
+        for (&slot, &v) in slots.iter().zip(&self.values) {
+            self.csc_values[slot as usize] += v;
+        }
+        let mat = SparseColMatRef::<u32, f64>::new(sym.as_ref(), &self.csc_values);
         let rhs_mat = faer::MatMut::from_column_major_slice_mut(rhs, n, 1);
         match symbolic {
             Symbolic::Llt {
