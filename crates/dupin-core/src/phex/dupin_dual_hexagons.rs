@@ -156,15 +156,15 @@ impl DualMesh {
     ///
     /// Errors: [`PhexError::NoValidTriangulation`] when no face can be formed.
     pub fn with_boundary_faces(t: &Triangulation) -> Result<DualMesh, PhexError> {
-    let positions: Vec<Vec3> = t
-        .triangles
-        .iter()
-        .map(|tr| {
-            let p = tr.map(|i| t.positions[i as usize]);
-            let n = tr.map(|i| t.normals[i as usize]);
-            tangent_plane_point(p, n)
-        })
-        .collect();
+        let positions: Vec<Vec3> = t
+            .triangles
+            .iter()
+            .map(|tr| {
+                let p = tr.map(|i| t.positions[i as usize]);
+                let n = tr.map(|i| t.normals[i as usize]);
+                tangent_plane_point(p, n)
+            })
+            .collect();
         dual_from_points_impl(t, positions, true)
     }
 }
@@ -184,7 +184,11 @@ fn edge_point(a: Vec3, na: Vec3, b: Vec3, nb: Vec3) -> Vec3 {
     } else {
         let n = (na + nb).normalize();
         let x = m + n * (0.5 * (ra + rb));
-        if x.iter().all(|v| v.is_finite()) { x } else { m }
+        if x.iter().all(|v| v.is_finite()) {
+            x
+        } else {
+            m
+        }
     }
 }
 
@@ -387,7 +391,9 @@ mod tests {
             // The Gauss-Newton optimisation makes every face, boundary faces included, planar
             // from a perturbed start.
             let mut mesh = d.mesh.clone();
-            let e = (0..mesh.num_faces()).map(|i| mesh.face_mean_edge(i)).sum::<f64>()
+            let e = (0..mesh.num_faces())
+                .map(|i| mesh.face_mean_edge(i))
+                .sum::<f64>()
                 / mesh.num_faces() as f64;
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             for p in mesh.positions.iter_mut() {
@@ -403,7 +409,11 @@ mod tests {
             while !opt.done() {
                 opt.step(&mut mesh, surface.as_ref()).unwrap();
             }
-            assert!(opt.max_planarity() <= 1e-10, "{scene}: {:e}", opt.max_planarity());
+            assert!(
+                opt.max_planarity() <= 1e-10,
+                "{scene}: {:e}",
+                opt.max_planarity()
+            );
             assert!(opt.iteration() <= 10);
         }
     }

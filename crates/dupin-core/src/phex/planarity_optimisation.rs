@@ -18,13 +18,14 @@
 //!
 //! Why this file assembles the normal equations itself instead of going through the shared
 //! [`crate::LevenbergMarquardt`] engine: the engine takes Jacobian triplets, so every iteration
-//! it receives ~80 (row, col) products per tetrahedron (about 5 million triplets for 10k
-//! hexagons), compares the whole triplet pattern with the previous one, and sums duplicates
-//! through an argsort; that dominated the run time (4.1 s for 10k faces). Here the sparsity
-//! pattern of JᵀJ is fixed by the mesh connectivity, so it is built and analysed (AMD ordering,
-//! symbolic supernodal Cholesky) once in [`PlanarityOptimiser::new`]; every iteration then
-//! accumulates a dense per-face block of JᵀJ and scatters it into the fixed CSC value array,
-//! and damping retries only change the diagonal. What the engine could offer to make this
+//! it would receive ~80 (row, col) products per tetrahedron (about 5 million triplets for 10k
+//! hexagons), compare the whole triplet pattern with the previous one, and sum duplicates
+//! through an argsort. Here the sparsity pattern of JᵀJ is fixed by the mesh connectivity, so
+//! it is built and analysed (AMD ordering, symbolic supernodal Cholesky) once in
+//! [`PlanarityOptimiser::new`]; every iteration accumulates a dense per-face block of JᵀJ and
+//! scatters it into the fixed CSC value array (about 1 ms per 1k faces), and damping retries
+//! only change the diagonal. The run time is then dominated by the numeric Cholesky
+//! factorisation itself (one per iteration). What the engine could offer to make this file
 //! unnecessary: a "fixed pattern" mode taking dense per-element blocks (element -> variable
 //! list) instead of triplets.
 
@@ -56,8 +57,8 @@ pub struct PlanarityOptions {
 impl Default for PlanarityOptions {
     fn default() -> Self {
         PlanarityOptions {
-            fairness: 1e-6,
-            distance: 1e-4,
+            fairness: 1e-8,
+            distance: 1e-6,
             tolerance: 1e-10,
             max_iterations: 10,
         }
@@ -414,9 +415,8 @@ impl PlanarityOptimiser {
                 for b in 0..n {
                     let (va, vb) = (f[a], f[b]);
                     if va <= vb {
-                        self.pattern.add_block(values, va, vb, |k, l| {
-                            local[(3 * a + k) * m + 3 * b + l]
-                        });
+                        self.pattern
+                            .add_block(values, va, vb, |k, l| local[(3 * a + k) * m + 3 * b + l]);
                     }
                 }
             }
@@ -441,8 +441,12 @@ impl PlanarityOptimiser {
                         let (cu, vu) = (coef(u), member(u));
                         if vt <= vu {
                             let c = ct * cu;
-                            self.pattern
-                                .add_block(values, vt, vu, |k, l| if k == l { c } else { 0.0 });
+                            self.pattern.add_block(
+                                values,
+                                vt,
+                                vu,
+                                |k, l| if k == l { c } else { 0.0 },
+                            );
                         }
                     }
                 }
@@ -508,7 +512,11 @@ impl PlanarityOptimiser {
                 "the mesh changed connectivity since the optimiser was created".into(),
             ));
         }
-        if !mesh.positions.iter().all(|p| p.iter().all(|c| c.is_finite())) {
+        if !mesh
+            .positions
+            .iter()
+            .all(|p| p.iter().all(|c| c.is_finite()))
+        {
             return Err(PhexError::Solver(SolverError::NonFinite));
         }
         let feet: Vec<(Vec3, Vec3)> = mesh
