@@ -660,11 +660,12 @@ mod tests {
             let mut out = vec![0.0; d.len()];
             let rows = opt.pattern.row_indices();
             for c in 0..d.len() {
-                for k in opt.pattern.col_ptr[c]..opt.pattern.col_ptr[c + 1] {
-                    let r = rows[k] as usize;
-                    out[r] += opt.values[k] * d[c];
+                let span = opt.pattern.col_ptr[c]..opt.pattern.col_ptr[c + 1];
+                for (&r, &a) in rows[span.clone()].iter().zip(&opt.values[span]) {
+                    let r = r as usize;
+                    out[r] += a * d[c];
                     if r != c {
-                        out[c] += opt.values[k] * d[r];
+                        out[c] += a * d[r];
                     }
                 }
             }
