@@ -65,6 +65,21 @@ fn bench(c: &mut Criterion) {
                 p[k] += rng.random_range(-1.0..1.0) * 1e-3 * e;
             }
         }
+        {
+            let mut m = noisy.clone();
+            let mut o =
+                PlanarityOptimiser::new(&m, Some(&d.vertex_uv), PlanarityOptions::default())
+                    .unwrap();
+            while !o.done() {
+                o.step(&mut m, torus.as_ref()).unwrap();
+            }
+            eprintln!(
+                "phex torus-bound {label} optimisation from 1e-3 noise: {} iterations, {} factorisations, max_planarity {:.2e}",
+                o.iteration(),
+                o.factorizations(),
+                o.max_planarity()
+            );
+        }
         g.bench_function("optimisation", |b| {
             b.iter(|| {
                 let mut m = noisy.clone();

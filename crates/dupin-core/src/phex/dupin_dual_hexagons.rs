@@ -142,8 +142,69 @@ pub fn dual_mesh_with(
     }
 }
 
+impl DualMesh {
+    /// The dual polygon mesh of `t` by tangent duality, with boundary faces (section 6: the
+    /// optimisation is "generalised to boundary faces").
+    ///
+    /// Interior triangulation vertices give the same faces as [`dual_mesh`]. A boundary vertex `v`
+    /// whose incident triangles form one fan `t_1 .. t_k` with `k >= 2` gives the face
+    /// `[m(v, w_in), t_1, .., t_k, m(v, w_out)]`, where `w_in`, `w_out` are its two boundary
+    /// neighbours and `m(v, w)` is a new dual vertex per boundary edge: the point of the tangent
+    /// planes of `v` and `w` nearest the edge midpoint (shared by the faces of `v` and `w`). Every
+    /// boundary face therefore also starts in the tangent plane of its vertex. Fans with one
+    /// triangle (corners) give no face.
+    ///
+    /// Errors: [`PhexError::NoValidTriangulation`] when no face can be formed.
+    pub fn with_boundary_faces(t: &Triangulation) -> Result<DualMesh, PhexError> {
+        let positions: Vec<Vec3> = t
+            .triangles
+            .iter()
+            .map(|tr| {
+                let p = tr.map(|i| t.positions[i as usize]);
+                let n = tr.map(|i| t.normals[i as usize]);
+                tangent_plane_point(p, n)
+            })
+            .collect();
+        dual_from_points_impl(t, positions, true)
+    }
+}
+
+/// The point of the tangent planes at `a` (normal `na`) and `b` (normal `nb`) nearest their
+/// midpoint (the midpoint projected onto the mean plane when the planes are nearly parallel).
+fn edge_point(a: Vec3, na: Vec3, b: Vec3, nb: Vec3) -> Vec3 {
+    let m = 0.5 * (a + b);
+    let (ra, rb) = (na.dot(&(a - m)), nb.dot(&(b - m)));
+    let c = na.dot(&nb);
+    let det = 1.0 - c * c;
+    if det > 1e-8 {
+        // x = m + α na + β nb with [1 c; c 1] (α, β) = (ra, rb).
+        let alpha = (ra - c * rb) / det;
+        let beta = (rb - c * ra) / det;
+        m + na * alpha + nb * beta
+    } else {
+        let n = (na + nb).normalize();
+        let x = m + n * (0.5 * (ra + rb));
+        if x.iter().all(|v| v.is_finite()) {
+            x
+        } else {
+            m
+        }
+    }
+}
+
 fn dual_from_points(t: &Triangulation, positions: Vec<Vec3>) -> Result<DualMesh, PhexError> {
+    dual_from_points_impl(t, positions, false)
+}
+
+fn dual_from_points_impl(
+    t: &Triangulation,
+    mut positions: Vec<Vec3>,
+    boundary: bool,
+) -> Result<DualMesh, PhexError> {
     let nv = t.positions.len();
+    let mut vertex_uv: Vec<crate::Vec2> =
+        t.triangles.iter().map(|tr| t.uv[tr[0] as usize]).collect();
+    let mut edge_points: std::collections::HashMap<(u32, u32), u32> = Default::default();
     // Star of every vertex: for a CCW triangle (a, b, c), vertex a sees the edge b -> c.
     let mut star: Vec<Vec<(u32, u32, u32)>> = vec![vec![]; nv];
     for (ti, tr) in t.triangles.iter().enumerate() {
@@ -154,6 +215,42 @@ fn dual_from_points(t: &Triangulation, positions: Vec<Vec3>) -> Result<DualMesh,
     let mut faces: Vec<Vec<u32>> = vec![];
     let mut face_vertex = vec![];
     for (v, st) in star.iter().enumerate() {
+        if boundary && st.len() >= 2 {
+            // An open fan: starts at the triangle whose `b` is no other triangle's `c`.
+            if let Some(&first) = st.iter().find(|e| st.iter().all(|f| f.1 != e.0)) {
+                let mut fan = vec![first];
+                let mut cur = first;
+                while let Some(&e) = st.iter().find(|e| e.0 == cur.1) {
+                    if fan.len() > st.len() {
+                        break;
+                    }
+                    fan.push(e);
+                    cur = e;
+                }
+                if fan.len() == st.len() {
+                    let mut point = |w: u32| {
+                        let key = (w.min(v as u32), w.max(v as u32));
+                        *edge_points.entry(key).or_insert_with(|| {
+                            let (a, b) = (key.0 as usize, key.1 as usize);
+                            positions.push(edge_point(
+                                t.positions[a],
+                                t.normals[a],
+                                t.positions[b],
+                                t.normals[b],
+                            ));
+                            vertex_uv.push(t.uv[v]);
+                            (positions.len() - 1) as u32
+                        })
+                    };
+                    let mut face = vec![point(first.0)];
+                    face.extend(fan.iter().map(|e| e.2));
+                    face.push(point(cur.1));
+                    faces.push(face);
+                    face_vertex.push(v as u32);
+                    continue;
+                }
+            }
+        }
         if st.len() < 3 {
             continue;
         }
@@ -183,7 +280,6 @@ fn dual_from_points(t: &Triangulation, positions: Vec<Vec3>) -> Result<DualMesh,
     }
     let mesh = PolyMesh::new(positions, &faces)
         .map_err(|e| PhexError::NoValidTriangulation(format!("dual mesh: {e}")))?;
-    let vertex_uv = t.triangles.iter().map(|tr| t.uv[tr[0] as usize]).collect();
     Ok(DualMesh {
         mesh,
         face_vertex,
@@ -251,6 +347,74 @@ mod tests {
             for &i in d.mesh.face(f) {
                 assert!((d.mesh.positions[i as usize] - p).dot(&n).abs() < 1e-9 * e);
             }
+        }
+    }
+
+    #[test]
+    fn boundary_faces_close_the_dual_and_become_planar() {
+        use crate::{PlanarityOptimiser, PlanarityOptions, max_planarity};
+        use std::collections::HashSet;
+        for (scene, seed) in [("sphere-radial", 3u64), ("hyperboloid-valid", 4)] {
+            let sc = crate::phex_scene(scene).unwrap();
+            let mut cfg = sc.config.clone();
+            cfg.optimize = false;
+            let r = crate::phex_run(cfg).unwrap();
+            let t = &r.triangulation;
+            let inner = dual_mesh(t).unwrap();
+            let d = DualMesh::with_boundary_faces(t).unwrap();
+            let interior: HashSet<u32> = inner.face_vertex.iter().copied().collect();
+            let boundary: Vec<usize> = (0..d.mesh.num_faces())
+                .filter(|&f| !interior.contains(&d.face_vertex[f]))
+                .collect();
+            assert!(!boundary.is_empty(), "{scene}: no boundary face");
+            assert_eq!(d.mesh.num_faces(), inner.mesh.num_faces() + boundary.len());
+            // Oriented 2-manifold with boundary: each directed edge once, each edge in <= 2 faces.
+            let mut directed = HashSet::new();
+            for f in d.mesh.faces() {
+                assert!(f.len() >= 4, "{scene}: face of {} vertices", f.len());
+                for k in 0..f.len() {
+                    assert!(directed.insert((f[k], f[(k + 1) % f.len()])), "{scene}");
+                }
+            }
+            // Boundary faces start in the tangent plane of their vertex (sphere: exactly).
+            if scene == "sphere-radial" {
+                for &f in &boundary {
+                    let v = d.face_vertex[f] as usize;
+                    let (p, n) = (t.positions[v], t.normals[v]);
+                    let e = d.mesh.face_mean_edge(f);
+                    for &i in d.mesh.face(f) {
+                        let off = (d.mesh.positions[i as usize] - p).dot(&n).abs();
+                        assert!(off < 1e-9 * e, "{scene}: {off:e}");
+                    }
+                }
+            }
+            // The Gauss-Newton optimisation makes every face, boundary faces included, planar
+            // from a perturbed start.
+            let mut mesh = d.mesh.clone();
+            let e = (0..mesh.num_faces())
+                .map(|i| mesh.face_mean_edge(i))
+                .sum::<f64>()
+                / mesh.num_faces() as f64;
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            for p in mesh.positions.iter_mut() {
+                for k in 0..3 {
+                    p[k] += rng.random_range(-1.0..1.0) * 1e-3 * e;
+                }
+            }
+            assert!(max_planarity(&mesh) > 1e-5);
+            let surface = crate::surface_by_name(&sc.config.surface, &[]).unwrap();
+            let mut opt =
+                PlanarityOptimiser::new(&mesh, Some(&d.vertex_uv), PlanarityOptions::default())
+                    .unwrap();
+            while !opt.done() {
+                opt.step(&mut mesh, surface.as_ref()).unwrap();
+            }
+            assert!(
+                opt.max_planarity() <= 1e-10,
+                "{scene}: {:e}",
+                opt.max_planarity()
+            );
+            assert!(opt.iteration() <= 10);
         }
     }
 }
