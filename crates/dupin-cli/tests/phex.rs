@@ -1,18 +1,7 @@
 //! End-to-end tests of `dupin phex`.
 
-use std::path::PathBuf;
-use std::process::Command;
-
-fn tmp(name: &str) -> PathBuf {
-    std::env::temp_dir().join(format!("dupin-phex-{}-{name}", std::process::id()))
-}
-
-fn dupin(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_dupin"))
-        .args(args)
-        .output()
-        .expect("dupin runs")
-}
+mod common;
+use common::{dupin, tmp};
 
 #[test]
 fn lists_every_contract_scene() {

@@ -1,18 +1,7 @@
 //! End-to-end tests of `dupin planarize`.
 
-use std::path::PathBuf;
-use std::process::Command;
-
-fn tmp(name: &str) -> PathBuf {
-    std::env::temp_dir().join(format!("dupin-planarize-{}-{name}", std::process::id()))
-}
-
-fn dupin(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_dupin"))
-        .args(args)
-        .output()
-        .expect("dupin runs")
-}
+mod common;
+use common::{dupin, json, tmp};
 
 /// A 6 x 6 quad grid on the saddle z = xy, rotated 30 degrees: far from planar.
 fn skew_grid_obj() -> String {
@@ -42,10 +31,6 @@ fn skew_grid_obj() -> String {
     out
 }
 
-fn read_json(p: &PathBuf) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
-}
-
 #[test]
 fn planarizes_a_skew_grid_and_reports_exact_fields() {
     let input = tmp("grid.obj");
@@ -63,7 +48,7 @@ fn planarizes_a_skew_grid_and_reports_exact_fields() {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(String::from_utf8_lossy(&o.stdout).lines().count(), 1);
-    let r = read_json(&report);
+    let r = json(&report);
     for key in [
         "vertices",
         "faces",
@@ -105,7 +90,7 @@ fn conical_mode_reports_its_residual_and_fix_boundary_keeps_boundary() {
         report.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let r = read_json(&report);
+    let r = json(&report);
     assert!(r.get("conical_residual").is_some());
     let text_in = std::fs::read_to_string(&input).unwrap();
     let text_out = std::fs::read_to_string(&out).unwrap();
@@ -175,7 +160,7 @@ fn iteration_cap_returns_best_mesh_with_converged_false_and_reason() {
         report.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let r = read_json(&report);
+    let r = json(&report);
     assert_eq!(r["converged"], false);
     assert_eq!(r["iterations"], 1);
     assert!(r["reason"].as_str().unwrap().contains("iteration cap"));
@@ -205,7 +190,7 @@ fn hexagons_and_mixed_faces_are_planarized() {
         report.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let r = read_json(&report);
+    let r = json(&report);
     assert!(r["max_planarity"].as_f64().unwrap() <= 1e-10, "{r}");
     let faces: Vec<usize> = std::fs::read_to_string(&out)
         .unwrap()
@@ -289,7 +274,7 @@ fn sqp_refinement_reaches_the_same_accuracy() {
         report.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let r = read_json(&report);
+    let r = json(&report);
     assert_eq!(r["converged"], true, "{r}");
     assert!(r["max_planarity"].as_f64().unwrap() <= 1e-10);
     for p in [input, out, report] {

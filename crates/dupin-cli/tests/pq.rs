@@ -1,22 +1,7 @@
 //! End-to-end tests of `dupin pq` and `dupin offset`.
 
-use std::path::PathBuf;
-use std::process::Command;
-
-fn tmp(name: &str) -> PathBuf {
-    std::env::temp_dir().join(format!("dupin-pq-{}-{name}", std::process::id()))
-}
-
-fn dupin(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_dupin"))
-        .args(args)
-        .output()
-        .expect("dupin runs")
-}
-
-fn json(p: &PathBuf) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
-}
+mod common;
+use common::{dupin, json, tmp};
 
 #[test]
 fn lists_the_contract_scenes() {
