@@ -12,8 +12,10 @@ use crate::offset::{OffsetError, offset_mesh};
 /// [`MeshTopology::edges`]. Returns the offset mesh too.
 ///
 /// Beams between two vertices that have cone axes (interior valence-4 vertices of a conical
-/// mesh) are planar. At the boundary the offset vertex is not fixed by a cone, so beams
-/// touching the boundary are planar only approximately.
+/// mesh) are planar by Geometry Fact 2. At the boundary no cone fixes the offset vertex:
+/// [`offset_mesh`] places it on the shifted planes of its faces such that every offset edge
+/// is parallel to its original edge, so the beams touching the boundary are planar too
+/// (their "axes" are the lines from each boundary vertex to its offset).
 pub fn support_structure(
     mesh: &PolyMesh,
     distance: f64,

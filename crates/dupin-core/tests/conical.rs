@@ -234,18 +234,26 @@ fn offsets_support_structure_and_fact_2() {
     assert!(max_planarity(&off) <= 1e-10);
     let (c0, c1) = (conical_residual(&m, &topo), conical_residual(&off, &topo));
     assert!(c1 <= 1e-9, "offset conical residual {c1} (original {c0})");
-    // Support beams between vertices with cone axes are planar.
-    let (beams, _) = support_structure(&m, d).unwrap();
+    // Every support beam is planar, the ones touching the boundary too (there the offset
+    // vertices are placed so that offset edges stay parallel to the originals).
+    let (beams, off2) = support_structure(&m, d).unwrap();
+    assert_eq!(off2.positions, off.positions);
     assert_eq!(beams.num_faces(), topo.edges().len());
     let axes = cone_axes(&m, &topo);
-    let mut interior_beams = 0;
+    let (mut interior_beams, mut boundary_beams) = (0, 0);
     for (k, (a, b)) in topo.edges().into_iter().enumerate() {
+        let p = dupin_core::face_planarity(&beams, k);
+        assert!(p <= 1e-10, "beam {k} ({a}, {b}): planarity {p}");
         if axes[a as usize].is_some() && axes[b as usize].is_some() {
-            assert!(dupin_core::face_planarity(&beams, k) <= 1e-10, "beam {k}");
             interior_beams += 1;
+        } else {
+            boundary_beams += 1;
         }
+        // Beams have the offset's height: the far edge is at distance ~d, not degenerate.
+        let (pa, qa) = (m.positions[a as usize], off.positions[a as usize]);
+        assert!((qa - pa).norm() < 3.0 * d, "beam {k} too long");
     }
-    assert!(interior_beams > 50);
+    assert!(interior_beams > 50 && boundary_beams >= 32);
     // Geometry Fact 2: neighbouring cone axes are coplanar.
     let mut pairs = 0;
     for (a, b) in topo.edges() {
@@ -267,6 +275,26 @@ fn offsets_support_structure_and_fact_2() {
         if img.face(f).len() == 4 {
             assert!(dupin_core::face_planarity(&img, f) <= 1e-9);
         }
+    }
+}
+
+#[test]
+fn support_beams_planar_on_a_symmetric_principal_mesh() {
+    // The exact principal grid of the vase: isosceles trapezoids, conical by symmetry. The
+    // boundary's parallelism conditions are rank deficient here (moving both ends of a
+    // boundary edge along their meridians keeps it parallel), which the offset must survive.
+    let m = principal_quad_mesh(&SurfaceOfRevolution::vase(), (0.0, 1.2), (-0.6, 0.9), 6, 5);
+    let topo = MeshTopology::new(&m).unwrap();
+    assert!(conical_residual(&m, &topo) <= 1e-12);
+    for d in [0.03, -0.08] {
+        let (beams, off) = support_structure(&m, d).unwrap();
+        for (k, (a, b)) in topo.edges().into_iter().enumerate() {
+            let p = dupin_core::face_planarity(&beams, k);
+            assert!(p <= 1e-10, "d {d}: beam ({a}, {b}) planarity {p}");
+            let h = (off.positions[a as usize] - m.positions[a as usize]).norm();
+            assert!(h >= 0.99 * d.abs() && h < 2.0 * d.abs(), "d {d}: beam height {h}");
+        }
+        assert!(max_planarity(&off) <= 1e-10);
     }
 }
 

@@ -75,15 +75,79 @@ fn catmull_clark_counts_planarity_and_boundary() {
 fn doo_sabin_counts_and_orientation() {
     let m = grid(3, |x, y| 0.1 * x * y);
     let s = doo_sabin(&m).unwrap();
-    // 9 face-faces, 12 interior-edge quads, 4 interior-vertex quads.
-    assert_eq!(s.num_faces(), 9 + 12 + 4);
-    assert_eq!(s.num_vertices(), 36);
-    MeshTopology::new(&s).unwrap();
+    // With boundary nothing is dropped: 9 face-faces, 24 edge quads (12 interior, 12 on the
+    // boundary), 16 vertex faces (4 interior quads, 8 boundary quads, 4 corner triangles).
+    assert_eq!(s.num_faces(), 9 + 24 + 16);
+    assert_eq!(s.num_vertices(), 36 + 2 * 12);
+    let sizes = s.face_sizes();
+    assert_eq!((sizes[&3], sizes[&4]), (4, 45));
+    let topo = MeshTopology::new(&s).unwrap();
+    // The boundary is kept: one loop, twice as many edges, and its vertices are exactly the
+    // Chaikin points of the old boundary polygon (corner cutting at 1/4 and 3/4).
+    let loop_of = |m: &PolyMesh| -> Vec<Vec3> {
+        let t = MeshTopology::new(m).unwrap();
+        let start = (0..m.num_vertices()).find(|&v| t.is_boundary(v)).unwrap();
+        let mut out = vec![m.positions[start]];
+        let mut v = start;
+        loop {
+            v = t.target(t.star(v)[0]) as usize;
+            if v == start {
+                return out;
+            }
+            out.push(m.positions[v]);
+        }
+    };
+    let (old, new) = (loop_of(&m), loop_of(&s));
+    assert_eq!(old.len(), 12);
+    assert_eq!(new.len(), 24);
+    assert_eq!(
+        (0..s.num_vertices()).filter(|&v| topo.is_boundary(v)).count(),
+        24
+    );
+    let expected = chaikin(&old, true);
+    for q in &new {
+        let d = expected.iter().map(|e| (e - q).norm()).fold(f64::INFINITY, f64::min);
+        assert!(d < 1e-14, "boundary vertex {q} is not a Chaikin point");
+    }
+    // Bounding box barely shrinks (the boundary is not eaten away).
+    let width = |m: &PolyMesh| {
+        let xs = m.positions.iter().map(|p| p.x);
+        xs.clone().fold(f64::NEG_INFINITY, f64::max) - xs.fold(f64::INFINITY, f64::min)
+    };
+    assert!((width(&s) - width(&m)).abs() < 1e-12);
     // On a closed mesh: F + E + V faces.
     let hex = dupin_core::torus_centroid_dual(6, 6, 3.0, 1.0);
     let s = doo_sabin(&hex).unwrap();
     assert_eq!(s.num_faces(), 36 + 108 + 72);
     MeshTopology::new(&s).unwrap();
+}
+
+#[test]
+fn doo_sabin_with_boundary_then_pq_perturbation() {
+    // A curved 3x3 grid with its first two quads merged into a hexagon (an interior vertex
+    // of valence 3 and a boundary vertex in one face): Doo-Sabin gives triangles, quads and
+    // hexagons; every level keeps F + E + V faces and perturbation makes all of them planar.
+    let g = grid(3, |x, y| 0.15 * (x - 1.5) * (y - 1.2) + 0.04 * y * y);
+    let mut faces: Vec<Vec<u32>> = vec![vec![0, 1, 2, 6, 5, 4]];
+    faces.extend(g.faces().skip(2).map(|f| f.to_vec()));
+    let mut m = PolyMesh::new(g.positions.clone(), faces).unwrap();
+    for level in 0..2 {
+        let topo = MeshTopology::new(&m).unwrap();
+        let (f, e, v) = (m.num_faces(), topo.edges().len(), m.num_vertices());
+        // One boundary loop: as many boundary edges as boundary vertices.
+        let nb = (0..v).filter(|&v| topo.is_boundary(v)).count();
+        let s = doo_sabin(&m).unwrap();
+        assert_eq!(s.num_faces(), f + e + v, "level {level}");
+        let st = MeshTopology::new(&s).unwrap();
+        let sb = (0..s.num_vertices()).filter(|&v| st.is_boundary(v)).count();
+        assert_eq!(sb, 2 * nb, "level {level}: boundary not kept");
+        assert!(max_planarity(&s) > 1e-4, "level {level}: nothing to planarise");
+        let r = pq_perturb(&s, PqOptions::default()).unwrap();
+        assert!(r.converged, "level {level}: {:?}", r.reason);
+        assert!(max_planarity(&r.mesh) <= 1e-10);
+        m = r.mesh;
+    }
+    assert!(m.faces().any(|f| f.len() > 4));
 }
 
 #[test]
