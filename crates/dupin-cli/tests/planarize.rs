@@ -105,13 +105,31 @@ fn conical_mode_reports_its_residual_and_fix_boundary_keeps_boundary() {
 fn bad_input_exits_2_with_one_error_line() {
     let input = tmp("bad.obj");
     let out = tmp("bad-out.obj");
+    // (input, what the one error line must mention)
     let cases = [
-        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n",
-        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 1\nf 1 2 3\nf 1 2 4\n",
-        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2\n",
-        "v 0 0 0\nv 0 0 0\nv 0 1 0\nf 1 2 3\n",
+        // OBJ syntax error: the line number.
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", "line 4"),
+        // Inconsistent orientation: edge 1 -> 2 used twice in the same direction.
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 1\nf 1 2 3\nf 1 2 4\n",
+            "inconsistent",
+        ),
+        // Repeated vertex in a face.
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2\n", "repeat"),
+        // Zero-length edge.
+        ("v 0 0 0\nv 0 0 0\nv 0 1 0\nf 1 2 3\n", "zero length"),
+        // Non-manifold edge: three faces on edge (1, 2).
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n",
+            "non-manifold",
+        ),
+        // Non-manifold vertex: two triangles touching at vertex 1 only.
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv -1 0 0\nv 0 -1 0\nf 1 2 3\nf 1 4 5\n",
+            "non-manifold",
+        ),
     ];
-    for text in cases {
+    for (text, needle) in cases {
         std::fs::write(&input, text).unwrap();
         let o = dupin(&[
             "planarize",
@@ -124,6 +142,7 @@ fn bad_input_exits_2_with_one_error_line() {
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(err.lines().count(), 1, "{err}");
         assert!(err.starts_with("error:"), "{err}");
+        assert!(err.to_lowercase().contains(needle), "{needle:?} not in {err}");
     }
     // Conical mode on a mesh without interior valence-4 vertex.
     std::fs::write(&input, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0.2\nf 1 2 3 4\n").unwrap();

@@ -61,6 +61,9 @@ fn conical_station_then_offset_with_support() {
     assert!(r["max_distance_error"].as_f64().unwrap() <= 1e-9 * 0.05 * 10.0);
     assert!(r["warnings"].as_array().unwrap().is_empty());
     assert!(std::fs::read_to_string(&beams).unwrap().contains("\nf "));
+    // Every beam planar, the boundary ones included.
+    let sp = r["support_max_planarity"].as_f64().unwrap();
+    assert!(sp <= 1e-10, "support_max_planarity {sp}");
     for p in [mesh, report, off, beams, rep2] {
         let _ = std::fs::remove_file(p);
     }

@@ -33,6 +33,42 @@ impl SurfaceOfRevolution {
     }
 }
 
+impl SurfaceOfRevolution {
+    /// The footpoint of `q` on the surface (nearest point over the profile range), the
+    /// reference-surface projection of the conical paper's closeness term. The nearest point
+    /// lies in q's meridian plane, so this is a 1D search over the profile: the best of 64
+    /// samples, then Newton on the squared distance, clamped to `v_range`. Returns the
+    /// parameters (u, v) and the point.
+    pub fn closest_point(&self, q: Vec3) -> (f64, f64, Vec3) {
+        let u = q.y.atan2(q.x);
+        let rho = q.x.hypot(q.y);
+        let (v0, v1) = self.v_range;
+        let dist2 = |v: f64| {
+            let [r, _, _, z, _, _] = (self.profile)(v);
+            (r - rho).powi(2) + (z - q.z).powi(2)
+        };
+        let mut v = (0..=64)
+            .map(|k| v0 + (v1 - v0) * k as f64 / 64.0)
+            .min_by(|a, b| dist2(*a).total_cmp(&dist2(*b)))
+            .unwrap_or(v0);
+        for _ in 0..30 {
+            let [r, r1, r2, z, z1, z2] = (self.profile)(v);
+            let g = (r - rho) * r1 + (z - q.z) * z1;
+            let h = r1 * r1 + z1 * z1 + (r - rho) * r2 + (z - q.z) * z2;
+            if h <= 0.0 || !g.is_finite() {
+                break;
+            }
+            let next = (v - g / h).clamp(v0, v1);
+            let done = (next - v).abs() <= 1e-15 * (1.0 + v.abs());
+            v = next;
+            if done {
+                break;
+            }
+        }
+        (u, v, self.position(u, v))
+    }
+}
+
 impl Surface for SurfaceOfRevolution {
     fn domain(&self) -> Domain {
         Domain {
@@ -100,6 +136,18 @@ mod tests {
             let fvv = (s.derivatives(u, v + h).pv - s.derivatives(u, v - h).pv) / (2.0 * h);
             assert!((fu - d.pu).norm() < 1e-8 && (fv - d.pv).norm() < 1e-8);
             assert!((fvv - d.pvv).norm() < 1e-7);
+        }
+    }
+
+    #[test]
+    fn closest_point_is_the_normal_footpoint() {
+        let s = SurfaceOfRevolution::vase();
+        for &(u, v, h) in &[(0.3, -0.4, 0.05), (2.0, 0.7, -0.1), (-1.0, 0.0, 0.02)] {
+            let d = s.derivatives(u, v);
+            let n = d.pu.cross(&d.pv).normalize();
+            let (cu, cv, p) = s.closest_point(d.p + h * n);
+            assert!((cu - u).abs() < 1e-12 && (cv - v).abs() < 1e-10, "{cu} {cv}");
+            assert!((p - d.p).norm() < 1e-10);
         }
     }
 }

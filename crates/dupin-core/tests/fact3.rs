@@ -1,25 +1,54 @@
 //! Geometry Fact 3 (conical paper, Sec. 4): refining a conical mesh by subdivision and conical
 //! perturbation makes its edges follow the principal curvature lines.
+//!
+//! Why the earlier version levelled off (at 0.067 rad): the closeness term pulls towards the
+//! *input* mesh of each level, so after Catmull-Clark (which shrinks and smooths) the levels
+//! drift away from the vase (5.5e-2 at every level) and the mesh aligns with the principal
+//! directions of the drifted surface, not of the vase. As in the paper (closeness to the
+//! reference surface), every subdivided level is now projected onto the vase before the
+//! perturbation; and the angle is measured at a fixed distance from the boundary, where the
+//! conical condition (interior vertices only) does not hold.
 
 use dupin_core::{
     MeshTopology, PolyMesh, PqMode, PqOptions, Surface, SurfaceOfRevolution, Vec3, catmull_clark,
-    conical_residual, pq_perturb,
+    conical_residual, max_planarity, pq_perturb,
 };
 
-/// Mean and max angle (radians) between the edges of `m` inside the parameter window and the
-/// nearest principal direction of the vase (meridian or parallel) at the edge midpoint. The
-/// vase has z = v, so a point near it has parameters (atan2(y, x), z).
-fn principal_angle(m: &PolyMesh, window: ((f64, f64), (f64, f64))) -> (f64, f64) {
+/// Graph distance of every vertex from the boundary.
+fn depth(m: &PolyMesh, topo: &MeshTopology) -> Vec<usize> {
+    let mut d = vec![usize::MAX; m.num_vertices()];
+    let mut queue = std::collections::VecDeque::new();
+    for (v, dv) in d.iter_mut().enumerate() {
+        if topo.is_boundary(v) {
+            *dv = 0;
+            queue.push_back(v);
+        }
+    }
+    while let Some(v) = queue.pop_front() {
+        for u in topo.neighbors(v) {
+            if d[u as usize] == usize::MAX {
+                d[u as usize] = d[v] + 1;
+                queue.push_back(u as usize);
+            }
+        }
+    }
+    d
+}
+
+/// Mean and max angle (radians) between the edges of `m` with both ends at least `min_depth`
+/// edges from the boundary and the nearest principal direction of the vase (meridian or
+/// parallel) at the footpoint of the edge midpoint.
+fn principal_angle(m: &PolyMesh, min_depth: usize) -> (f64, f64) {
     let s = SurfaceOfRevolution::vase();
     let topo = MeshTopology::new(m).unwrap();
+    let dp = depth(m, &topo);
     let (mut sum, mut max, mut count) = (0.0, 0.0f64, 0);
     for (a, b) in topo.edges() {
-        let (pa, pb) = (m.positions[a as usize], m.positions[b as usize]);
-        let mid = 0.5 * (pa + pb);
-        let (u, v) = (mid.y.atan2(mid.x), mid.z);
-        if u < window.0.0 || u > window.0.1 || v < window.1.0 || v > window.1.1 {
+        if dp[a as usize].min(dp[b as usize]) < min_depth {
             continue;
         }
+        let (pa, pb) = (m.positions[a as usize], m.positions[b as usize]);
+        let (u, v, _) = s.closest_point(0.5 * (pa + pb));
         let d = s.derivatives(u, v);
         let n = d.pu.cross(&d.pv).normalize();
         let e: Vec3 = pb - pa;
@@ -35,12 +64,13 @@ fn principal_angle(m: &PolyMesh, window: ((f64, f64), (f64, f64))) -> (f64, f64)
         max = max.max(ang);
         count += 1;
     }
+    assert!(count > 0);
     (sum / count as f64, max)
 }
 
 #[test]
 fn refinement_aligns_with_principal_directions() {
-    // A sheared (non-principal) quad grid on the vase.
+    // A sheared (non-principal) 8 x 6 quad grid on the vase.
     let s = SurfaceOfRevolution::vase();
     let (nu, nv) = (8usize, 6usize);
     let mut p = Vec::new();
@@ -58,23 +88,34 @@ fn refinement_aligns_with_principal_directions() {
         })
         .collect();
     let mut m = PolyMesh::new(p, faces).unwrap();
+    // More penalty iterations than the default 4: the closeness to the vase and the fairness
+    // get time to act before the exact phase (4: 0.0109, 0.0066, 0.0056 at levels 1-3;
+    // 12: 0.0075, 0.0029, 0.0016).
     let opts = PqOptions {
         mode: PqMode::Conical,
+        penalty_iterations: 12,
         ..PqOptions::default()
     };
-    let start = principal_angle(&m, ((-10.0, 10.0), (-10.0, 10.0))).0;
+    // Two rows of the coarse mesh away from the boundary: 2 << level edges at level `level`.
+    let start = principal_angle(&m, 2).0;
     let mut angles = Vec::new();
     for level in 0..4 {
         let r = pq_perturb(&m, opts.clone()).unwrap();
         assert!(r.converged, "level {level}: {:?}", r.reason);
         let topo = MeshTopology::new(&r.mesh).unwrap();
         assert!(conical_residual(&r.mesh, &topo) <= 1e-10);
-        angles.push(principal_angle(&r.mesh, ((-10.0, 10.0), (-10.0, 10.0))).0);
+        assert!(max_planarity(&r.mesh) <= 1e-10);
+        angles.push(principal_angle(&r.mesh, 2 << level));
         m = catmull_clark(&r.mesh).unwrap();
+        for q in &mut m.positions {
+            *q = s.closest_point(*q).2;
+        }
     }
-    eprintln!("mean angle to the principal directions: input {start}, per level {angles:?}");
-    assert!(angles[0] < 0.5 * start);
+    eprintln!("(mean, max) angle to the principal directions: input {start}, per level {angles:?}");
+    assert!(angles[0].0 < 0.5 * start);
     for w in angles.windows(2) {
-        assert!(w[1] < w[0], "not shrinking: {angles:?}");
+        assert!(w[1].0 < 0.75 * w[0].0, "not shrinking: {angles:?}");
     }
+    let last = angles[3];
+    assert!(last.0 < 0.0025 && last.1 < 0.02, "final angle {last:?}");
 }
