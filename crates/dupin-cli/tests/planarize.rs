@@ -142,7 +142,10 @@ fn bad_input_exits_2_with_one_error_line() {
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(err.lines().count(), 1, "{err}");
         assert!(err.starts_with("error:"), "{err}");
-        assert!(err.to_lowercase().contains(needle), "{needle:?} not in {err}");
+        assert!(
+            err.to_lowercase().contains(needle),
+            "{needle:?} not in {err}"
+        );
     }
     // Conical mode on a mesh without interior valence-4 vertex.
     std::fs::write(&input, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0.2\nf 1 2 3 4\n").unwrap();

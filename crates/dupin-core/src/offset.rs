@@ -114,7 +114,8 @@ pub fn offset_mesh(mesh: &PolyMesh, distance: f64) -> Result<PolyMesh, OffsetErr
 /// symmetric trapezoids of a surface of revolution leave one direction free.
 fn parallel_boundary(mesh: &PolyMesh, topo: &MeshTopology, pos: &mut [Vec3], free: &[Vec<Vec3>]) {
     let edges = topo.edges();
-    let touches = |&(a, b): &(u32, u32)| !free[a as usize].is_empty() || !free[b as usize].is_empty();
+    let touches =
+        |&(a, b): &(u32, u32)| !free[a as usize].is_empty() || !free[b as usize].is_empty();
     // Union-find over vertices with free directions, joined by the edges they share.
     let mut parent: Vec<usize> = (0..pos.len()).collect();
     fn root(p: &mut [usize], mut i: usize) -> usize {
@@ -132,8 +133,15 @@ fn parallel_boundary(mesh: &PolyMesh, topo: &MeshTopology, pos: &mut [Vec3], fre
     }
     let mut groups: std::collections::BTreeMap<usize, Vec<(u32, u32)>> = Default::default();
     for e in edges.iter().filter(|e| touches(e)) {
-        let v = if free[e.0 as usize].is_empty() { e.1 } else { e.0 };
-        groups.entry(root(&mut parent, v as usize)).or_default().push(*e);
+        let v = if free[e.0 as usize].is_empty() {
+            e.1
+        } else {
+            e.0
+        };
+        groups
+            .entry(root(&mut parent, v as usize))
+            .or_default()
+            .push(*e);
     }
     for group in groups.values() {
         // Column of the first free coordinate of each vertex in this group.
@@ -151,8 +159,8 @@ fn parallel_boundary(mesh: &PolyMesh, topo: &MeshTopology, pos: &mut [Vec3], fre
         let mut c = nalgebra::DMatrix::<f64>::zeros(3 * group.len(), n);
         let mut rhs = nalgebra::DVector::<f64>::zeros(3 * group.len());
         for (i, &(a, b)) in group.iter().enumerate() {
-            let Some(e) = (mesh.positions[b as usize] - mesh.positions[a as usize])
-                .try_normalize(0.0)
+            let Some(e) =
+                (mesh.positions[b as usize] - mesh.positions[a as usize]).try_normalize(0.0)
             else {
                 continue;
             };

@@ -146,7 +146,10 @@ mod tests {
             let d = s.derivatives(u, v);
             let n = d.pu.cross(&d.pv).normalize();
             let (cu, cv, p) = s.closest_point(d.p + h * n);
-            assert!((cu - u).abs() < 1e-12 && (cv - v).abs() < 1e-10, "{cu} {cv}");
+            assert!(
+                (cu - u).abs() < 1e-12 && (cv - v).abs() < 1e-10,
+                "{cu} {cv}"
+            );
             assert!((p - d.p).norm() < 1e-10);
         }
     }

@@ -292,7 +292,10 @@ fn support_beams_planar_on_a_symmetric_principal_mesh() {
             let p = dupin_core::face_planarity(&beams, k);
             assert!(p <= 1e-10, "d {d}: beam ({a}, {b}) planarity {p}");
             let h = (off.positions[a as usize] - m.positions[a as usize]).norm();
-            assert!(h >= 0.99 * d.abs() && h < 2.0 * d.abs(), "d {d}: beam height {h}");
+            assert!(
+                h >= 0.99 * d.abs() && h < 2.0 * d.abs(),
+                "d {d}: beam height {h}"
+            );
         }
         assert!(max_planarity(&off) <= 1e-10);
     }

@@ -101,12 +101,17 @@ fn doo_sabin_counts_and_orientation() {
     assert_eq!(old.len(), 12);
     assert_eq!(new.len(), 24);
     assert_eq!(
-        (0..s.num_vertices()).filter(|&v| topo.is_boundary(v)).count(),
+        (0..s.num_vertices())
+            .filter(|&v| topo.is_boundary(v))
+            .count(),
         24
     );
     let expected = chaikin(&old, true);
     for q in &new {
-        let d = expected.iter().map(|e| (e - q).norm()).fold(f64::INFINITY, f64::min);
+        let d = expected
+            .iter()
+            .map(|e| (e - q).norm())
+            .fold(f64::INFINITY, f64::min);
         assert!(d < 1e-14, "boundary vertex {q} is not a Chaikin point");
     }
     // Bounding box barely shrinks (the boundary is not eaten away).
@@ -141,7 +146,10 @@ fn doo_sabin_with_boundary_then_pq_perturbation() {
         let st = MeshTopology::new(&s).unwrap();
         let sb = (0..s.num_vertices()).filter(|&v| st.is_boundary(v)).count();
         assert_eq!(sb, 2 * nb, "level {level}: boundary not kept");
-        assert!(max_planarity(&s) > 1e-4, "level {level}: nothing to planarise");
+        assert!(
+            max_planarity(&s) > 1e-4,
+            "level {level}: nothing to planarise"
+        );
         let r = pq_perturb(&s, PqOptions::default()).unwrap();
         assert!(r.converged, "level {level}: {:?}", r.reason);
         assert!(max_planarity(&r.mesh) <= 1e-10);

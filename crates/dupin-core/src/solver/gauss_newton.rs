@@ -454,6 +454,59 @@ mod tests {
         }
     }
 
+    /// On an underdetermined system (fewer residuals than unknowns, the constraints of the
+    /// PQ exact phase) a step at near-zero damping is the SQP / Newton-KKT step of
+    /// `min ½|h|²` subject to the linearised constraints `c + J h = 0`: the KKT system
+    /// `[I Jᵀ; J 0] (h, λ) = (0, -c)`, solved densely here for comparison.
+    #[test]
+    fn underdetermined_step_is_the_kkt_min_norm_step() {
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let (m, n) = (12, 40);
+        let mut a = Vec::new();
+        for i in 0..m {
+            for j in 0..n {
+                if j % m == i || rng.random::<f64>() < 0.2 {
+                    a.push((i as u32, j as u32, rng.random::<f64>() * 2.0 - 1.0));
+                }
+            }
+        }
+        let b: Vec<f64> = (0..m).map(|_| rng.random::<f64>()).collect();
+        let p = Linear {
+            a: a.clone(),
+            b: b.clone(),
+            n,
+        };
+        let mut lm = LevenbergMarquardt::new(LmOptions::default());
+        lm.set_damping(1e-9);
+        let x0: Vec<f64> = (0..n).map(|_| rng.random::<f64>()).collect();
+        let mut x = x0.clone();
+        lm.step(&p, &mut x).unwrap();
+        let mut j = nalgebra::DMatrix::<f64>::zeros(m, n);
+        for &(i, k, v) in &a {
+            j[(i as usize, k as usize)] += v;
+        }
+        let c = &j * nalgebra::DVector::from_column_slice(&x0) - nalgebra::DVector::from_vec(b);
+        let mut kkt = nalgebra::DMatrix::<f64>::identity(n + m, n + m);
+        kkt.view_mut((n, n), (m, m)).fill(0.0);
+        kkt.view_mut((n, 0), (m, n)).copy_from(&j);
+        kkt.view_mut((0, n), (n, m)).copy_from(&j.transpose());
+        let mut rhs = nalgebra::DVector::<f64>::zeros(n + m);
+        rhs.rows_mut(n, m).copy_from(&(-&c));
+        let sol = kkt.lu().solve(&rhs).unwrap();
+        let h_kkt = sol.rows(0, n);
+        let h: Vec<f64> = x.iter().zip(&x0).map(|(a, b)| a - b).collect();
+        let err = (0..n).map(|i| (h[i] - h_kkt[i]).abs()).fold(0.0, f64::max);
+        // The damping (1e-9 of the largest diagonal) perturbs the step by ~1e-7 relative; a
+        // different solution of the underdetermined system would differ by O(1).
+        assert!(err <= 1e-5 * h_kkt.amax(), "step differs from KKT by {err}");
+        // And the linear constraints are met after this one step.
+        let c1 = &j
+            * (nalgebra::DVector::from_column_slice(&x)
+                - nalgebra::DVector::from_column_slice(&x0))
+            + &c;
+        assert!(c1.amax() <= 1e-5 * c.amax(), "{}", c1.amax());
+    }
+
     /// A linear problem whose last variables form blocks of 3 seen by one residual group each.
     struct Blocked {
         inner: Linear,
