@@ -160,6 +160,24 @@ fn bad_input_exits_2_with_one_error_line() {
     ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("valence 4"));
+    // Circular mode on a mesh without quads.
+    std::fs::write(
+        &input,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0.3\nf 1 2 3\nf 2 4 3\n",
+    )
+    .unwrap();
+    let o = dupin(&[
+        "planarize",
+        "--input",
+        input.to_str().unwrap(),
+        "--mode",
+        "circular",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.starts_with("error:") && err.contains("quad"), "{err}");
     let _ = std::fs::remove_file(&input);
     let _ = std::fs::remove_file(&out);
 }

@@ -87,5 +87,27 @@ fn unknown_scene_and_bad_distance_exit_2() {
         out.to_str().unwrap(),
     ]);
     assert_eq!(o.status.code(), Some(2));
-    let _ = std::fs::remove_file(&input);
+    // A non-planar input is offset anyway, with warnings in the report (exit 0).
+    std::fs::write(&input, "v 0 0 0\nv 1 0 0\nv 1 1 0.3\nv 0 1 0\nf 1 2 3 4\n").unwrap();
+    let rep = tmp("warn.json");
+    let o = dupin(&[
+        "offset",
+        "--input",
+        input.to_str().unwrap(),
+        "--distance",
+        "0.1",
+        "--out",
+        out.to_str().unwrap(),
+        "--report",
+        rep.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let w = json(&rep)["warnings"].as_array().unwrap().clone();
+    assert!(
+        w.iter().any(|x| x.as_str().unwrap().contains("not planar")),
+        "{w:?}"
+    );
+    for p in [input, out, rep] {
+        let _ = std::fs::remove_file(p);
+    }
 }
