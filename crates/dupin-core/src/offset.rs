@@ -31,9 +31,9 @@ pub enum OffsetError {
 /// `d / cos θ`, θ the angle between axis and face normals. Other vertices satisfy the shifted
 /// planes of their faces in the least-squares sense; when the planes do not determine them
 /// (boundary vertices in one or two faces) the remaining freedom is used to make every offset
-/// edge parallel to its original ([`parallel_boundary`]), which is what makes the support
-/// beams of boundary edges planar; what is still free after that goes to the point nearest to
-/// `v + d m`, m the mean face normal. At interior conical vertices all shifted planes pass
+/// edge parallel to its original (least squares over the free directions), which makes the
+/// support beams of boundary edges planar; what is still free after that goes to the point
+/// nearest to `v + d m`, m the mean face normal. At interior conical vertices all shifted planes pass
 /// through the result exactly.
 pub fn offset_mesh(mesh: &PolyMesh, distance: f64) -> Result<PolyMesh, OffsetError> {
     if !distance.is_finite() {
