@@ -85,7 +85,8 @@ pub use phex::{
     PHEX_SCENES, PhexConfig, PhexError, PhexMetrics, PhexPhase, PhexPipeline, PhexReport,
     PhexResult, PhexScene, PlanarityOptimiser, PlanarityOptions, PlanarityStep, Triangulation,
     TriangulationMethod, TriangulationSpec, TwistedSurface, bounded_ratio,
-    convex_loop_triangulation, dual_mesh, dual_mesh_with, face_info, loop_subdivide, phex_report,
+    convex_loop_triangulation, dual_mesh, dual_mesh_options, dual_mesh_with, face_info,
+    loop_subdivide, phex_report, triangulate_along_fields, ConjugateFields,
     phex_run, phex_scene, tangent_plane_point, triangulate,
 };
 pub use planarity::{face_planarity, max_planarity};

@@ -88,16 +88,7 @@ pub const PARABOLIC_THRESHOLD: f64 = 1e-8;
 ///
 /// Errors: [`PhexError::NoValidTriangulation`] when no interior vertex exists.
 pub fn dual_mesh(t: &Triangulation) -> Result<DualMesh, PhexError> {
-    let positions: Vec<Vec3> = t
-        .triangles
-        .iter()
-        .map(|tr| {
-            let p = tr.map(|i| t.positions[i as usize]);
-            let n = tr.map(|i| t.normals[i as usize]);
-            tangent_plane_point(p, n)
-        })
-        .collect();
-    dual_from_points(t, positions)
+    dual_from_points_impl(t, tangent_points(t), false)
 }
 
 /// Builds the dual polygon mesh of `t` with the chosen [`Initialisation`]; `surface` gives the
@@ -109,8 +100,21 @@ pub fn dual_mesh_with(
     surface: &dyn crate::Surface,
     init: Initialisation,
 ) -> Result<DualMesh, PhexError> {
-    match init {
-        Initialisation::TangentDuality => dual_mesh(t),
+    dual_mesh_options(t, surface, init, false)
+}
+
+/// [`dual_mesh_with`], plus the boundary faces of [`DualMesh::with_boundary_faces`] when
+/// `boundary_faces` is set (their edge vertices are always placed by tangent duality).
+///
+/// Errors: [`PhexError::NoValidTriangulation`] when no face can be formed.
+pub fn dual_mesh_options(
+    t: &Triangulation,
+    surface: &dyn crate::Surface,
+    init: Initialisation,
+    boundary_faces: bool,
+) -> Result<DualMesh, PhexError> {
+    let positions = match init {
+        Initialisation::TangentDuality => tangent_points(t),
         Initialisation::DupinDuality => {
             let curv: Vec<Option<crate::Curvature>> =
                 t.uv.iter()
@@ -123,8 +127,7 @@ pub fn dual_mesh_with(
                         })
                     })
                     .collect();
-            let positions = t
-                .triangles
+            t.triangles
                 .iter()
                 .map(|tr| {
                     let centroid = tr.iter().map(|&i| t.positions[i as usize]).sum::<Vec3>() / 3.0;
@@ -136,10 +139,21 @@ pub fn dual_mesh_with(
                         _ => centroid,
                     }
                 })
-                .collect();
-            dual_from_points(t, positions)
+                .collect()
         }
-    }
+    };
+    dual_from_points_impl(t, positions, boundary_faces)
+}
+
+fn tangent_points(t: &Triangulation) -> Vec<Vec3> {
+    t.triangles
+        .iter()
+        .map(|tr| {
+            let p = tr.map(|i| t.positions[i as usize]);
+            let n = tr.map(|i| t.normals[i as usize]);
+            tangent_plane_point(p, n)
+        })
+        .collect()
 }
 
 impl DualMesh {
@@ -156,16 +170,7 @@ impl DualMesh {
     ///
     /// Errors: [`PhexError::NoValidTriangulation`] when no face can be formed.
     pub fn with_boundary_faces(t: &Triangulation) -> Result<DualMesh, PhexError> {
-        let positions: Vec<Vec3> = t
-            .triangles
-            .iter()
-            .map(|tr| {
-                let p = tr.map(|i| t.positions[i as usize]);
-                let n = tr.map(|i| t.normals[i as usize]);
-                tangent_plane_point(p, n)
-            })
-            .collect();
-        dual_from_points_impl(t, positions, true)
+        dual_from_points_impl(t, tangent_points(t), true)
     }
 }
 
@@ -190,10 +195,6 @@ fn edge_point(a: Vec3, na: Vec3, b: Vec3, nb: Vec3) -> Vec3 {
             m
         }
     }
-}
-
-fn dual_from_points(t: &Triangulation, positions: Vec<Vec3>) -> Result<DualMesh, PhexError> {
-    dual_from_points_impl(t, positions, false)
 }
 
 fn dual_from_points_impl(

@@ -4,9 +4,10 @@
 //! web page); [`phex_run`] the one-shot function (for the CLI).
 
 use super::PhexError;
-use super::dupin_dual_hexagons::{DualMesh, dual_mesh_with};
+use super::dupin_dual_hexagons::{DualMesh, dual_mesh_options};
 use super::planarity_optimisation::{PlanarityOptimiser, PlanarityOptions};
 use super::report::{PhexReport, phex_report};
+use super::conjugate_fields::triangulate_along_fields;
 use super::scenes::TwistedSurface;
 use super::triangulation::{
     LayerRule, Triangulation, TriangulationMethod, TriangulationSpec, triangulate,
@@ -44,6 +45,13 @@ pub struct PhexConfig {
     pub loop_subdivision: bool,
     /// How the hexagon vertices are initialised (section 6).
     pub initialisation: super::Initialisation,
+    /// Also make faces at boundary triangulation vertices (section 6: the optimisation
+    /// "generalised to boundary faces"; see [`super::DualMesh::with_boundary_faces`]).
+    pub boundary_faces: bool,
+    /// Method 2 with a user-chosen first direction field: the angle (radians) of the first
+    /// field against the first principal direction (the u direction at umbilics); the second
+    /// field is its conjugate. `None`: the parameter lines (which must be conjugate).
+    pub field_angle: Option<f64>,
 }
 
 impl PhexConfig {
@@ -72,6 +80,8 @@ impl PhexConfig {
             optimize: true,
             loop_subdivision: false,
             initialisation: super::Initialisation::TangentDuality,
+            boundary_faces: true,
+            field_angle: None,
         }
     }
 }
@@ -248,7 +258,25 @@ impl PhexPipeline {
             along,
             max_layers: 4000,
         };
-        let tri = triangulate(surface.as_ref(), &spec)?;
+        let tri = match config.field_angle {
+            None => triangulate(surface.as_ref(), &spec)?,
+            Some(angle) => {
+                if config.method != TriangulationMethod::Prescribed {
+                    return Err(PhexError::BadParameter(
+                        "a field angle needs method 2 (prescribed); drop it or use \
+                         --method prescribed"
+                            .into(),
+                    ));
+                }
+                if !(angle.is_finite() && angle.abs() <= std::f64::consts::FRAC_PI_2) {
+                    return Err(PhexError::BadParameter(format!(
+                        "field angle {:.3} degrees; use a value in [-90, 90]",
+                        angle.to_degrees()
+                    )));
+                }
+                triangulate_along_fields(surface.as_ref(), &spec, angle, size)?
+            }
+        };
         if tri.triangles.len() > 4_000_000 {
             return Err(PhexError::BadSize(format!(
                 "{} triangles; use a larger size",
@@ -416,8 +444,12 @@ impl PhexPipeline {
                 }
             }
             PhexPhase::Hexagons => {
-                let d =
-                    dual_mesh_with(&self.tri, self.surface.as_ref(), self.config.initialisation)?;
+                let d = dual_mesh_options(
+                    &self.tri,
+                    self.surface.as_ref(),
+                    self.config.initialisation,
+                    self.config.boundary_faces,
+                )?;
                 self.metrics.faces = d.mesh.num_faces();
                 self.metrics.vertices = d.mesh.num_vertices();
                 self.metrics.max_planarity = max_planarity(&d.mesh);

@@ -68,6 +68,8 @@ fn cfg(
         optimize: true,
         loop_subdivision: false,
         initialisation: super::Initialisation::TangentDuality,
+        boundary_faces: true,
+        field_angle: None,
     }
 }
 
@@ -430,6 +432,20 @@ mod tests {
         bad
     }
 
+    /// Largest shape deviation over the hexagons away from parabolic curves.
+    pub(crate) fn shape_stats(rep: &PhexReport) -> f64 {
+        let kmax = rep
+            .per_face
+            .iter()
+            .map(|f| f.gaussian.abs())
+            .fold(0.0, f64::max);
+        rep.per_face
+            .iter()
+            .filter(|f| f.gaussian.abs() >= AWAY * kmax)
+            .filter_map(|f| f.shape_deviation)
+            .fold(0.0, f64::max)
+    }
+
     #[test]
     fn every_valid_scene_meets_the_acceptance_thresholds() {
         let mut failures = vec![];
@@ -530,6 +546,39 @@ mod tests {
             assert!(r0.report.max_planarity > 1e-8, "{name}: starts non-planar");
             let bad = acceptance(&r.report);
             assert!(bad.is_empty(), "{name}: {bad:?}");
+        }
+    }
+
+    /// Prints the scenes table of docs/phex.md (`cargo test -p dupin-core --release
+    /// scene_table -- --ignored --nocapture`).
+    #[test]
+    #[ignore]
+    fn scene_table() {
+        for name in PHEX_SCENES {
+            let scene = phex_scene(name).unwrap();
+            let c = scene.config.clone();
+            match phex_run(scene.config) {
+                Ok(r) => {
+                    let rep = &r.report;
+                    let shape = shape_stats(rep);
+                    eprintln!(
+                        "| {name} | {} | {:?} | {:?} | {} | {} | {:.1e} | {} | {:.1e} | {:.2e} | {:.2} | {:?} | {:?}",
+                        c.surface,
+                        c.method,
+                        c.size,
+                        rep.faces,
+                        rep.iterations,
+                        rep.max_planarity,
+                        rep.invalid_faces,
+                        rep.max_surface_distance / rep.bbox_diagonal,
+                        rep.min_edge_ratio,
+                        shape,
+                        acceptance(rep),
+                        rep.face_sizes,
+                    );
+                }
+                Err(e) => eprintln!("| {name} | error {e}"),
+            }
         }
     }
 
