@@ -13,7 +13,9 @@
 //! does for us).
 
 use super::PhexError;
-use super::triangulation::{LayerRule, Triangulation, TriangulationSpec, bounded_ratio, ideal_ratio};
+use super::triangulation::{
+    LayerRule, Triangulation, TriangulationSpec, bounded_ratio, ideal_ratio,
+};
 use crate::{Surface, Vec2, Vec3};
 
 /// The two conjugate direction fields of method 2 on a surface.
@@ -25,7 +27,8 @@ pub struct ConjugateFields<'a> {
 
 impl<'a> ConjugateFields<'a> {
     /// D_F at `angle` (radians) from the first principal direction (from the u direction at
-    /// umbilics, where every direction is principal), D_G conjugate to it.
+    /// umbilics, |k1 - k2| <= 1e-6 max |k|, where every direction is principal), D_G conjugate
+    /// to it.
     pub fn new(surface: &'a dyn Surface, angle: f64) -> Self {
         ConjugateFields {
             surface,
@@ -41,7 +44,15 @@ impl<'a> ConjugateFields<'a> {
         let (u, v) = self.dom.normalize(uv.x, uv.y);
         let c = self.surface.curvature(u, v).ok()?;
         let (sn, cs) = self.angle.sin_cos();
-        let d1 = c.dir1 * cs + c.dir2 * sn;
+        // At (near-)umbilics the principal frame is rounding noise: use the u direction.
+        let (e1, e2) = if (c.k1 - c.k2).abs() <= 1e-6 * c.k1.abs().max(c.k2.abs()) {
+            let d = self.surface.derivatives(u, v);
+            let e1 = d.pu.normalize();
+            (e1, c.normal.cross(&e1))
+        } else {
+            (c.dir1, c.dir2)
+        };
+        let d1 = e1 * cs + e2 * sn;
         let d2 = c.conjugate_direction(&d1).ok()?;
         (d1.cross(&d2).norm() > 0.05).then_some((d1, d2))
     }
@@ -181,7 +192,7 @@ pub fn triangulate_along_fields(
         let a = if spec.swap { p.x } else { p.y };
         a >= lo - 1e-9 && a <= hi + 1e-9
     };
-    let seed = to_uv(spec.swap, a0, spec.start);
+    let seed = to_uv(spec.swap, 0.5 * (a0 + a1), 0.5 * (spec.start + spec.end));
     if f.directions(seed).is_none() {
         return Err(PhexError::NoValidTriangulation(format!(
             "the first field at {:.1} degrees is asymptotic (self-conjugate) or undefined at the \
@@ -191,12 +202,15 @@ pub fn triangulate_along_fields(
     }
     let step = size / 8.0;
     let along_ref = to_uv(spec.swap, 1.0, 0.0);
-    let across_ref = to_uv(spec.swap, 0.0, dir);
-    // Base flow line: from (along start, start) over the along span, inside the band.
-    let span = a1 - a0;
-    let line = f.trace(seed, 0, along_ref, step, 1e6 * size, &|p| {
-        in_band(p) && along_of(p) <= a0 + span + 1e-9
+    // Base flow line: through the middle of the region, over the along span, inside the band.
+    let fwd = f.trace(seed, 0, along_ref, step, 1e6 * size, &|p| {
+        in_band(p) && along_of(p) <= a1 + 1e-9
     });
+    let bwd = f.trace(seed, 0, -along_ref, step, 1e6 * size, &|p| {
+        in_band(p) && along_of(p) >= a0 - 1e-9
+    });
+    let mut line: Vec<Vec2> = bwd.into_iter().rev().collect();
+    line.extend(fwd.into_iter().skip(1));
     let base = resample(s, &f.dom, &line, size)?;
     let n = base.len() - 1;
     if !(6..=4000).contains(&n) {
@@ -232,150 +246,213 @@ pub fn triangulate_along_fields(
         t.normals.push(nrm);
         Ok((t.uv.len() - 1) as u32)
     };
-    let mut layers_uv: Vec<Vec<Vec2>> = vec![base];
+    // Layers on a staggered lattice: point g of an even layer sits at x = g, of an odd one at
+    // x = g + 1/2; `first` is the lattice index of a layer's first point. Points leaving the
+    // band are trimmed, so the layers fill the region even when the fields are tilted.
+    struct Layer {
+        first: i64,
+        pts: Vec<Vec2>,
+        ids: Vec<u32>,
+    }
     let mut ids = vec![];
-    for &p in &layers_uv[0] {
+    for &p in &base {
         ids.push(push(&mut t, p)?);
     }
-    t.layers.push(ids);
-    let mut prev_ratio: Option<f64> = None;
-    for m in 1..spec.max_layers {
-        let cur = &layers_uv[m - 1];
-        let k = cur.len();
-        // Feet of the D_G flow lines and, for the interior ones, the ideal heights.
-        let mut feet: Vec<(Vec2, Option<f64>)> = vec![];
-        let mut ratios = vec![];
-        if m % 2 == 0 {
-            feet.push((layers_uv[m - 2][0], None));
-        }
-        for i in 0..k - 1 {
-            let (a, b) = (cur[i], cur[i + 1]);
-            let ab = (pos(s, &f.dom, b) - pos(s, &f.dom, a)).norm();
-            let r = match spec.rule {
-                LayerRule::Fixed(r) => r,
-                LayerRule::Ideal { bound } => match ideal_ratio(s, a, b) {
-                    Some(r) => bounded_ratio(r, bound),
-                    // Section 5.3: re-use the previous step across a parabolic stretch.
-                    None => prev_ratio.unwrap_or(0.75f64.sqrt()),
-                },
+    t.layers.push(ids.clone());
+    let base = Layer {
+        first: 0,
+        pts: base,
+        ids,
+    };
+    // Layers from the base line toward `end`, then toward `start`.
+    let mut down = vec![];
+    for sign in [1.0, -1.0] {
+        let across_ref = to_uv(spec.swap, 0.0, dir * sign);
+        let mut layers = vec![Layer {
+            first: 0,
+            pts: base.pts.clone(),
+            ids: base.ids.clone(),
+        }];
+        let mut prev_ratio: Option<f64> = None;
+        for m in 1..spec.max_layers {
+            let cur = &layers[m - 1];
+            let get = |l: &Layer, g: i64| {
+                let i = g - l.first;
+                (i >= 0 && (i as usize) < l.pts.len()).then(|| l.pts[i as usize])
             };
-            ratios.push(r);
-            feet.push(((a + b) / 2.0, Some(r * ab)));
-        }
-        if m % 2 == 0 {
-            feet.push((*layers_uv[m - 2].last().unwrap_or(&cur[k - 1]), None));
-        }
-        // Ideal apexes C_i along the D_G flow lines.
-        let mut ideal = vec![];
-        for (foot, h) in &feet {
-            if let Some(h) = h {
-                let l = f.trace(*foot, 1, across_ref, h / 8.0, *h, &|_| true);
-                if l.len() == 9 {
-                    ideal.push((*l.last().unwrap_or(foot), *h));
-                }
-            }
-        }
-        if ideal.len() < feet.iter().filter(|x| x.1.is_some()).count() {
-            break;
-        }
-        let prev_len: f64 = cur
-            .windows(2)
-            .map(|w| (pos(s, &f.dom, w[1]) - pos(s, &f.dom, w[0])).norm())
-            .sum();
-        let hmax = feet.iter().filter_map(|x| x.1).fold(0.0, f64::max);
-        // Pass 1 through the median ideal apex; pass 2 through the one that came out lowest.
-        let mut seed_idx = ideal.len() / 2;
-        let mut result = None;
-        for _pass in 0..2 {
-            let sp = ideal[seed_idx].0;
-            let reach = 1.5 * prev_len + 4.0 * hmax;
-            let fwd = f.trace(sp, 0, along_ref, step, reach, &|_| true);
-            let bwd = f.trace(sp, 0, -along_ref, step, reach, &|_| true);
-            let mut l1: Vec<Vec2> = bwd.into_iter().rev().collect();
-            l1.extend(fwd.into_iter().skip(1));
-            let mut pts = vec![];
-            let mut heights = vec![];
-            for (foot, h) in &feet {
-                let lim = 4.0 * h.unwrap_or(hmax).max(hmax);
-                match hit(&f, *foot, across_ref, step, lim, &l1) {
-                    Some((p, len)) => {
-                        pts.push(p);
-                        heights.push(h.map(|h| len / h));
-                    }
-                    None => break,
-                }
-            }
-            if pts.len() < feet.len() {
-                result = None;
-                break;
-            }
-            // Index (among the interior feet) of the lowest relative height.
-            let rel: Vec<f64> = heights.iter().flatten().copied().collect();
-            let (imin, &low) = rel
-                .iter()
-                .enumerate()
-                .min_by(|a, b| a.1.total_cmp(b.1))
-                .unwrap_or((0, &1.0));
-            result = Some(pts);
-            if low >= 0.999 || imin == seed_idx {
-                break;
-            }
-            seed_idx = imin;
-        }
-        let Some(pts) = result else { break };
-        if pts
-            .iter()
-            .any(|&p| !in_band(p) || (across_of(p) - spec.end) * dir > 1e-12)
-        {
-            break;
-        }
-        prev_ratio = Some(ratios.iter().sum::<f64>() / ratios.len().max(1) as f64);
-        let mean_step = pts
-            .iter()
-            .zip(&feet)
-            .map(|(p, (q, _))| (across_of(*p) - across_of(*q)).abs())
-            .sum::<f64>()
-            / pts.len() as f64;
-        let prev_ids = t.layers[m - 1].clone();
-        let mut new_ids = vec![];
-        for &p in &pts {
-            new_ids.push(push(&mut t, p)?);
-        }
-        let tri = |t: &mut Triangulation, a: u32, b: u32, c: u32| {
-            // Orient along the surface normal (the fields' orientation is arbitrary).
-            let (pa, pb, pc) = (
-                t.positions[a as usize],
-                t.positions[b as usize],
-                t.positions[c as usize],
-            );
-            if (pb - pa).cross(&(pc - pa)).dot(&t.normals[a as usize]) >= 0.0 {
-                t.triangles.push([a, b, c]);
+            let (c0, c1) = (cur.first, cur.first + cur.pts.len() as i64);
+            // Feet (lattice index, point, ideal height) of the D_G flow lines: odd layers over the
+            // segments (g, g+1), even ones over (g-1, g) plus the ends over layer m-2.
+            let mut feet: Vec<(i64, Vec2, Option<f64>)> = vec![];
+            let mut ratios = vec![];
+            let (g0, g1) = if m % 2 == 1 {
+                (c0, c1 - 1)
             } else {
-                t.triangles.push([a, c, b]);
-            }
-        };
-        let (pk, nk) = (prev_ids.len(), new_ids.len());
-        if m % 2 == 1 {
-            // New point i over segment (i, i+1).
-            for i in 0..pk - 1 {
-                tri(&mut t, prev_ids[i], prev_ids[i + 1], new_ids[i]);
-                if i + 1 < nk {
-                    tri(&mut t, new_ids[i], prev_ids[i + 1], new_ids[i + 1]);
+                (c0, c1 + 1)
+            };
+            for g in g0..g1 {
+                let (ia, ib) = if m % 2 == 1 { (g, g + 1) } else { (g - 1, g) };
+                match (get(cur, ia), get(cur, ib)) {
+                    (Some(a), Some(b)) => {
+                        let ab = (pos(s, &f.dom, b) - pos(s, &f.dom, a)).norm();
+                        let r = match spec.rule {
+                            LayerRule::Fixed(r) => r,
+                            LayerRule::Ideal { bound } => match ideal_ratio(s, a, b) {
+                                Some(r) => bounded_ratio(r, bound),
+                                // Section 5.3: re-use the previous step across a parabolic stretch.
+                                None => prev_ratio.unwrap_or(0.75f64.sqrt()),
+                            },
+                        };
+                        ratios.push(r);
+                        feet.push((g, (a + b) / 2.0, Some(r * ab)));
+                    }
+                    _ => {
+                        if let Some(p) = get(&layers[m - 2], g) {
+                            feet.push((g, p, None));
+                        }
+                    }
                 }
             }
-        } else {
-            // New point i+1 over segment (i, i+1); the ends over the ends two layers down.
-            for i in 0..pk {
-                if i + 1 < pk {
-                    tri(&mut t, prev_ids[i], prev_ids[i + 1], new_ids[i + 1]);
-                }
-                tri(&mut t, new_ids[i], prev_ids[i], new_ids[i + 1]);
+            if ratios.is_empty() {
+                break;
             }
+            // Ideal apexes C_i along the D_G flow lines.
+            let mut ideal = vec![];
+            for (_, foot, h) in &feet {
+                if let Some(h) = h {
+                    let l = f.trace(*foot, 1, across_ref, h / 8.0, *h, &|_| true);
+                    ideal.push((l.len() == 9).then(|| l[8]));
+                }
+            }
+            let Some(mid) = ideal
+                .iter()
+                .flatten()
+                .nth(ideal.iter().flatten().count() / 2)
+            else {
+                break;
+            };
+            let prev_len: f64 = cur
+                .pts
+                .windows(2)
+                .map(|w| (pos(s, &f.dom, w[1]) - pos(s, &f.dom, w[0])).norm())
+                .sum();
+            let hmax = feet.iter().filter_map(|x| x.2).fold(0.0, f64::max);
+            // Pass 1 through the median ideal apex; pass 2 through the one that came out lowest
+            // relative to its ideal height, so that all are at least ideal (above DE).
+            let mut sp = *mid;
+            let mut found: Vec<Option<Vec2>> = vec![];
+            for pass in 0..2 {
+                let reach = 1.5 * prev_len + 4.0 * hmax;
+                let fwd = f.trace(sp, 0, along_ref, step, reach, &|_| true);
+                let bwd = f.trace(sp, 0, -along_ref, step, reach, &|_| true);
+                let mut l1: Vec<Vec2> = bwd.into_iter().rev().collect();
+                l1.extend(fwd.into_iter().skip(1));
+                found.clear();
+                let mut rel = vec![];
+                for (_, foot, h) in &feet {
+                    let lim = 4.0 * h.unwrap_or(hmax).max(hmax);
+                    let x = hit(&f, *foot, across_ref, step, lim, &l1);
+                    found.push(x.map(|x| x.0));
+                    if let Some(h) = h {
+                        rel.push(x.map_or(f64::INFINITY, |x| x.1 / h));
+                    }
+                }
+                let (imin, &low) = rel
+                    .iter()
+                    .enumerate()
+                    .min_by(|a, b| a.1.total_cmp(b.1))
+                    .unwrap_or((0, &1.0));
+                match ideal.get(imin) {
+                    Some(Some(p)) if pass == 0 && low < 0.999 => sp = *p,
+                    _ => break,
+                }
+            }
+            // The longest run of consecutive points inside the band and before `end`.
+            let ok = |p: &Option<Vec2>| p.is_some_and(in_band);
+            let (mut best, mut run_start) = ((0usize, 0usize), None);
+            for i in 0..=found.len() {
+                if i < found.len() && ok(&found[i]) {
+                    run_start.get_or_insert(i);
+                } else if let Some(st) = run_start.take()
+                    && i - st > best.1 - best.0
+                {
+                    best = (st, i);
+                }
+            }
+            if best.1 - best.0 < 2 {
+                break;
+            }
+            prev_ratio = Some(ratios.iter().sum::<f64>() / ratios.len() as f64);
+            let pts: Vec<Vec2> = found[best.0..best.1].iter().flatten().copied().collect();
+            let first = feet[best.0].0;
+            let mean_step = pts
+                .iter()
+                .zip(&feet[best.0..best.1])
+                .map(|(p, (_, q, _))| (across_of(*p) - across_of(*q)).abs())
+                .sum::<f64>()
+                / pts.len() as f64;
+            let mut new_ids = vec![];
+            for &p in &pts {
+                new_ids.push(push(&mut t, p)?);
+            }
+            let layer = Layer {
+                first,
+                pts,
+                ids: new_ids.clone(),
+            };
+            let id = |l: &Layer, g: i64| {
+                let i = g - l.first;
+                (i >= 0 && (i as usize) < l.ids.len()).then(|| l.ids[i as usize])
+            };
+            let cur = &layers[m - 1];
+            let tri = |t: &mut Triangulation, a: Option<u32>, b: Option<u32>, c: Option<u32>| {
+                let (Some(a), Some(b), Some(c)) = (a, b, c) else {
+                    return;
+                };
+                // Orient along the surface normal (the fields' orientation is arbitrary).
+                let (pa, pb, pc) = (
+                    t.positions[a as usize],
+                    t.positions[b as usize],
+                    t.positions[c as usize],
+                );
+                if (pb - pa).cross(&(pc - pa)).dot(&t.normals[a as usize]) >= 0.0 {
+                    t.triangles.push([a, b, c]);
+                } else {
+                    t.triangles.push([a, c, b]);
+                }
+            };
+            let lo = cur.first.min(layer.first) - 1;
+            let hi =
+                (cur.first + cur.ids.len() as i64).max(layer.first + layer.ids.len() as i64) + 1;
+            for g in lo..hi {
+                if m % 2 == 1 {
+                    // New point g (x = g + 1/2) over the segment (g, g+1).
+                    tri(&mut t, id(cur, g), id(cur, g + 1), id(&layer, g));
+                    tri(&mut t, id(&layer, g), id(cur, g + 1), id(&layer, g + 1));
+                } else {
+                    // New point g (x = g) over the segment (g-1, g) of the odd layer.
+                    tri(&mut t, id(cur, g - 1), id(cur, g), id(&layer, g));
+                    tri(&mut t, id(&layer, g), id(cur, g), id(&layer, g + 1));
+                }
+            }
+            if sign > 0.0 {
+                t.layers.push(new_ids);
+                t.layer_steps.push(mean_step);
+            } else {
+                down.push((new_ids, mean_step));
+            }
+            layers.push(layer);
         }
-        t.layers.push(new_ids);
-        t.layer_steps.push(mean_step);
-        layers_uv.push(pts);
     }
+    // Layer order for the stepper: the lowest layer first, the base line in between.
+    let up_layers = std::mem::take(&mut t.layers);
+    let up_steps = std::mem::take(&mut t.layer_steps);
+    for (ids, h) in down.into_iter().rev() {
+        t.layers.push(ids);
+        t.layer_steps.push(h);
+    }
+    t.layers.extend(up_layers);
+    t.layer_steps.extend(up_steps);
     if t.layers.len() < 2 {
         return Err(PhexError::NoValidTriangulation(format!(
             "not even one layer fits along the field at {:.1} degrees: choose another \
@@ -447,4 +524,113 @@ fn resample(
         out.push(line[j] + (line[j + 1] - line[j]) * w);
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{PhexConfig, TriangulationMethod, phex_run, surface_by_name};
+
+    /// (surface, params, across range, angle in degrees, size) of the field-angle cases.
+    type Case = (&'static str, Vec<(String, f64)>, (f64, f64), f64, f64);
+
+    fn cases() -> Vec<Case> {
+        vec![
+            ("torus", vec![], (-1.0, 1.0), 15.0, 0.1),
+            ("hyperboloid", vec![], (-0.8, 0.8), -20.0, 0.1),
+        ]
+    }
+
+    fn config(c: &Case) -> PhexConfig {
+        let mut cfg =
+            PhexConfig::for_surface(c.0, &c.1, TriangulationMethod::Prescribed, Some(c.4));
+        cfg.across = Some(c.2);
+        cfg.field_angle = Some(c.3.to_radians());
+        cfg
+    }
+
+    /// Section 5.2: the layer edges A_i A_i+1 follow D_F (at the chosen angle from the first
+    /// principal direction) and the segments M_i C'_i follow the conjugate field D_G, i.e. the
+    /// second fundamental form II(A_i A_i+1, M_i C'_i) vanishes up to discretisation error.
+    #[test]
+    fn triangulation_edges_follow_the_chosen_field_and_its_conjugate() {
+        for c in cases() {
+            let s = surface_by_name(c.0, &[]).unwrap();
+            let r = phex_run(config(&c)).unwrap();
+            let t = &r.triangulation;
+            assert!(t.layers.len() >= 6, "{}: {} layers", c.0, t.layers.len());
+            let (mut worst_conj, mut worst_angle, mut n) = (0.0f64, 0.0f64, 0);
+            let mut layer_of = vec![usize::MAX; t.positions.len()];
+            for (j, l) in t.layers.iter().enumerate() {
+                for &v in l {
+                    layer_of[v as usize] = j;
+                }
+            }
+            // Triangles A_i A_i+1 C'_i: two vertices on one layer, the apex built after them.
+            for tr in &t.triangles {
+                let mut tr = tr.map(|v| v as usize);
+                tr.sort();
+                let [a, b, cp] = tr;
+                if layer_of[a] != layer_of[b] || layer_of[cp] == layer_of[a] {
+                    continue;
+                }
+                {
+                    let mid = (t.uv[a] + t.uv[b]) / 2.0;
+                    let dom = s.domain();
+                    let (u, v) = dom.normalize(mid.x, mid.y);
+                    let curv = s.curvature(u, v).unwrap();
+                    let fr = curv.frame();
+                    let ab = fr.vector_to_local(&(t.positions[b] - t.positions[a]));
+                    let mc = fr.vector_to_local(&(t.positions[cp] - s.position(u, v)));
+                    let ind = curv.indicatrix().unwrap();
+                    let kmax = curv.k1.abs().max(curv.k2.abs());
+                    let rel = ind.bilinear(&ab, &mc).abs() / (kmax * ab.norm() * mc.norm());
+                    worst_conj = worst_conj.max(rel);
+                    // Angle of A_i A_i+1 against the first principal direction, modulo pi.
+                    let ang = ab.y.atan2(ab.x);
+                    let want = c.3.to_radians();
+                    let d = (ang - want).rem_euclid(std::f64::consts::PI);
+                    worst_angle = worst_angle.max(d.min(std::f64::consts::PI - d));
+                    n += 1;
+                }
+            }
+            eprintln!(
+                "{}: {n} triangles, worst relative II {worst_conj:.2e}, worst angle error {:.2} deg",
+                c.0,
+                worst_angle.to_degrees()
+            );
+            assert!(n > 100);
+            assert!(worst_conj < 0.02, "{}: II {worst_conj:e}", c.0);
+            assert!(worst_angle.to_degrees() < 3.0, "{}: angle", c.0);
+        }
+    }
+
+    #[test]
+    fn field_angle_runs_meet_the_acceptance_thresholds() {
+        for c in cases() {
+            let r = phex_run(config(&c)).unwrap_or_else(|e| panic!("{}: {e}", c.0));
+            let bad = crate::phex::scenes::acceptance_for_tests(&r.report);
+            eprintln!("{}: {} faces, {bad:?}", c.0, r.report.faces);
+            assert!(r.report.faces > 500, "{}", c.0);
+            assert!(bad.is_empty(), "{}: {bad:?}", c.0);
+        }
+    }
+
+    #[test]
+    fn an_asymptotic_first_field_is_a_typed_error() {
+        // On the hyperboloid (a = c = 1) the asymptotic directions are at 45 degrees from the
+        // principal ones: D_F there is self-conjugate and no triangulation exists.
+        let mut c = cases()[1].clone();
+        c.3 = 45.0;
+        match phex_run(config(&c)) {
+            Err(PhexError::NoValidTriangulation(m)) => assert!(m.contains("field-angle"), "{m}"),
+            other => panic!("{:?}", other.map(|r| r.report.faces)),
+        }
+        let mut cfg = config(&cases()[0]);
+        cfg.field_angle = Some(f64::NAN);
+        assert!(matches!(phex_run(cfg), Err(PhexError::BadParameter(_))));
+        let mut cfg = config(&cases()[0]);
+        cfg.method = TriangulationMethod::Progressive;
+        assert!(matches!(phex_run(cfg), Err(PhexError::BadParameter(_))));
+    }
 }

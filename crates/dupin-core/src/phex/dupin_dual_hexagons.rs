@@ -197,6 +197,23 @@ fn edge_point(a: Vec3, na: Vec3, b: Vec3, nb: Vec3) -> Vec3 {
     }
 }
 
+/// Whether `pts`, projected onto the plane through `origin` with unit normal `n`, form a simple
+/// polygon.
+fn starts_simple(pts: &[Vec3], origin: Vec3, n: Vec3) -> bool {
+    let e1 = if n.x.abs() < 0.9 {
+        Vec3::x()
+    } else {
+        Vec3::y()
+    };
+    let e1 = (e1 - n * n.dot(&e1)).normalize();
+    let e2 = n.cross(&e1);
+    let q: Vec<crate::Vec2> = pts
+        .iter()
+        .map(|p| crate::Vec2::new((p - origin).dot(&e1), (p - origin).dot(&e2)))
+        .collect();
+    crate::is_simple_polygon(&q).unwrap_or(false)
+}
+
 fn dual_from_points_impl(
     t: &Triangulation,
     mut positions: Vec<Vec3>,
@@ -229,6 +246,18 @@ fn dual_from_points_impl(
                     cur = e;
                 }
                 if fan.len() == st.len() {
+                    let edge = |w: u32| {
+                        let (a, b) = (w as usize, v);
+                        edge_point(t.positions[a], t.normals[a], t.positions[b], t.normals[b])
+                    };
+                    // Keep only boundary faces that start as simple polygons in the tangent
+                    // plane of their vertex (on K < 0 a half star can fold over near corners).
+                    let mut pts = vec![edge(first.0)];
+                    pts.extend(fan.iter().map(|e| positions[e.2 as usize]));
+                    pts.push(edge(cur.1));
+                    if !starts_simple(&pts, t.positions[v], t.normals[v]) {
+                        continue;
+                    }
                     let mut point = |w: u32| {
                         let key = (w.min(v as u32), w.max(v as u32));
                         *edge_points.entry(key).or_insert_with(|| {

@@ -4,10 +4,10 @@
 //! web page); [`phex_run`] the one-shot function (for the CLI).
 
 use super::PhexError;
+use super::conjugate_fields::triangulate_along_fields;
 use super::dupin_dual_hexagons::{DualMesh, dual_mesh_options};
 use super::planarity_optimisation::{PlanarityOptimiser, PlanarityOptions};
 use super::report::{PhexReport, phex_report};
-use super::conjugate_fields::triangulate_along_fields;
 use super::scenes::TwistedSurface;
 use super::triangulation::{
     LayerRule, Triangulation, TriangulationMethod, TriangulationSpec, triangulate,

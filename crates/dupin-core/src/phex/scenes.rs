@@ -131,9 +131,11 @@ pub fn phex_scene(name: &str) -> Result<PhexScene, PhexError> {
                 false,
                 (-1.1, 1.1),
                 None,
-                0.1,
+                0.07,
             );
-            c.twist = 0.3;
+            // Fig. 20 right: layers along loxodromes (10 degrees from the parallels) stacked
+            // along the orthogonal (conjugate) loxodromes.
+            c.field_angle = Some(10f64.to_radians());
             (c, true)
         }
         "hyperboloid-invalid" => (
@@ -419,7 +421,8 @@ mod tests {
             .per_face
             .iter()
             .filter(|f| {
-                f.gaussian.abs() > 0.0
+                f.shape_deviation.is_some()
+                    && f.gaussian.abs() > 0.0
                     && f.gaussian.abs() >= AWAY * kmax
                     && (f.gaussian > 0.0) != f.convex
             })
