@@ -166,10 +166,26 @@ fn build_surface(config: &PhexConfig) -> Result<Box<dyn Surface>, PhexError> {
         .map(|(k, v)| (k.as_str(), *v))
         .collect();
     let s: Box<dyn Surface> = if config.surface == super::scenes::FREEFORM {
-        Box::new(super::scenes::FreeformSurface {
-            amplitude: 0.4,
-            curl: 0.3,
-        })
+        let (mut amplitude, mut curl) = (0.4, 0.3);
+        for (k, v) in &params {
+            let slot = match *k {
+                "amplitude" => &mut amplitude,
+                "curl" => &mut curl,
+                _ => {
+                    return Err(PhexError::BadParameter(format!(
+                        "{} has no parameter '{k}'; use amplitude or curl",
+                        super::scenes::FREEFORM
+                    )));
+                }
+            };
+            if !(v.is_finite() && v.abs() <= 1.0) {
+                return Err(PhexError::BadParameter(format!(
+                    "{k} = {v}; use a value in [-1, 1]"
+                )));
+            }
+            *slot = *v;
+        }
+        Box::new(super::scenes::FreeformSurface { amplitude, curl })
     } else {
         surface_by_name(&config.surface, &params)?
     };
