@@ -670,7 +670,10 @@ mod tests {
                 if shape > SHAPE_BOUND {
                     bad.push(format!("shape deviation {shape:.2}"));
                 }
-                eprintln!("round {round} {scene} {params:?}: {} faces {bad:?}", res.report.faces);
+                eprintln!(
+                    "round {round} {scene} {params:?}: {} faces {bad:?}",
+                    res.report.faces
+                );
                 assert!(bad.is_empty(), "{scene} {params:?}: {bad:?}");
             }
         }
