@@ -653,8 +653,15 @@ mod tests {
                 ("sphere-spiral", vec![("radius", scale)], Some(0.1 * scale)),
             ];
             for (scene, params, size) in cases {
-                if scene == "convex-loop" && round > 0 {
-                    continue; // 10k faces: one sample keeps the test fast
+                // The slow families (10k faces; Gauss-Newton needed) get one sample each.
+                let slow = [
+                    "convex-loop",
+                    "vase-bottom-up",
+                    "vase-longitudinal",
+                    "freeform-parabolic",
+                ];
+                if round > 0 && slow.contains(&scene) {
+                    continue;
                 }
                 let mut c = phex_scene(scene).unwrap().config;
                 c.params = params.iter().map(|(k, v)| (k.to_string(), *v)).collect();
