@@ -687,6 +687,25 @@ mod tests {
     }
 
     #[test]
+    fn freeform_parabolic_layers_cross_the_parabolic_curve() {
+        // Fig. 22: the conjugate network contains the parabolic curve u = 0 transversally, so
+        // every layer crosses it and faces on both sides (K > 0 and K < 0) are valid.
+        let r = phex_run(phex_scene("freeform-parabolic").unwrap().config).unwrap();
+        let t = &r.triangulation;
+        for l in &t.layers {
+            let u = l.iter().map(|&i| t.uv[i as usize].x);
+            let (lo, hi) = u.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+                (a.min(x), b.max(x))
+            });
+            assert!(lo < -1.0 && hi > 1.0, "layer spans u in [{lo}, {hi}]");
+        }
+        let pos = r.report.per_face.iter().filter(|f| f.gaussian > 0.0).count();
+        let neg = r.report.per_face.iter().filter(|f| f.gaussian < 0.0).count();
+        assert!(pos > 500 && neg > 500, "{pos} faces with K > 0, {neg} with K < 0");
+        assert_eq!(r.report.invalid_faces, 0);
+    }
+
+    #[test]
     fn unknown_scene_is_a_typed_error() {
         assert!(matches!(
             phex_scene("nope"),
