@@ -609,7 +609,8 @@ mod tests {
         for round in 0..2 {
             let mut r = |a: f64, b: f64| rng.random_range(a..b);
             let scale = r(0.8, 1.25);
-            let cases: Vec<(&str, Vec<(&str, f64)>, Option<f64>)> = vec![
+            type Case = (&'static str, Vec<(&'static str, f64)>, Option<f64>);
+            let cases: Vec<Case> = vec![
                 (
                     "cyclide-architecture",
                     vec![("a", r(1.9, 2.3)), ("c", r(0.3, 0.6)), ("mu", r(0.95, 1.3))],
