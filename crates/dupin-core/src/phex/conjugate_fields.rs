@@ -132,28 +132,54 @@ fn cross2(a: Vec2, b: Vec2) -> f64 {
     a.x * b.y - a.y * b.x
 }
 
-/// First crossing of the segment p q with the polyline `line`: (fraction along p q).
-fn segment_hits(p: Vec2, q: Vec2, line: &[Vec2]) -> Option<f64> {
-    let (lo, hi) = (p.inf(&q), p.sup(&q));
-    let mut best: Option<f64> = None;
-    for w in line.windows(2) {
-        let (a, b) = (w[0], w[1]);
-        if a.x.max(b.x) < lo.x || a.x.min(b.x) > hi.x || a.y.max(b.y) < lo.y || a.y.min(b.y) > hi.y
-        {
-            continue;
-        }
-        let (r, s) = (q - p, b - a);
-        let den = cross2(r, s);
-        if den == 0.0 {
-            continue;
-        }
-        let t = cross2(a - p, s) / den;
-        let u = cross2(a - p, r) / den;
-        if (0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u) {
-            best = Some(best.map_or(t, |x: f64| x.min(t)));
-        }
+/// A polyline with the bounding boxes of its chunks of [`CHUNK`] segments (crossing tests skip
+/// whole chunks; a layer's flow line has thousands of segments).
+struct Polyline {
+    pts: Vec<Vec2>,
+    boxes: Vec<(Vec2, Vec2)>,
+}
+
+const CHUNK: usize = 32;
+
+impl Polyline {
+    fn new(pts: Vec<Vec2>) -> Self {
+        let boxes = (0..pts.len().saturating_sub(1))
+            .step_by(CHUNK)
+            .map(|k| {
+                let w = &pts[k..(k + CHUNK + 1).min(pts.len())];
+                let lo = w.iter().fold(w[0], |a, b| a.inf(b));
+                let hi = w.iter().fold(w[0], |a, b| a.sup(b));
+                (lo, hi)
+            })
+            .collect();
+        Polyline { pts, boxes }
     }
-    best
+
+    /// First crossing of the segment p q with the polyline: the fraction along p q.
+    fn hits(&self, p: Vec2, q: Vec2) -> Option<f64> {
+        let (lo, hi) = (p.inf(&q), p.sup(&q));
+        let mut best: Option<f64> = None;
+        for (c, (blo, bhi)) in self.boxes.iter().enumerate() {
+            if bhi.x < lo.x || blo.x > hi.x || bhi.y < lo.y || blo.y > hi.y {
+                continue;
+            }
+            let end = ((c + 1) * CHUNK + 1).min(self.pts.len());
+            for w in self.pts[c * CHUNK..end].windows(2) {
+                let (a, b) = (w[0], w[1]);
+                let (r, s) = (q - p, b - a);
+                let den = cross2(r, s);
+                if den == 0.0 {
+                    continue;
+                }
+                let t = cross2(a - p, s) / den;
+                let u = cross2(a - p, r) / den;
+                if (0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u) {
+                    best = Some(best.map_or(t, |x: f64| x.min(t)));
+                }
+            }
+        }
+        best
+    }
 }
 
 /// Builds a method-2 triangulation along the flow lines of [`ConjugateFields`] with first-field
@@ -347,6 +373,7 @@ pub fn triangulate_along_fields(
                 let bwd = f.trace(sp, 0, -along_ref, step, reach, &|_| true);
                 let mut l1: Vec<Vec2> = bwd.into_iter().rev().collect();
                 l1.extend(fwd.into_iter().skip(1));
+                let l1 = Polyline::new(l1);
                 found.clear();
                 let mut rel = vec![];
                 for (_, foot, h) in &feet {
@@ -475,12 +502,12 @@ fn hit(
     reference: Vec2,
     h: f64,
     limit: f64,
-    line: &[Vec2],
+    line: &Polyline,
 ) -> Option<(Vec2, f64)> {
     let (mut cur, mut r, mut len) = (foot, reference, 0.0);
     while len < limit {
         let (q, dir) = f.rk4(cur, 1, r, h)?;
-        if let Some(t) = segment_hits(cur, q, line) {
+        if let Some(t) = line.hits(cur, q) {
             return Some((cur + (q - cur) * t, len + t * h));
         }
         cur = q;

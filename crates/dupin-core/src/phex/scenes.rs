@@ -700,9 +700,22 @@ mod tests {
             });
             assert!(lo < -1.0 && hi > 1.0, "layer spans u in [{lo}, {hi}]");
         }
-        let pos = r.report.per_face.iter().filter(|f| f.gaussian > 0.0).count();
-        let neg = r.report.per_face.iter().filter(|f| f.gaussian < 0.0).count();
-        assert!(pos > 500 && neg > 500, "{pos} faces with K > 0, {neg} with K < 0");
+        let pos = r
+            .report
+            .per_face
+            .iter()
+            .filter(|f| f.gaussian > 0.0)
+            .count();
+        let neg = r
+            .report
+            .per_face
+            .iter()
+            .filter(|f| f.gaussian < 0.0)
+            .count();
+        assert!(
+            pos > 500 && neg > 500,
+            "{pos} faces with K > 0, {neg} with K < 0"
+        );
         assert_eq!(r.report.invalid_faces, 0);
     }
 
