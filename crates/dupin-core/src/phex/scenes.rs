@@ -503,7 +503,13 @@ mod tests {
 
     #[test]
     fn stepper_exposes_layers_then_iterations_and_matches_the_one_shot_run() {
-        let scene = phex_scene("sphere-radial").unwrap();
+        for name in ["sphere-radial", "sphere-spiral"] {
+            stepper_matches_one_shot(name);
+        }
+    }
+
+    fn stepper_matches_one_shot(name: &str) {
+        let scene = phex_scene(name).unwrap();
         let mut p = PhexPipeline::new(scene.config.clone()).unwrap();
         let layers = p.triangulation().layers.len();
         let mut last_faces = 0;
