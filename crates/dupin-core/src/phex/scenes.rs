@@ -472,6 +472,17 @@ mod tests {
                     if !(shape <= SHAPE_BOUND) {
                         bad.push(format!("shape deviation {shape:.2}"));
                     }
+                    // Boundary faces are part of the mesh checked above, on every open scene.
+                    let interior = crate::dual_mesh(&r.triangulation)
+                        .map(|d| d.mesh.num_faces())
+                        .unwrap_or(0);
+                    let closed = ["torus-bound", "cyclide-prescribed", "convex-loop"];
+                    if closed.contains(name) != (r.report.faces == interior) {
+                        bad.push(format!(
+                            "{} faces, {interior} of them interior",
+                            r.report.faces
+                        ));
+                    }
                     if !bad.is_empty() {
                         failures.push(format!("{name}: {}", bad.join(", ")));
                     }
