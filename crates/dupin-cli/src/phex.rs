@@ -32,6 +32,13 @@ pub struct PhexArgs {
     /// Skip the planarity optimisation.
     #[arg(long)]
     pub no_optimize: bool,
+    /// Extension: method 2 along a user-chosen first direction field at DEG degrees from the
+    /// first principal direction (the u direction at umbilics) and its conjugate field.
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    pub field_angle: Option<f64>,
+    /// Extension: no faces at boundary vertices of the triangulation (closed stars only).
+    #[arg(long)]
+    pub no_boundary_faces: bool,
     /// Print the scene names, one a line.
     #[arg(long)]
     pub list_scenes: bool,
@@ -104,6 +111,17 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
     }
     if args.no_optimize {
         config.optimize = false;
+    }
+    if let Some(deg) = args.field_angle {
+        if !(deg.is_finite() && deg.abs() <= 90.0) {
+            return Err(CliError::Input(format!(
+                "--field-angle {deg}: use degrees in [-90, 90]"
+            )));
+        }
+        config.field_angle = Some(deg.to_radians());
+    }
+    if args.no_boundary_faces {
+        config.boundary_faces = false;
     }
     let label = args
         .scene

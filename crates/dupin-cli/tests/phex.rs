@@ -133,6 +133,61 @@ fn bad_input_exits_2_with_one_error_line() {
             m,
         ],
         vec!["phex", "--scene", "torus-bound"],
+        // A first field along an asymptotic (self-conjugate) direction: no valid triangulation.
+        vec![
+            "phex",
+            "--surface",
+            "hyperboloid",
+            "--field-angle",
+            "45",
+            "--out",
+            m,
+        ],
+        vec![
+            "phex",
+            "--scene",
+            "torus-bound",
+            "--field-angle",
+            "120",
+            "--out",
+            m,
+        ],
+        vec![
+            "phex",
+            "--scene",
+            "sphere-radial",
+            "--field-angle",
+            "10",
+            "--out",
+            m,
+        ],
+        vec![
+            "phex",
+            "--scene",
+            "torus-bound",
+            "--iterations",
+            "5000",
+            "--out",
+            m,
+        ],
+        vec![
+            "phex",
+            "--surface",
+            "freeform-translational",
+            "--set",
+            "amplitude=7",
+            "--out",
+            m,
+        ],
+        vec![
+            "phex",
+            "--surface",
+            "freeform-translational",
+            "--set",
+            "wobble=0.1",
+            "--out",
+            m,
+        ],
     ] {
         let o = dupin(&args);
         assert_eq!(o.status.code(), Some(2), "{args:?}");
@@ -140,4 +195,39 @@ fn bad_input_exits_2_with_one_error_line() {
         assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
         assert!(err.starts_with("error:"), "{args:?}: {err}");
     }
+}
+
+#[test]
+fn field_angle_extension_and_boundary_faces() {
+    let mesh = tmp("fa.obj");
+    let report = tmp("fa.json");
+    let run = |surface: &str, extra: &[&str]| {
+        let mut args = vec![
+            "phex",
+            "--surface",
+            surface,
+            "--size",
+            "0.2",
+            "--out",
+            mesh.to_str().unwrap(),
+            "--report",
+            report.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let o = dupin(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let r: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+        assert!(r["max_planarity"].as_f64().unwrap() <= 1e-10, "{r}");
+        assert_eq!(r["invalid_faces"].as_u64().unwrap(), 0, "{r}");
+        r["faces"].as_u64().unwrap()
+    };
+    // Method 2 along a field at -15 degrees from the principal direction (negative value).
+    assert!(run("torus", &["--field-angle", "-15"]) > 100);
+    // Boundary faces are on by default: the open sphere band has more faces with them.
+    let with = run("sphere", &[]);
+    let without = run("sphere", &["--no-boundary-faces"]);
+    assert!(with > without, "{with} vs {without}");
+    let _ = std::fs::remove_file(mesh);
+    let _ = std::fs::remove_file(report);
 }

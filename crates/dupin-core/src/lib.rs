@@ -81,12 +81,13 @@ pub use mesh_topology::{MeshTopology, TopologyError};
 pub use obj::{ObjError, parse_obj, write_obj};
 pub use offset::{OffsetError, offset_mesh};
 pub use phex::{
-    DualMesh, FREEFORM, FaceInfo, FreeformSurface, Initialisation, LayerRule, PARABOLIC_THRESHOLD,
-    PHEX_SCENES, PhexConfig, PhexError, PhexMetrics, PhexPhase, PhexPipeline, PhexReport,
-    PhexResult, PhexScene, PlanarityOptimiser, PlanarityOptions, PlanarityStep, Triangulation,
-    TriangulationMethod, TriangulationSpec, TwistedSurface, bounded_ratio,
-    convex_loop_triangulation, dual_mesh, dual_mesh_with, face_info, loop_subdivide, phex_report,
-    phex_run, phex_scene, tangent_plane_point, triangulate,
+    ConjugateFields, DualMesh, FREEFORM, FaceInfo, FreeformSurface, Initialisation, LayerRule,
+    PARABOLIC_THRESHOLD, PHEX_SCENES, PhexConfig, PhexError, PhexMetrics, PhexPhase, PhexPipeline,
+    PhexReport, PhexResult, PhexScene, PlanarityOptimiser, PlanarityOptions, PlanarityStep,
+    Triangulation, TriangulationMethod, TriangulationSpec, TwistedSurface, bounded_ratio,
+    convex_loop_triangulation, dual_mesh, dual_mesh_options, dual_mesh_with, face_info,
+    loop_subdivide, phex_report, phex_run, phex_scene, tangent_plane_point, triangulate,
+    triangulate_along_fields,
 };
 pub use planarity::{face_planarity, max_planarity};
 pub use point_set::{PointSetError, parse_points, parse_segments};

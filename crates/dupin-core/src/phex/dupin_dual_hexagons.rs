@@ -88,16 +88,7 @@ pub const PARABOLIC_THRESHOLD: f64 = 1e-8;
 ///
 /// Errors: [`PhexError::NoValidTriangulation`] when no interior vertex exists.
 pub fn dual_mesh(t: &Triangulation) -> Result<DualMesh, PhexError> {
-    let positions: Vec<Vec3> = t
-        .triangles
-        .iter()
-        .map(|tr| {
-            let p = tr.map(|i| t.positions[i as usize]);
-            let n = tr.map(|i| t.normals[i as usize]);
-            tangent_plane_point(p, n)
-        })
-        .collect();
-    dual_from_points(t, positions)
+    dual_from_points_impl(t, tangent_points(t), false)
 }
 
 /// Builds the dual polygon mesh of `t` with the chosen [`Initialisation`]; `surface` gives the
@@ -109,8 +100,21 @@ pub fn dual_mesh_with(
     surface: &dyn crate::Surface,
     init: Initialisation,
 ) -> Result<DualMesh, PhexError> {
-    match init {
-        Initialisation::TangentDuality => dual_mesh(t),
+    dual_mesh_options(t, surface, init, false)
+}
+
+/// [`dual_mesh_with`], plus the boundary faces of [`DualMesh::with_boundary_faces`] when
+/// `boundary_faces` is set (their edge vertices are always placed by tangent duality).
+///
+/// Errors: [`PhexError::NoValidTriangulation`] when no face can be formed.
+pub fn dual_mesh_options(
+    t: &Triangulation,
+    surface: &dyn crate::Surface,
+    init: Initialisation,
+    boundary_faces: bool,
+) -> Result<DualMesh, PhexError> {
+    let positions = match init {
+        Initialisation::TangentDuality => tangent_points(t),
         Initialisation::DupinDuality => {
             let curv: Vec<Option<crate::Curvature>> =
                 t.uv.iter()
@@ -123,8 +127,7 @@ pub fn dual_mesh_with(
                         })
                     })
                     .collect();
-            let positions = t
-                .triangles
+            t.triangles
                 .iter()
                 .map(|tr| {
                     let centroid = tr.iter().map(|&i| t.positions[i as usize]).sum::<Vec3>() / 3.0;
@@ -136,10 +139,21 @@ pub fn dual_mesh_with(
                         _ => centroid,
                     }
                 })
-                .collect();
-            dual_from_points(t, positions)
+                .collect()
         }
-    }
+    };
+    dual_from_points_impl(t, positions, boundary_faces)
+}
+
+fn tangent_points(t: &Triangulation) -> Vec<Vec3> {
+    t.triangles
+        .iter()
+        .map(|tr| {
+            let p = tr.map(|i| t.positions[i as usize]);
+            let n = tr.map(|i| t.normals[i as usize]);
+            tangent_plane_point(p, n)
+        })
+        .collect()
 }
 
 impl DualMesh {
@@ -156,16 +170,7 @@ impl DualMesh {
     ///
     /// Errors: [`PhexError::NoValidTriangulation`] when no face can be formed.
     pub fn with_boundary_faces(t: &Triangulation) -> Result<DualMesh, PhexError> {
-        let positions: Vec<Vec3> = t
-            .triangles
-            .iter()
-            .map(|tr| {
-                let p = tr.map(|i| t.positions[i as usize]);
-                let n = tr.map(|i| t.normals[i as usize]);
-                tangent_plane_point(p, n)
-            })
-            .collect();
-        dual_from_points_impl(t, positions, true)
+        dual_from_points_impl(t, tangent_points(t), true)
     }
 }
 
@@ -192,8 +197,21 @@ fn edge_point(a: Vec3, na: Vec3, b: Vec3, nb: Vec3) -> Vec3 {
     }
 }
 
-fn dual_from_points(t: &Triangulation, positions: Vec<Vec3>) -> Result<DualMesh, PhexError> {
-    dual_from_points_impl(t, positions, false)
+/// Whether `pts`, projected onto the plane through `origin` with unit normal `n`, form a simple
+/// polygon.
+fn starts_simple(pts: &[Vec3], origin: Vec3, n: Vec3) -> bool {
+    let e1 = if n.x.abs() < 0.9 {
+        Vec3::x()
+    } else {
+        Vec3::y()
+    };
+    let e1 = (e1 - n * n.dot(&e1)).normalize();
+    let e2 = n.cross(&e1);
+    let q: Vec<crate::Vec2> = pts
+        .iter()
+        .map(|p| crate::Vec2::new((p - origin).dot(&e1), (p - origin).dot(&e2)))
+        .collect();
+    crate::is_simple_polygon(&q).unwrap_or(false)
 }
 
 fn dual_from_points_impl(
@@ -228,6 +246,18 @@ fn dual_from_points_impl(
                     cur = e;
                 }
                 if fan.len() == st.len() {
+                    let edge = |w: u32| {
+                        let (a, b) = (w as usize, v);
+                        edge_point(t.positions[a], t.normals[a], t.positions[b], t.normals[b])
+                    };
+                    // Keep only boundary faces that start as simple polygons in the tangent
+                    // plane of their vertex (on K < 0 a half star can fold over near corners).
+                    let mut pts = vec![edge(first.0)];
+                    pts.extend(fan.iter().map(|e| positions[e.2 as usize]));
+                    pts.push(edge(cur.1));
+                    if !starts_simple(&pts, t.positions[v], t.normals[v]) {
+                        continue;
+                    }
                     let mut point = |w: u32| {
                         let key = (w.min(v as u32), w.max(v as u32));
                         *edge_points.entry(key).or_insert_with(|| {

@@ -2,6 +2,7 @@
 //! tangent/Dupin dual hexagonal mesh, and Gauss-Newton planarity optimisation, as a one-shot
 //! function ([`phex_run`]) and a stateful stepper ([`PhexPipeline`]).
 
+mod conjugate_fields;
 mod dupin_dual_hexagons;
 mod loop_subdivision;
 mod pipeline;
@@ -10,8 +11,10 @@ mod report;
 mod scenes;
 mod triangulation;
 
+pub use conjugate_fields::{ConjugateFields, triangulate_along_fields};
 pub use dupin_dual_hexagons::{
-    DualMesh, Initialisation, PARABOLIC_THRESHOLD, dual_mesh, dual_mesh_with, tangent_plane_point,
+    DualMesh, Initialisation, PARABOLIC_THRESHOLD, dual_mesh, dual_mesh_options, dual_mesh_with,
+    tangent_plane_point,
 };
 pub use loop_subdivision::{convex_loop_triangulation, loop_subdivide};
 pub use pipeline::{PhexConfig, PhexMetrics, PhexPhase, PhexPipeline, PhexResult, phex_run};

@@ -4,7 +4,8 @@
 //! web page); [`phex_run`] the one-shot function (for the CLI).
 
 use super::PhexError;
-use super::dupin_dual_hexagons::{DualMesh, dual_mesh_with};
+use super::conjugate_fields::triangulate_along_fields;
+use super::dupin_dual_hexagons::{DualMesh, dual_mesh_options};
 use super::planarity_optimisation::{PlanarityOptimiser, PlanarityOptions};
 use super::report::{PhexReport, phex_report};
 use super::scenes::TwistedSurface;
@@ -44,6 +45,13 @@ pub struct PhexConfig {
     pub loop_subdivision: bool,
     /// How the hexagon vertices are initialised (section 6).
     pub initialisation: super::Initialisation,
+    /// Also make faces at boundary triangulation vertices (section 6: the optimisation
+    /// "generalised to boundary faces"; see [`super::DualMesh::with_boundary_faces`]).
+    pub boundary_faces: bool,
+    /// Method 2 with a user-chosen first direction field: the angle (radians) of the first
+    /// field against the first principal direction (the u direction at umbilics); the second
+    /// field is its conjugate. `None`: the parameter lines (which must be conjugate).
+    pub field_angle: Option<f64>,
 }
 
 impl PhexConfig {
@@ -72,6 +80,8 @@ impl PhexConfig {
             optimize: true,
             loop_subdivision: false,
             initialisation: super::Initialisation::TangentDuality,
+            boundary_faces: true,
+            field_angle: None,
         }
     }
 }
@@ -156,10 +166,26 @@ fn build_surface(config: &PhexConfig) -> Result<Box<dyn Surface>, PhexError> {
         .map(|(k, v)| (k.as_str(), *v))
         .collect();
     let s: Box<dyn Surface> = if config.surface == super::scenes::FREEFORM {
-        Box::new(super::scenes::FreeformSurface {
-            amplitude: 0.4,
-            curl: 0.3,
-        })
+        let (mut amplitude, mut curl) = (0.4, 0.3);
+        for (k, v) in &params {
+            let slot = match *k {
+                "amplitude" => &mut amplitude,
+                "curl" => &mut curl,
+                _ => {
+                    return Err(PhexError::BadParameter(format!(
+                        "{} has no parameter '{k}'; use amplitude or curl",
+                        super::scenes::FREEFORM
+                    )));
+                }
+            };
+            if !(v.is_finite() && v.abs() <= 1.0) {
+                return Err(PhexError::BadParameter(format!(
+                    "{k} = {v}; use a value in [-1, 1]"
+                )));
+            }
+            *slot = *v;
+        }
+        Box::new(super::scenes::FreeformSurface { amplitude, curl })
     } else {
         surface_by_name(&config.surface, &params)?
     };
@@ -248,7 +274,25 @@ impl PhexPipeline {
             along,
             max_layers: 4000,
         };
-        let tri = triangulate(surface.as_ref(), &spec)?;
+        let tri = match config.field_angle {
+            None => triangulate(surface.as_ref(), &spec)?,
+            Some(angle) => {
+                if config.method != TriangulationMethod::Prescribed {
+                    return Err(PhexError::BadParameter(
+                        "a field angle needs method 2 (prescribed); drop it or use \
+                         --method prescribed"
+                            .into(),
+                    ));
+                }
+                if !(angle.is_finite() && angle.abs() <= std::f64::consts::FRAC_PI_2) {
+                    return Err(PhexError::BadParameter(format!(
+                        "field angle {:.3} degrees; use a value in [-90, 90]",
+                        angle.to_degrees()
+                    )));
+                }
+                triangulate_along_fields(surface.as_ref(), &spec, angle, size)?
+            }
+        };
         if tri.triangles.len() > 4_000_000 {
             return Err(PhexError::BadSize(format!(
                 "{} triangles; use a larger size",
@@ -416,8 +460,12 @@ impl PhexPipeline {
                 }
             }
             PhexPhase::Hexagons => {
-                let d =
-                    dual_mesh_with(&self.tri, self.surface.as_ref(), self.config.initialisation)?;
+                let d = dual_mesh_options(
+                    &self.tri,
+                    self.surface.as_ref(),
+                    self.config.initialisation,
+                    self.config.boundary_faces,
+                )?;
                 self.metrics.faces = d.mesh.num_faces();
                 self.metrics.vertices = d.mesh.num_vertices();
                 self.metrics.max_planarity = max_planarity(&d.mesh);

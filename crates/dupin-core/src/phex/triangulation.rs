@@ -105,7 +105,7 @@ fn to_uv(swap: bool, along: f64, across: f64) -> Vec2 {
 
 /// Ratio |CM|/|AB| of the ideal triangle on AB (surface points with parameters `a`, `b`), or
 /// `None` where no ideal triangle exists (parabolic point, degenerate segment).
-fn ideal_ratio(s: &dyn Surface, a: Vec2, b: Vec2) -> Option<f64> {
+pub(super) fn ideal_ratio(s: &dyn Surface, a: Vec2, b: Vec2) -> Option<f64> {
     let m = (a + b) / 2.0;
     let curv = s.curvature(m.x, m.y).ok()?;
     let (pa, pb) = (s.position(a.x, a.y), s.position(b.x, b.y));
