@@ -44,6 +44,10 @@ pub struct PhexConfig {
     pub loop_subdivision: bool,
     /// How the hexagon vertices are initialised (section 6).
     pub initialisation: super::Initialisation,
+    /// Initial fairness weight lambda of the planarity optimisation (section 7; >= 0).
+    pub lambda: f64,
+    /// Initial surface-distance weight mu of the planarity optimisation (section 7; >= 0).
+    pub mu: f64,
 }
 
 impl PhexConfig {
@@ -72,6 +76,8 @@ impl PhexConfig {
             optimize: true,
             loop_subdivision: false,
             initialisation: super::Initialisation::TangentDuality,
+            lambda: PlanarityOptions::default().fairness,
+            mu: PlanarityOptions::default().distance,
         }
     }
 }
@@ -188,6 +194,20 @@ impl PhexPipeline {
             return Err(PhexError::BadParameter(format!(
                 "{} iterations; use at most 1000",
                 config.iterations
+            )));
+        }
+        for (name, w) in [("lambda", config.lambda), ("mu", config.mu)] {
+            if !(w.is_finite() && w >= 0.0) {
+                return Err(PhexError::BadParameter(format!(
+                    "{name} = {w} must be a finite weight >= 0"
+                )));
+            }
+        }
+        if let LayerRule::Ideal { bound } = config.rule
+            && !(bound.is_finite() && (0.0..=1.0).contains(&bound))
+        {
+            return Err(PhexError::BadParameter(format!(
+                "lower bound b = {bound} must be in [0, 1]"
             )));
         }
         let surface = build_surface(&config)?;
@@ -427,6 +447,8 @@ impl PhexPipeline {
                     Some(&d.vertex_uv),
                     PlanarityOptions {
                         max_iterations: self.config.iterations,
+                        fairness: self.config.lambda,
+                        distance: self.config.mu,
                         ..PlanarityOptions::default()
                     },
                 )?;

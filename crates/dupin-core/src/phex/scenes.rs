@@ -68,6 +68,8 @@ fn cfg(
         optimize: true,
         loop_subdivision: false,
         initialisation: super::Initialisation::TangentDuality,
+        lambda: super::PlanarityOptions::default().fairness,
+        mu: super::PlanarityOptions::default().distance,
     }
 }
 
