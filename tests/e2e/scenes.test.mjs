@@ -21,8 +21,9 @@ test('every contract scene steps to completion with planar faces', async () => {
     for (const scene of ONLY ?? [...PHEX, ...PQ]) {
       const t0 = Date.now();
       await byId(page, 'scene-select').selectOption(scene);
+      // The hash follows the worker's first state of the new scene.
+      await page.waitForFunction((s) => new URLSearchParams(location.hash.slice(1)).get('scene') === s, scene, { timeout: 120_000 });
       await waitSteps(page, 1);
-      await page.waitForFunction((s) => location.hash.includes(`scene=${s}`), scene);
       const first = await metrics(page);
       const firstShot = await shot(page, `scene-${scene}-step1`);
       const oneStep = first.phase === 'done'; // PQ scenes are one step
