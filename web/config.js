@@ -8,7 +8,7 @@ export function defaults() {
   return {
     scene: 'torus',
     params: {},
-    free: { surface: 'torus', method: 'progressive', size: null, bound: null, lambda: null, mu: null },
+    free: { surface: 'torus', method: 'progressive', init: 'tangent-duality', size: null, bound: null, lambda: null, mu: null },
     steps: 1,
     color: 'planarity',
     panelEdge: 1.5,
@@ -33,6 +33,7 @@ export function readHash(hash, { scenes, catalog, torusParams }) {
     c.free.surface = surface.name;
     for (const p of surface.params) c.params[p.key] = h.has(`p.${p.key}`) ? num(h.get(`p.${p.key}`)) : p.default;
     if (h.get('method') === 'prescribed') c.free.method = 'prescribed';
+    if (h.get('init') === 'dupin-duality') c.free.init = 'dupin-duality';
     for (const k of ['size', 'bound', 'lambda', 'mu']) if (h.has(k)) c.free[k] = num(h.get(k));
   }
   const steps = Number(h.get('steps'));
@@ -53,6 +54,7 @@ export function writeHash(c) {
     h.set('surface', c.free.surface);
     for (const [k, v] of Object.entries(c.params)) h.set(`p.${k}`, String(v));
     h.set('method', c.free.method);
+    if (c.free.init !== 'tangent-duality') h.set('init', c.free.init);
     for (const k of ['size', 'bound', 'lambda', 'mu']) if (c.free[k] !== null) h.set(k, String(c.free[k]));
   }
   if (c.scene !== 'torus') h.set('steps', String(c.steps));
@@ -67,7 +69,7 @@ export function writeHash(c) {
 export function sessionConfig(c) {
   if (c.scene === 'torus') return null;
   if (c.scene !== FREE) return { scene: c.scene };
-  const out = { surface: c.free.surface, params: { ...c.params }, method: c.free.method };
+  const out = { surface: c.free.surface, params: { ...c.params }, method: c.free.method, init: c.free.init };
   for (const k of ['size', 'bound', 'lambda', 'mu']) if (c.free[k] !== null) out[k] = c.free[k];
   return out;
 }

@@ -95,8 +95,13 @@ export function buildFields(box, c, { catalog, torusParams, defaults, onChange }
   method.append(new Option('progressive', 'progressive'), new Option('prescribed', 'prescribed'));
   method.value = c.free.method;
   method.addEventListener('change', () => onChange((n) => { n.free.method = method.value; }, 'free-method'));
-  box.append(el('label', { className: 'field' }, el('span', { className: 'field-label', textContent: 'surface' }), pick),
-    el('label', { className: 'field' }, el('span', { className: 'field-label', textContent: 'method' }), method));
+  const init = el('select', { title: 'hexagon initialisation: tangent duality (sec. 4.1, starts planar) or Dupin duality (sec. 6, the optimisation makes it planar)' });
+  init.dataset.testid = 'free-init';
+  init.append(new Option('tangent duality', 'tangent-duality'), new Option('Dupin duality', 'dupin-duality'));
+  init.value = c.free.init;
+  init.addEventListener('change', () => onChange((n) => { n.free.init = init.value; }, 'free-init'));
+  const labelled = (text, e) => el('label', { className: 'field' }, el('span', { className: 'field-label', textContent: text }), e);
+  box.append(labelled('surface', pick), labelled('method', method), labelled('init', init));
   for (const p of surface?.params ?? []) {
     box.append(numberField({
       id: `param-${p.key}`, label: p.key, value: c.params[p.key], min: p.min, max: p.max,

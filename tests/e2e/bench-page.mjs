@@ -9,7 +9,7 @@ for (const [backend, webgpu] of [['WebGPU', true], ['WebGL2', false]]) {
   const { browser, page } = await openPage({ webgpu });
   out[`${backend} first frame ms`] = Number(await page.evaluate(() => document.body.dataset.firstFrameMs));
   // Frame time while orbiting the 10k-face mesh: 60 drags, one rendered frame each.
-  await page.goto(`${process.env.DUPIN_URL ?? 'http://127.0.0.1:8080/'}#scene=free&surface=torus&method=prescribed&size=0.155${webgpu ? '' : '&backend=webgl2'}`);
+  await page.goto(`${process.env.DUPIN_URL ?? 'http://127.0.0.1:8080/'}#scene=free&surface=torus&method=prescribed&size=0.155&init=dupin-duality${webgpu ? '' : '&backend=webgl2'}`);
   await page.waitForFunction(() => document.body.dataset.ready === 'true');
   await waitSteps(page, 1);
   if (webgpu) {
@@ -39,7 +39,7 @@ for (const [backend, webgpu] of [['WebGPU', true], ['WebGL2', false]]) {
   });
   out[`${backend} orbit frame ms (median), 10k hexagons`] = median(frameMs);
   if (webgpu) {
-    await page.goto(`${process.env.DUPIN_URL ?? 'http://127.0.0.1:8080/'}#scene=free&surface=torus&method=prescribed&size=0.49`);
+    await page.goto(`${process.env.DUPIN_URL ?? 'http://127.0.0.1:8080/'}#scene=free&surface=torus&method=prescribed&size=0.49&init=dupin-duality`);
     await page.waitForFunction(() => new URLSearchParams(location.hash.slice(1)).get('size') === '0.49');
     await waitSteps(page, 1);
     await page.evaluate(() => window.dupin.stepLog.splice(0));

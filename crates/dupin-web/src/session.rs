@@ -2,7 +2,7 @@
 
 use crate::mesh_data::MeshData;
 use dupin_core::{
-    LayerRule, PHEX_SCENES, PQ_SCENES, PhexConfig, PhexPipeline, PolyMesh, SheetOptions,
+    Initialisation, LayerRule, PHEX_SCENES, PQ_SCENES, PhexConfig, PhexPipeline, PolyMesh, SheetOptions,
     TriangulationMethod, face_info, face_planarity, max_planarity, panel_schedule,
     panel_schedule_svg, phex_scene, pq_scene, surface_catalog, write_obj,
 };
@@ -10,7 +10,8 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use wasm_bindgen::prelude::*;
 
-/// `new Session(config)`: `{ scene }` or `{ surface, params, method, size, bound, lambda, mu }`.
+/// `new Session(config)`: `{ scene }` or `{ surface, params, method, size, bound, lambda, mu,
+/// init }`.
 #[derive(Deserialize, Serialize, Clone)]
 #[serde(deny_unknown_fields)]
 struct SessionConfig {
@@ -26,6 +27,9 @@ struct SessionConfig {
     lambda: Option<f64>,
     /// Initial surface-distance weight (section 7).
     mu: Option<f64>,
+    /// Hexagon initialisation: `tangent-duality` (default, section 4.1) or `dupin-duality`
+    /// (section 6; starts non-planar, so the optimisation runs).
+    init: Option<String>,
 }
 
 /// Histogram bins of log10(face planarity): `HIST_BINS` bins over [HIST_LO, HIST_HI]; values
@@ -260,6 +264,15 @@ impl Session {
                 if let Some(m) = cfg.mu {
                     config.mu = m;
                 }
+                config.initialisation = match cfg.init.as_deref().unwrap_or("tangent-duality") {
+                    "tangent-duality" => Initialisation::TangentDuality,
+                    "dupin-duality" => Initialisation::DupinDuality,
+                    other => {
+                        return Err(JsError::new(&format!(
+                            "init must be `tangent-duality` or `dupin-duality`, not `{other}`"
+                        )));
+                    }
+                };
                 Run::Phex(Box::new(PhexPipeline::new(config).map_err(err)?))
             }
             _ => {

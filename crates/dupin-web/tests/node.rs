@@ -91,6 +91,7 @@ fn bad_session_configs_throw_readable_errors() {
         (r#"{"surface":"torus","bound":7}"#, "lower bound b"),
         (r#"{"surface":"torus","params":{"r":-1}}"#, "r"),
         (r#"{"surface":"torus","size":1000}"#, "size"),
+        (r#"{"surface":"torus","init":"magic"}"#, "init"),
     ] {
         let err = match Session::new(js_sys::JSON::parse(json).unwrap()) {
             Err(e) => wasm_bindgen::JsValue::from(e),
