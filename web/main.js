@@ -94,6 +94,19 @@ function load(next, { reframe = true, field = null } = {}) {
 let candidate = null; // configuration sent to the worker, not yet confirmed
 
 function onState(s) {
+  const t0 = performance.now();
+  try { applyState(s); } finally { noteTask('state', t0); }
+}
+
+// Main-thread work per worker message and per frame over 16 ms (window.dupin.slowTasks), to
+// find what a long task was.
+const slowTasks = [];
+function noteTask(what, t0) {
+  const ms = performance.now() - t0;
+  if (ms > 16 && slowTasks.length < 1000) slowTasks.push({ what, ms: Math.round(ms), faces: lastFaces });
+}
+
+function applyState(s) {
   if (candidate) {
     config = candidate.config;
     if (candidate.field) showFieldError(fieldsBox, candidate.field, '');
@@ -177,6 +190,7 @@ window.dupin = {
   get config() { return config; },
   requestRedraw: () => { dirty = true; },
   stepLog,
+  slowTasks,
 };
 
 // ---- orbit: mouse drag, wheel, touch (one finger orbits, two pinch) ---------------------------
@@ -219,8 +233,10 @@ function frame() {
   viewer.poll();
   if (dirty) {
     dirty = false;
+    const t0 = performance.now();
     try {
       viewer.render();
+      noteTask('render', t0);
       if (document.body.dataset.ready !== 'true' && settled) {
         document.body.dataset.firstFrameMs = performance.now().toFixed(0);
         document.body.dataset.ready = 'true';

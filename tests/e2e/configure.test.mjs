@@ -17,7 +17,7 @@ test('a 10k-face run in the worker leaves no main-thread task over 50 ms', async
       new PerformanceObserver((l) => window.__long.push(...l.getEntries().map((e) => e.duration))).observe({ type: 'longtask' });
     });
     // The observer does see a main-thread task of 80 ms (so an empty list below means something).
-    await page.evaluate(() => { const t = performance.now(); while (performance.now() - t < 80); });
+    await page.evaluate(() => { setTimeout(() => { const t = performance.now(); while (performance.now() - t < 80); }, 0); });
     await page.waitForFunction(() => window.__long.length > 0);
     await page.evaluate(() => { window.__long.length = 0; });
     await byId(page, 'play').click();
@@ -29,7 +29,8 @@ test('a 10k-face run in the worker leaves no main-thread task over 50 ms', async
     const log = await page.evaluate(() => window.dupin.stepLog);
     const opt = log.filter((s) => s.phase === 'optimisation' || s.phase === 'done');
     assert.ok(Number(m.iteration) >= 2, `only ${m.iteration} optimisation iterations ran`);
-    console.log(JSON.stringify({ faces: m.faces, steps: log.length, longTasks: long, optimisationStepMs: opt.map((s) => Math.round(s.ms)) }));
+    const slow = await page.evaluate(() => window.dupin.slowTasks);
+    console.log(JSON.stringify({ faces: m.faces, steps: log.length, longTasks: long, slowTasks: slow, optimisationStepMs: opt.map((s) => Math.round(s.ms)) }));
     assert.ok(long.every((d) => d <= 50), `main-thread tasks over 50 ms: ${long.map(Math.round).join(', ')}`);
     assert.deepEqual(errors, []);
   } finally {
