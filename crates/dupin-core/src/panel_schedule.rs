@@ -308,8 +308,12 @@ mod tests {
                 rng.random_range(-5.0..5.0),
                 rng.random_range(-5.0..5.0),
             );
-            let a =
-                Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), 0.3).normalize();
+            let a = Vec3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                0.3,
+            )
+            .normalize();
             let b = a.cross(&Vec3::new(0.1, 0.9, -0.4)).normalize();
             let start = positions.len() as u32;
             for k in 0..n {
@@ -336,7 +340,11 @@ mod tests {
                 for j in i + 1..n {
                     let d3 = (mesh.positions[f[i] as usize] - mesh.positions[f[j] as usize]).norm();
                     let d2 = dist(&p.corners[i], &p.corners[j]);
-                    assert!((d3 - d2).abs() <= 1e-9, "face {} pair {i},{j}: {d3} vs {d2}", p.face);
+                    assert!(
+                        (d3 - d2).abs() <= 1e-9,
+                        "face {} pair {i},{j}: {d3} vs {d2}",
+                        p.face
+                    );
                 }
                 let e = dist(&p.corners[i], &p.corners[(i + 1) % n]);
                 assert!((e - p.edge_lengths[i]).abs() <= 1e-9);
@@ -351,8 +359,14 @@ mod tests {
             .panels
             .iter()
             .map(|p| {
-                let lo = p.corners.iter().fold(Vec2::repeat(f64::INFINITY), |a, c| a.inf(c));
-                let hi = p.corners.iter().fold(Vec2::repeat(f64::NEG_INFINITY), |a, c| a.sup(c));
+                let lo = p
+                    .corners
+                    .iter()
+                    .fold(Vec2::repeat(f64::INFINITY), |a, c| a.inf(c));
+                let hi = p
+                    .corners
+                    .iter()
+                    .fold(Vec2::repeat(f64::NEG_INFINITY), |a, c| a.sup(c));
                 (p.sheet, lo, hi)
             })
             .collect();
@@ -380,7 +394,14 @@ mod tests {
         cfg.size = Some(cfg.size.unwrap() * 2.0);
         let r = phex_run(cfg).unwrap();
         assert!(r.report.max_planarity <= 1e-10);
-        let sched = panel_schedule(&r.mesh, &SheetOptions { sheet: None, gap: None }).unwrap();
+        let sched = panel_schedule(
+            &r.mesh,
+            &SheetOptions {
+                sheet: None,
+                gap: None,
+            },
+        )
+        .unwrap();
         for p in &sched.panels {
             let n = p.corners.len();
             for k in 0..n {
@@ -406,17 +427,38 @@ mod tests {
         )
         .unwrap();
         for sheet in [(0.0, 1.0), (f64::NAN, 1.0), (1.0, -1.0)] {
-            let e = panel_schedule(&mesh, &SheetOptions { sheet: Some(sheet), gap: None });
+            let e = panel_schedule(
+                &mesh,
+                &SheetOptions {
+                    sheet: Some(sheet),
+                    gap: None,
+                },
+            );
             assert!(matches!(e, Err(PanelScheduleError::BadSheet(_))));
         }
-        let e = panel_schedule(&mesh, &SheetOptions { sheet: Some((1.0, 1.0)), gap: Some(0.0) });
-        assert!(matches!(e, Err(PanelScheduleError::PanelTooLarge { face: 0, .. })));
+        let e = panel_schedule(
+            &mesh,
+            &SheetOptions {
+                sheet: Some((1.0, 1.0)),
+                gap: Some(0.0),
+            },
+        );
+        assert!(matches!(
+            e,
+            Err(PanelScheduleError::PanelTooLarge { face: 0, .. })
+        ));
         let degenerate = PolyMesh::new(
             vec![Vec3::zeros(), Vec3::zeros(), Vec3::new(0.0, 1.0, 0.0)],
             [[0u32, 1, 2]],
         );
         if let Ok(m) = degenerate {
-            let e = panel_schedule(&m, &SheetOptions { sheet: None, gap: None });
+            let e = panel_schedule(
+                &m,
+                &SheetOptions {
+                    sheet: None,
+                    gap: None,
+                },
+            );
             assert!(matches!(e, Err(PanelScheduleError::DegenerateFace(0))));
         }
     }

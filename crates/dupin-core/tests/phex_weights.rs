@@ -1,7 +1,9 @@
 //! The free mode's optimisation weights: `PhexConfig::lambda` and `mu` (P-Hex paper, section 7)
 //! reach the planarity optimisation, and bad values are typed errors.
 
-use dupin_core::{Initialisation, LayerRule, PhexConfig, PhexError, PhexPipeline, phex_run, phex_scene};
+use dupin_core::{
+    Initialisation, LayerRule, PhexConfig, PhexError, PhexPipeline, phex_run, phex_scene,
+};
 
 fn small() -> PhexConfig {
     // About 1k hexagons that need Gauss-Newton iterations (BENCHMARKS.md's 1k size).
@@ -40,17 +42,28 @@ fn lambda_and_mu_change_the_optimised_mesh() {
 
 #[test]
 fn bad_weights_and_bounds_are_errors() {
-    for (lambda, mu) in [(-1.0, 0.0), (f64::NAN, 0.0), (0.0, -1e-9), (0.0, f64::INFINITY)] {
+    for (lambda, mu) in [
+        (-1.0, 0.0),
+        (f64::NAN, 0.0),
+        (0.0, -1e-9),
+        (0.0, f64::INFINITY),
+    ] {
         let mut c = small();
         c.lambda = lambda;
         c.mu = mu;
         let e = PhexPipeline::new(c).err();
-        assert!(matches!(e, Some(PhexError::BadParameter(_))), "{lambda} {mu}: {e:?}");
+        assert!(
+            matches!(e, Some(PhexError::BadParameter(_))),
+            "{lambda} {mu}: {e:?}"
+        );
     }
     for b in [-0.1, 1.5, f64::NAN] {
         let mut c = small();
         c.rule = LayerRule::Ideal { bound: b };
         let e = PhexPipeline::new(c).err();
-        assert!(matches!(e, Some(PhexError::BadParameter(_))), "b = {b}: {e:?}");
+        assert!(
+            matches!(e, Some(PhexError::BadParameter(_))),
+            "b = {b}: {e:?}"
+        );
     }
 }

@@ -56,13 +56,19 @@ impl MeshData {
         edges: Vec<f32>,
     ) -> Result<MeshData, JsError> {
         let n = positions.len();
-        if n % 3 != 0 || normals.len() != n || indices.len() % 3 != 0 || edges.len() % 6 != 0 {
+        if !n.is_multiple_of(3)
+            || normals.len() != n
+            || !indices.len().is_multiple_of(3)
+            || !edges.len().is_multiple_of(6)
+        {
             return Err(JsError::new(
                 "mesh arrays: positions and normals need 3 floats a vertex, indices 3 a triangle, edges 6 a segment",
             ));
         }
         if !colors.is_empty() && colors.len() != n {
-            return Err(JsError::new("mesh arrays: colors need 3 floats a vertex (or none)"));
+            return Err(JsError::new(
+                "mesh arrays: colors need 3 floats a vertex (or none)",
+            ));
         }
         if let Some(&i) = indices.iter().find(|&&i| i as usize >= n / 3) {
             return Err(JsError::new(&format!(

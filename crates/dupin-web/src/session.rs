@@ -2,8 +2,8 @@
 
 use crate::mesh_data::MeshData;
 use dupin_core::{
-    Initialisation, LayerRule, PHEX_SCENES, PQ_SCENES, PhexConfig, PhexPipeline, PolyMesh, SheetOptions,
-    TriangulationMethod, face_info, face_planarity, max_planarity, panel_schedule,
+    Initialisation, LayerRule, PHEX_SCENES, PQ_SCENES, PhexConfig, PhexPipeline, PolyMesh,
+    SheetOptions, TriangulationMethod, face_info, face_planarity, max_planarity, panel_schedule,
     panel_schedule_svg, phex_scene, pq_scene, surface_catalog, write_obj,
 };
 use serde::{Deserialize, Serialize};
@@ -520,7 +520,9 @@ fn planarity_histogram(per_face: &[f64]) -> Vec<u32> {
     let w = (HIST_HI - HIST_LO) / HIST_BINS as f64;
     for &p in per_face {
         let x = if p > 0.0 { p.log10() } else { HIST_LO };
-        let b = ((x - HIST_LO) / w).floor().clamp(0.0, (HIST_BINS - 1) as f64) as usize;
+        let b = ((x - HIST_LO) / w)
+            .floor()
+            .clamp(0.0, (HIST_BINS - 1) as f64) as usize;
         h[b] += 1;
     }
     h

@@ -107,7 +107,9 @@ impl Viewer {
     /// The camera as `[target x, y, z, distance, yaw, pitch]` (for the URL hash).
     pub fn camera(&self) -> Vec<f32> {
         let c = &self.camera;
-        vec![c.target.x, c.target.y, c.target.z, c.distance, c.yaw, c.pitch]
+        vec![
+            c.target.x, c.target.y, c.target.z, c.distance, c.yaw, c.pitch,
+        ]
     }
 
     /// Sets the camera from [`Viewer::camera`]'s six numbers. Throws for a wrong length,

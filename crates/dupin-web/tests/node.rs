@@ -119,7 +119,9 @@ fn mesh_arrays_round_trip_and_reject_bad_lengths() {
     .unwrap();
     assert_eq!(back.triangle_count(), m.triangle_count());
     assert!(MeshData::from_arrays(vec![0.0; 4], vec![0.0; 4], vec![], vec![], vec![]).is_err());
-    assert!(MeshData::from_arrays(vec![0.0; 9], vec![0.0; 9], vec![0, 1, 3], vec![], vec![]).is_err());
+    assert!(
+        MeshData::from_arrays(vec![0.0; 9], vec![0.0; 9], vec![0, 1, 3], vec![], vec![]).is_err()
+    );
 }
 
 #[wasm_bindgen_test]
@@ -129,7 +131,12 @@ fn surface_catalog_lists_every_library_surface_with_ranges() {
     for s in cat.iter() {
         let params = js_sys::Array::from(&js_sys::Reflect::get(&s, &"params".into()).unwrap());
         for p in params.iter() {
-            let f = |k: &str| js_sys::Reflect::get(&p, &k.into()).unwrap().as_f64().unwrap();
+            let f = |k: &str| {
+                js_sys::Reflect::get(&p, &k.into())
+                    .unwrap()
+                    .as_f64()
+                    .unwrap()
+            };
             assert!(f("min") <= f("default") && f("default") <= f("max"));
         }
     }
