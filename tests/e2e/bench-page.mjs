@@ -19,7 +19,6 @@ for (const [backend, webgpu] of [['WebGPU', true], ['WebGL2', false]]) {
     const opt = log.filter((s) => s.phase === 'optimisation' || s.phase === 'done').map((s) => s.ms);
     out['10k faces'] = log.at(-1).faces;
     out['10k optimisation step ms (median, all)'] = [median(opt), opt.map(Math.round)];
-    out['10k dual-mesh step ms'] = Math.round(log.find((s) => s.phase !== 'triangulation' && s.phase !== 'done' && s.faces > 0 && s !== log[0])?.ms ?? NaN);
   }
   const frameMs = await page.evaluate(async () => {
     const c = document.querySelector('[data-testid=canvas]');
@@ -52,4 +51,4 @@ for (const [backend, webgpu] of [['WebGPU', true], ['WebGL2', false]]) {
   }
   await browser.close();
 }
-console.log(JSON.stringify(out, null, 1));
+console.log(JSON.stringify(out));
