@@ -131,7 +131,7 @@ function applyState(s) {
   lastFaces = m.faces;
   lastPhase = m.phase;
   lastMetrics = m;
-  stepLog.push({ phase: m.phase, faces: m.faces, ms: m.ms, at: performance.now() });
+  stepLog.push({ phase: m.phase, layer: m.layer, iteration: m.iteration, faces: m.faces, maxPlanarity: m.maxPlanarity, steps: s.steps, ms: m.ms, at: performance.now() });
   if (stepLog.length > 5000) stepLog.shift();
   showMetrics(metricsEl, m, config);
   drawHistogram($('histogram'), m);

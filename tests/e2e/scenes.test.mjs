@@ -20,6 +20,7 @@ test('every contract scene steps to completion with planar faces', async () => {
     const times = {};
     for (const scene of ONLY ?? [...PHEX, ...PQ]) {
       const t0 = Date.now();
+      await page.evaluate(() => window.dupin.stepLog.splice(0));
       await byId(page, 'scene-select').selectOption(scene);
       // The hash follows the worker's first state of the new scene.
       await page.waitForFunction((s) => new URLSearchParams(location.hash.slice(1)).get('scene') === s, scene, { timeout: 120_000 });
@@ -42,6 +43,14 @@ test('every contract scene steps to completion with planar faces', async () => {
         }
       }
       const m = await metrics(page);
+      // Every step the worker reported changed the metrics (each step is one state message).
+      const log = (await page.evaluate(() => window.dupin.stepLog)).filter((e, i, a) => i === 0 || e.steps !== a[i - 1].steps);
+      assert.equal(log.length, Number(m.steps), `${scene}: one state per step`);
+      for (let i = 1; i < log.length; i++) {
+        const [a, b] = [log[i - 1], log[i]];
+        const changed = ['phase', 'layer', 'iteration', 'faces', 'maxPlanarity'].some((k) => a[k] !== b[k]);
+        assert.ok(changed, `${scene}: step ${b.steps} left the metrics unchanged`);
+      }
       assert.ok(Number(m.faces) > 0, `${scene}: no faces`);
       assert.ok(Number(m.maxPlanarity) <= 1e-10, `${scene}: max planarity ${m.maxPlanarity}`);
       const last = await shot(page, `scene-${scene}`);
