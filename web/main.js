@@ -1,178 +1,210 @@
-// Dupin configurator: a thin shell. Geometry and rendering live in Rust (../crates/dupin-web);
-// this file wires DOM events, the URL hash and the frame loop.
-import init, { Session, Viewer, sceneNames, torusMesh } from './pkg/dupin_web.js';
+// Dupin configurator: a thin shell. Geometry lives in Rust (../crates/dupin-web): the solver's
+// `Session` runs in a module worker (worker.js), the wgpu `Viewer` draws here. This file wires
+// DOM events, the URL hash and the frame loop; the pieces are small modules:
+//   config.js (configuration <-> hash), controls.js (picker and fields), metrics.js (panel,
+//   histogram, legend), solver.js (worker client). Other tabs plug in through `window.dupin`.
+import init, { MeshData, Viewer, colorLegend, freeDefaults, sceneNames, surfaceCatalog, torusMesh } from './pkg/dupin_web.js';
+import { FREE, defaults, readHash, sessionConfig, writeHash } from './config.js';
+import { buildFields, clearFieldErrors, fillScenePicker, showFieldError } from './controls.js';
+import { drawHistogram, drawLegend, showMetrics } from './metrics.js';
+import { Solver } from './solver.js';
 
-const $ = (id) => document.querySelector(`[data-testid="${id}"]`) ?? document.getElementById(id);
+const $ = (id) => document.querySelector(`[data-testid="${id}"]`);
 const statusEl = $('status');
 const metricsEl = $('metrics');
 const canvas = $('canvas');
+const fieldsBox = document.getElementById('params');
 
-// Scenes available in this build. Each has typed parameters shown as numeric fields.
-const SCENES = {
-  torus: {
-    label: 'Torus (surface preview)',
-    params: { R: { label: 'R', value: 2, min: 0.05, max: 100 }, r: { label: 'r', value: 0.7, min: 0.01, max: 100 } },
-    build: (p) => torusMesh(p.R, p.r, 96, 48),
-  },
-};
+const TORUS = { R: { label: 'R', value: 2 }, r: { label: 'r', value: 0.7 } };
 
 let viewer = null;
-let mesh = null;        // MeshData on screen
-let session = null;     // Session of a stepped scene (null for the surface preview)
+let solver = null;
+let mesh = null;          // MeshData on screen
+let config = defaults();  // what is on screen (last configuration that loaded)
+let running = false;      // a stepped scene or free configuration is loaded in the worker
 let playing = false;
+let done = true;
 let dirty = true;
+let lastFaces = 0;
+let lastPhase = '';
+let userMoved = false;
+let pendingCamera = null; // camera from a restored URL, applied with the first mesh
+let ctx = null;           // { scenes, catalog, defaults }
+let lastMetrics = null;   // metrics on screen (redrawn when the panel edge changes)
+const stepLog = [];      // per-step { phase, faces, ms } for benchmarks (window.dupin.stepLog)
+let settled = false;      // something was shown or reported (the first frame may count as ready)
 
 function showStatus(text, isError = false) {
   statusEl.textContent = text;
   statusEl.classList.toggle('error', isError);
 }
 
-function showMetrics(m) {
-  metricsEl.dataset.phase = m.phase;
-  metricsEl.dataset.iteration = String(m.iteration);
-  metricsEl.dataset.faces = String(m.faces);
-  metricsEl.dataset.maxPlanarity = String(m.maxPlanarity);
-  const rows = [['phase', m.phase], ['layer', m.layer ?? 0], ['iteration', m.iteration], ['faces', m.faces],
-    ['vertices', m.vertices], ['max planarity', m.maxPlanarity.toExponential(2)],
-    ['invalid faces', m.invalidFaces ?? 0], ['step time', m.ms === undefined ? '–' : `${m.ms.toFixed(1)} ms`]];
-  metricsEl.replaceChildren(...rows.flatMap(([k, v]) => {
-    const dt = document.createElement('dt'); dt.textContent = k;
-    const dd = document.createElement('dd'); dd.textContent = String(v);
-    return [dt, dd];
-  }));
-}
-
-// ---- configuration <-> URL hash -------------------------------------------------------------
-function readHash() {
-  const h = new URLSearchParams(location.hash.slice(1));
-  const name = h.get('scene');
-  const scene = SCENES[name] || STEPPED.includes(name) ? name : 'torus';
-  const params = {};
-  for (const [k, spec] of Object.entries(SCENES[scene]?.params ?? {})) {
-    const v = Number(h.get(k));
-    params[k] = h.has(k) && Number.isFinite(v) ? v : spec.value;
-  }
-  return { scene, params, backend: h.get('backend') === 'webgl2' ? 'webgl2' : 'auto' };
-}
-
-function writeHash(cfg) {
-  const h = new URLSearchParams({ scene: cfg.scene, ...cfg.params });
-  if (cfg.backend !== 'auto') h.set('backend', cfg.backend);
-  history.replaceState(null, '', '#' + h.toString());
-}
-
-let config = { scene: 'torus', params: {}, backend: 'auto' };
-
-function buildControls() {
-  const select = $('scene-select');
-  const preview = Object.entries(SCENES).map(([name, s]) => new Option(s.label, name));
-  const stepped = STEPPED.map((name) => new Option(name, name));
-  select.replaceChildren(...preview, ...stepped);
-  select.value = config.scene;
-  const box = document.getElementById('params');
-  box.replaceChildren();
-  for (const [k, spec] of Object.entries(SCENES[config.scene]?.params ?? {})) {
-    const label = document.createElement('label');
-    label.textContent = spec.label;
-    const input = document.createElement('input');
-    Object.assign(input, { type: 'number', step: 'any', min: spec.min, max: spec.max, value: config.params[k] });
-    input.dataset.testid = `param-${k}`;
-    const msg = document.createElement('span');
-    msg.className = 'field-error';
-    input.addEventListener('change', () => {
-      const v = Number(input.value);
-      const ok = input.value.trim() !== '' && Number.isFinite(v) && v >= spec.min && v <= spec.max;
-      input.classList.toggle('invalid', !ok);
-      msg.textContent = ok ? '' : `${spec.label} must be a number in [${spec.min}, ${spec.max}]`;
-      if (ok) { config.params[k] = v; writeHash(config); loadScene(false); }
-    });
-    label.append(input, msg);
-    box.append(label);
-  }
-}
-
-function showError(e) {
-  showStatus(`${viewer.backend} · ${e.message ?? e}`, true);
-}
+function syncHash() { history.replaceState(null, '', writeHash(config)); }
 
 function showMesh(next, reframe) {
   viewer.setMesh(next, reframe);
   mesh?.free();
   mesh = next;
+  settled = true;
+  if (pendingCamera) {
+    viewer.setCamera(pendingCamera);
+    pendingCamera = null;
+    userMoved = true;
+  }
   dirty = true;
 }
 
-// Selecting a scene starts it from its first step; the surface preview is computed at once.
-function loadScene(reframe) {
-  setPlaying(false);
-  session?.free();
-  session = null;
-  lastFaces = 0;
-  lastPhase = '';
-  userMoved = false;
-  try {
-    if (SCENES[config.scene]) {
-      showMesh(SCENES[config.scene].build(config.params), reframe);
-      showMetrics({ phase: 'done', iteration: 0, faces: mesh.triangleCount, vertices: mesh.vertexCount, maxPlanarity: 0 });
-    } else {
-      session = new Session({ scene: config.scene });
-      step(reframe);
-    }
-    showStatus(viewer.backend);
-  } catch (e) {
-    showError(e);
-  }
-  updateButtons();
+function updateButtons() {
+  $('step').disabled = !running || done;
+  $('play').disabled = !running || done;
+  $('reset').disabled = !running;
+  $('play').textContent = playing ? 'Pause' : 'Play';
+  for (const id of ['export-json', 'export-svg']) $(id).disabled = !running;
 }
 
-function step(reframe = false) {
-  if (!session) return;
+// ---- loading a configuration -----------------------------------------------------------------
+/** Shows configuration `next`; `field` names the input that changed (its errors go there). */
+function load(next, { reframe = true, field = null } = {}) {
+  if (next.scene === 'torus') {
+    try {
+      const m = torusMesh(next.params.R, next.params.r, 96, 48);
+      solver.post('pause');
+      solver.gen += 1; // drop anything the worker still sends for the previous run
+      running = false; playing = false; done = true;
+      config = next;
+      showMesh(m, reframe);
+      lastMetrics = { phase: 'done', iteration: 0, faces: m.triangleCount, vertices: m.vertexCount, maxPlanarity: 0 };
+      showMetrics(metricsEl, lastMetrics, config);
+      drawHistogram($('histogram'), {});
+      if (field) showFieldError(fieldsBox, field, '');
+      showStatus(viewer.backend);
+      syncHash();
+    } catch (e) {
+      reportError(e.message ?? String(e), field);
+    }
+    updateButtons();
+    return;
+  }
+  lastFaces = 0;
+  lastPhase = '';
+  userMoved = !!pendingCamera;
+  candidate = { config: next, field, reframe };
+  solver.load(sessionConfig(next), { steps: next.steps, mode: next.color, field });
+}
+let candidate = null; // configuration sent to the worker, not yet confirmed
+
+function onState(s) {
+  const t0 = performance.now();
+  try { applyState(s); } finally { noteTask('state', t0); }
+}
+
+// Main-thread work per worker message and per frame over 16 ms (window.dupin.slowTasks), to
+// find what a long task was.
+const slowTasks = [];
+function noteTask(what, t0) {
+  const ms = performance.now() - t0;
+  if (ms > 16 && slowTasks.length < 1000) slowTasks.push({ what, ms: Math.round(ms), faces: lastFaces });
+}
+
+function applyState(s) {
+  if (candidate) {
+    config = candidate.config;
+    if (candidate.field) showFieldError(fieldsBox, candidate.field, '');
+    candidate = null;
+    running = true;
+    showStatus(viewer.backend);
+  }
+  const m = s.metrics;
+  m.steps = s.steps;
+  config.steps = s.steps;
+  done = s.done;
+  playing = s.playing;
   try {
-    const t = performance.now();
-    const m = session.step();
-    m.ms = performance.now() - t;
+    const next = MeshData.fromArrays(s.mesh.positions, s.mesh.normals, s.mesh.indices, s.mesh.colors, s.mesh.edges);
     // Frame the growing mesh at its first step and once more when its last layer is in, unless
     // the user has taken the camera.
     const grown = lastPhase === 'triangulation' && m.phase !== 'triangulation';
-    showMesh(session.mesh(), reframe || lastFaces === 0 || (grown && !userMoved));
-    lastFaces = m.faces;
-    lastPhase = m.phase;
-    showMetrics(m);
+    showMesh(next, lastFaces === 0 ? !userMoved : grown && !userMoved);
   } catch (e) {
-    setPlaying(false);
-    showError(e);
+    showStatus(`${viewer.backend} · ${e.message ?? e}`, true);
+  }
+  lastFaces = m.faces;
+  lastPhase = m.phase;
+  lastMetrics = m;
+  stepLog.push({ phase: m.phase, layer: m.layer, iteration: m.iteration, faces: m.faces, maxPlanarity: m.maxPlanarity, steps: s.steps, ms: m.ms, at: performance.now() });
+  if (stepLog.length > 5000) stepLog.shift();
+  showMetrics(metricsEl, m, config);
+  drawHistogram($('histogram'), m);
+  syncHash();
+  updateButtons();
+  if (playing) requestAnimationFrame(() => solver.post('ack'));
+}
+
+function reportError(message, field) {
+  settled = true;
+  if (!(field && showFieldError(fieldsBox, field, message))) showStatus(`${viewer.backend} · ${message}`, true);
+}
+
+function onError(e) {
+  playing = false;
+  if (e.load) {
+    const field = candidate?.field ?? e.field;
+    candidate = null;
+    reportError(e.message, field);
+  } else {
+    reportError(e.message, e.field);
   }
   updateButtons();
 }
-let lastFaces = 0;
-let lastPhase = '';
-let userMoved = false;
 
-function setPlaying(on) {
-  playing = on && !!session && !session.done();
-  $('play').textContent = playing ? 'Pause' : 'Play';
-  if (playing) setTimeout(playLoop, 0);
+// ---- downloads ---------------------------------------------------------------------------------
+function download(name, data, type) {
+  const url = URL.createObjectURL(data instanceof Blob ? data : new Blob([data], { type }));
+  const a = Object.assign(document.createElement('a'), { href: url, download: name });
+  a.click();
+  setTimeout(() => URL.revokeObjectURL(url), 1000);
 }
 
-function playLoop() {
-  if (!playing) return;
-  step();
-  if (session?.done()) setPlaying(false);
-  else setTimeout(playLoop, 30);
+const EXPORT_TYPES = { obj: 'text/plain', json: 'application/json', svg: 'image/svg+xml' };
+function onExport(m) {
+  const name = config.scene === FREE ? `free-${config.free.surface}` : config.scene;
+  download(`${name}.${m.kind}`, m.text, EXPORT_TYPES[m.kind]);
 }
 
-function updateButtons() {
-  const stepped = !!session;
-  $('step').disabled = !stepped || session.done();
-  $('play').disabled = !stepped || session.done();
-  $('reset').disabled = !stepped;
+/** Renders the view at `scale` x the canvas size on the GPU and returns a PNG blob. */
+async function snapshotPng(scale = 1) {
+  const image = await viewer.snapshot(scale);
+  const c = new OffscreenCanvas(image.width, image.height);
+  c.getContext('2d').putImageData(image, 0, 0);
+  return c.convertToBlob({ type: 'image/png' });
 }
 
-// ---- orbit: mouse drag, wheel, touch (one finger orbits, two pinch) --------------------------
+// For tests and scripting: pixels as the page draws them (headless Chromium composites no WebGPU
+// canvas into its own screenshots), and hooks for other tabs.
+window.dupin = {
+  snapshotDataUrl: async (scale = 1) => {
+    const blob = await snapshotPng(scale);
+    return new Promise((resolve) => { const r = new FileReader(); r.onload = () => resolve(r.result); r.readAsDataURL(blob); });
+  },
+  get viewer() { return viewer; },
+  get config() { return config; },
+  requestRedraw: () => { dirty = true; },
+  stepLog,
+  slowTasks,
+};
+
+// ---- orbit: mouse drag, wheel, touch (one finger orbits, two pinch) ---------------------------
+function cameraMoved() {
+  userMoved = true;
+  dirty = true;
+  clearTimeout(cameraMoved.timer);
+  cameraMoved.timer = setTimeout(() => { config.camera = Array.from(viewer.camera()); syncHash(); }, 150);
+}
+
 function wireInput() {
   const pointers = new Map();
   let pinch = 0;
-  canvas.addEventListener('pointerdown', (e) => { canvas.setPointerCapture(e.pointerId); pointers.set(e.pointerId, e); userMoved = true; });
+  canvas.addEventListener('pointerdown', (e) => { canvas.setPointerCapture(e.pointerId); pointers.set(e.pointerId, e); });
   canvas.addEventListener('pointermove', (e) => {
     const prev = pointers.get(e.pointerId);
     if (!prev) return;
@@ -185,12 +217,12 @@ function wireInput() {
       if (pinch > 0) viewer.zoom(pinch / d);
       pinch = d;
     }
-    dirty = true;
+    cameraMoved();
   });
   const up = (e) => { pointers.delete(e.pointerId); pinch = 0; };
   canvas.addEventListener('pointerup', up);
   canvas.addEventListener('pointercancel', up);
-  canvas.addEventListener('wheel', (e) => { e.preventDefault(); userMoved = true; viewer.zoom(Math.exp(e.deltaY * 0.001)); dirty = true; }, { passive: false });
+  canvas.addEventListener('wheel', (e) => { e.preventDefault(); viewer.zoom(Math.exp(e.deltaY * 0.001)); cameraMoved(); }, { passive: false });
 }
 
 function frame() {
@@ -201,9 +233,11 @@ function frame() {
   viewer.poll();
   if (dirty) {
     dirty = false;
+    const t0 = performance.now();
     try {
       viewer.render();
-      if (document.body.dataset.ready !== 'true') {
+      noteTask('render', t0);
+      if (document.body.dataset.ready !== 'true' && settled) {
         document.body.dataset.firstFrameMs = performance.now().toFixed(0);
         document.body.dataset.ready = 'true';
       }
@@ -214,68 +248,101 @@ function frame() {
   requestAnimationFrame(frame);
 }
 
-/** Renders the view at `scale` x the canvas size on the GPU and returns a PNG blob. */
-async function snapshotPng(scale = 1) {
-  const image = await viewer.snapshot(scale);
-  const c = new OffscreenCanvas(image.width, image.height);
-  c.getContext('2d').putImageData(image, 0, 0);
-  return c.convertToBlob({ type: 'image/png' });
+// ---- controls -----------------------------------------------------------------------------------
+function rebuildFields() {
+  buildFields(fieldsBox, config, {
+    catalog: ctx.catalog,
+    torusParams: TORUS,
+    defaults: ctx.defaults,
+    // One field changed: try the current configuration with that change; the core decides.
+    onChange: (apply, field, rebuild = false) => {
+      const next = structuredClone(config);
+      apply(next);
+      next.steps = 1;
+      next.camera = null;
+      if (rebuild) { config = next; rebuildFields(); }
+      load(next, { reframe: true, field });
+    },
+  });
 }
 
-// For tests and scripting: pixels as the page draws them (headless Chromium composites no WebGPU
-// canvas into its own screenshots).
-window.dupin = {
-  snapshotDataUrl: async (scale = 1) => {
-    const blob = await snapshotPng(scale);
-    return new Promise((resolve) => { const r = new FileReader(); r.onload = () => resolve(r.result); r.readAsDataURL(blob); });
-  },
-};
-
-function download(name, data, type) {
-  const url = URL.createObjectURL(data instanceof Blob ? data : new Blob([data], { type }));
-  const a = Object.assign(document.createElement('a'), { href: url, download: name });
-  a.click();
-  setTimeout(() => URL.revokeObjectURL(url), 1000);
+function setColorMode(mode) {
+  config.color = mode;
+  drawLegend($('legend'), colorLegend(mode));
+  if (running) solver.post('mode', { mode });
+  syncHash();
 }
 
-let STEPPED = [];
+function restore(hash) {
+  const next = readHash(hash, { scenes: ctx.scenes, catalog: ctx.catalog, torusParams: TORUS });
+  config = { ...next, steps: 1 };
+  pendingCamera = next.camera;
+  $('scene-select').value = next.scene;
+  $('color-mode').value = next.color;
+  $('panel-edge').classList.remove('invalid');
+  $('panel-edge-error').textContent = '';
+  $('panel-edge').value = String(next.panelEdge);
+  drawLegend($('legend'), colorLegend(next.color));
+  clearFieldErrors(fieldsBox);
+  rebuildFields();
+  load(next, { reframe: !next.camera });
+}
 
 async function main() {
   try {
     await init();
-    STEPPED = sceneNames();
-    config = readHash();
+    ctx = { scenes: sceneNames(), catalog: surfaceCatalog(), defaults: freeDefaults() };
+    solver = new Solver({ onState, onError, onExport });
+    const backend = readHash(location.hash, { scenes: ctx.scenes, catalog: ctx.catalog, torusParams: TORUS }).backend;
     canvas.width = Math.max(1, canvas.clientWidth);
     canvas.height = Math.max(1, canvas.clientHeight);
-    viewer = await Viewer.create(canvas, config.backend === 'webgl2');
+    viewer = await Viewer.create(canvas, backend === 'webgl2');
+    await solver.ready;
   } catch (e) {
     showStatus(`Cannot start: ${e.message ?? e}`, true);
     return;
   }
-  buildControls();
+  fillScenePicker($('scene-select'), ctx.scenes);
   $('scene-select').addEventListener('change', (e) => {
-    config = { scene: e.target.value, params: {}, backend: config.backend };
-    for (const [k, s] of Object.entries(SCENES[config.scene]?.params ?? {})) config.params[k] = s.value;
-    writeHash(config);
-    buildControls();
-    loadScene(true);
+    const next = defaults();
+    Object.assign(next, { scene: e.target.value, color: config.color, panelEdge: config.panelEdge, backend: config.backend });
+    if (next.scene === 'torus') for (const [k, s] of Object.entries(TORUS)) next.params[k] = s.value;
+    if (next.scene === FREE) {
+      const s = ctx.catalog.find((x) => x.name === next.free.surface) ?? ctx.catalog[0];
+      next.free.surface = s.name;
+      for (const p of s.params) next.params[p.key] = p.default;
+    }
+    config = next;
+    rebuildFields();
+    load(next, { reframe: true });
   });
-  window.addEventListener('hashchange', () => { config = readHash(); buildControls(); loadScene(true); });
-  $('step').addEventListener('click', () => { setPlaying(false); step(); });
-  $('play').addEventListener('click', () => setPlaying(!playing));
-  $('reset').addEventListener('click', () => loadScene(true));
+  window.addEventListener('hashchange', () => { if (location.hash !== writeHash(config)) restore(location.hash); });
+  $('step').addEventListener('click', () => solver.post('step'));
+  $('play').addEventListener('click', () => { solver.post(playing ? 'pause' : 'play'); playing = !playing; updateButtons(); });
+  $('reset').addEventListener('click', () => { if (running) load({ ...config, steps: 1 }, { reframe: true }); });
+  $('color-mode').addEventListener('change', (e) => setColorMode(e.target.value));
+  $('panel-edge').addEventListener('change', (e) => {
+    const v = Number(e.target.value);
+    const ok = e.target.value.trim() !== '' && Number.isFinite(v) && v > 0;
+    const msg = $('panel-edge-error');
+    msg.textContent = ok ? '' : 'panel edge must be a positive length in metres';
+    e.target.classList.toggle('invalid', !ok);
+    if (!ok) return;
+    config.panelEdge = v;
+    if (lastMetrics) showMetrics(metricsEl, lastMetrics, config);
+    syncHash();
+  });
   $('export-obj').addEventListener('click', () => {
-    try {
-      const text = session ? session.exportObj() : mesh?.toObj();
-      if (text) download(`${config.scene}.obj`, text, 'text/plain');
-    } catch (e) { showError(e); }
+    if (running) solver.post('export', { kind: 'obj' });
+    else if (mesh) { try { onExport({ kind: 'obj', text: mesh.toObj() }); } catch (e) { showStatus(e.message, true); } }
   });
+  $('export-json').addEventListener('click', () => solver.post('export', { kind: 'json' }));
+  $('export-svg').addEventListener('click', () => solver.post('export', { kind: 'svg', panelEdge: config.panelEdge }));
   $('screenshot').addEventListener('click', async () => {
     try { download(`${config.scene}@2x.png`, await snapshotPng(2)); } catch (e) { showStatus(`${viewer.backend} · ${e.message ?? e}`, true); }
   });
-  writeHash(config);
   wireInput();
-  loadScene(true);
+  restore(location.hash);
   requestAnimationFrame(frame);
 }
 

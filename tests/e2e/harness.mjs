@@ -105,3 +105,37 @@ export async function drag(page, dx, dy) {
   for (let i = 1; i <= 8; i++) await page.mouse.move(x + (dx * i) / 8, y + (dy * i) / 8);
   await page.mouse.up();
 }
+
+/** Metrics as the page shows them (the `metrics` element's data attributes). */
+export async function metrics(page) {
+  return page.evaluate(() => ({ ...document.querySelector('[data-testid=metrics]').dataset }));
+}
+
+/** Waits until the metrics show `steps` steps taken (each worker state bumps it). */
+export async function waitSteps(page, steps, timeout = 120_000) {
+  await page.waitForFunction((n) => document.querySelector('[data-testid=metrics]').dataset.steps === String(n), steps, { timeout });
+}
+
+/** Waits for the run to finish (`data-phase` = `done`). */
+export async function waitDone(page, timeout = 180_000) {
+  await page.waitForFunction(() => document.querySelector('[data-testid=metrics]').dataset.phase === 'done', null, { timeout });
+}
+
+/** Clicks an export button and returns the downloaded text. */
+export async function exportText(page, id) {
+  const [download] = await Promise.all([page.waitForEvent('download'), byId(page, id).click()]);
+  return (await import('node:fs')).readFileSync(await download.path(), 'utf8');
+}
+
+/** Parses OBJ text strictly (only `v` and `f`); returns the counts. */
+export function parseObj(text) {
+  const lines = text.split('\n').filter(Boolean);
+  const v = lines.filter((l) => l.startsWith('v ')), f = lines.filter((l) => l.startsWith('f '));
+  if (v.length + f.length !== lines.length) throw new Error('OBJ has statements other than v and f');
+  for (const l of v) if (l.split(' ').slice(1).map(Number).filter(Number.isFinite).length !== 3) throw new Error(`bad vertex ${l}`);
+  for (const l of f) {
+    const idx = l.split(' ').slice(1).map(Number);
+    if (!(idx.length >= 3 && idx.every((i) => Number.isInteger(i) && i >= 1 && i <= v.length))) throw new Error(`bad face ${l}`);
+  }
+  return { vertices: v.length, faces: f.length };
+}

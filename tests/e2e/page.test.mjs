@@ -87,11 +87,11 @@ test('bad input shows an inline message and leaves the page usable', async () =>
     const faces = await byId(page, 'metrics').getAttribute('data-faces');
     await byId(page, 'param-R').fill('-5');
     await byId(page, 'param-R').dispatchEvent('change');
-    assert.match(await page.locator('.field-error').first().textContent(), /R must be a number/);
+    assert.match(await byId(page, 'param-R-error').textContent(), /R must be a positive number/);
     assert.equal(await byId(page, 'metrics').getAttribute('data-faces'), faces);
     await byId(page, 'param-R').fill('4');
     await byId(page, 'param-R').dispatchEvent('change');
-    assert.equal(await page.locator('.field-error').first().textContent(), '');
+    assert.equal(await byId(page, 'param-R-error').textContent(), '');
     assert.match(page.url(), /R=4/);
     assert.equal((await byId(page, 'status').textContent()).trim(), 'WebGPU');
     assert.deepEqual(errors, []);
@@ -99,34 +99,3 @@ test('bad input shows an inline message and leaves the page usable', async () =>
     await browser.close();
   }
 });
-
-// Stepped scenes: select, play to the end, check the contract metrics and the exported OBJ.
-const PLAYED = (process.env.DUPIN_SCENES ?? 'cyclide-architecture,torus-bound,conical-station,pq-catmull-clark').split(',');
-for (const scene of PLAYED) {
-  test(`scene ${scene} plays to completion with planar faces`, async () => {
-    const { browser, page, errors } = await openPage();
-    try {
-      await byId(page, 'scene-select').selectOption(scene);
-      const m = byId(page, 'metrics');
-      const oneStep = (await m.getAttribute('data-phase')) === 'done'; // PQ scenes: one step
-      const before = await shot(page, `scene-${scene}-first-step`);
-      if (!oneStep) await byId(page, 'play').click();
-      await page.waitForFunction(() => document.querySelector('[data-testid=metrics]').dataset.phase === 'done', null, { timeout: 120_000 });
-      const faces = Number(await m.getAttribute('data-faces'));
-      const planarity = Number(await m.getAttribute('data-max-planarity'));
-      assert.ok(faces > 0);
-      assert.ok(planarity <= 1e-10, `max planarity ${planarity}`);
-      const after = await shot(page, `scene-${scene}`);
-      const { covered, differing } = await pixelStats(page, after, before);
-      assert.ok(covered > 0.05, `only ${(covered * 100).toFixed(1)}% covered`);
-      if (!oneStep) assert.ok(differing > 0.001, 'the picture did not change from the first step to the end');
-      assert.match(page.url(), new RegExp(`scene=${scene}`));
-      const [download] = await Promise.all([page.waitForEvent('download'), byId(page, 'export-obj').click()]);
-      const text = (await import('node:fs')).readFileSync(await download.path(), 'utf8');
-      assert.equal(text.split('\n').filter((l) => l.startsWith('f ')).length, faces);
-      assert.deepEqual(errors, []);
-    } finally {
-      await browser.close();
-    }
-  });
-}

@@ -37,6 +37,7 @@ mod mesh;
 mod mesh_topology;
 mod obj;
 mod offset;
+mod panel_schedule;
 mod phex;
 mod planarity;
 mod point_set;
@@ -80,6 +81,9 @@ pub use mesh::{MeshError, PolyMesh};
 pub use mesh_topology::{MeshTopology, TopologyError};
 pub use obj::{ObjError, parse_obj, write_obj};
 pub use offset::{OffsetError, offset_mesh};
+pub use panel_schedule::{
+    FlatPanel, PanelSchedule, PanelScheduleError, SheetOptions, panel_schedule, panel_schedule_svg,
+};
 pub use phex::{
     ConjugateFields, DualMesh, FREEFORM, FaceInfo, FreeformSurface, Initialisation, LayerRule,
     PARABOLIC_THRESHOLD, PHEX_SCENES, PhexConfig, PhexError, PhexMetrics, PhexPhase, PhexPipeline,

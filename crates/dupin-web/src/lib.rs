@@ -12,7 +12,7 @@ mod session;
 mod viewer;
 
 pub use mesh_data::{MeshData, torus_mesh};
-pub use session::{Session, scene_names};
+pub use session::{Session, color_legend, free_defaults, scene_names, surface_catalog_js};
 #[cfg(target_arch = "wasm32")]
 pub use viewer::Viewer;
 

@@ -44,6 +44,50 @@ impl MeshData {
 
 #[wasm_bindgen]
 impl MeshData {
+    /// Rebuilds a mesh from the typed arrays of its getters (how a Web Worker hands render
+    /// buffers to the page's thread). Throws when the lengths do not fit together or an index
+    /// is out of range.
+    #[wasm_bindgen(js_name = fromArrays)]
+    pub fn from_arrays(
+        positions: Vec<f32>,
+        normals: Vec<f32>,
+        indices: Vec<u32>,
+        colors: Vec<f32>,
+        edges: Vec<f32>,
+    ) -> Result<MeshData, JsError> {
+        let n = positions.len();
+        if !n.is_multiple_of(3)
+            || normals.len() != n
+            || !indices.len().is_multiple_of(3)
+            || !edges.len().is_multiple_of(6)
+        {
+            return Err(JsError::new(
+                "mesh arrays: positions and normals need 3 floats a vertex, indices 3 a triangle, edges 6 a segment",
+            ));
+        }
+        if !colors.is_empty() && colors.len() != n {
+            return Err(JsError::new(
+                "mesh arrays: colors need 3 floats a vertex (or none)",
+            ));
+        }
+        if let Some(&i) = indices.iter().find(|&&i| i as usize >= n / 3) {
+            return Err(JsError::new(&format!(
+                "mesh arrays: index {i} out of range for {} vertices",
+                n / 3
+            )));
+        }
+        Ok(MeshData {
+            buffers: TriangleBuffers {
+                positions,
+                normals,
+                indices,
+            },
+            colors,
+            edges,
+            panels: None,
+        })
+    }
+
     /// Vertex positions, x y z per vertex.
     #[wasm_bindgen(getter)]
     pub fn positions(&self) -> js_sys::Float32Array {

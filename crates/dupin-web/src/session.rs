@@ -2,15 +2,17 @@
 
 use crate::mesh_data::MeshData;
 use dupin_core::{
-    PHEX_SCENES, PQ_SCENES, PhexConfig, PhexPipeline, PolyMesh, TriangulationMethod, face_info,
-    face_planarity, max_planarity, phex_scene, pq_scene, write_obj,
+    Initialisation, LayerRule, PHEX_SCENES, PQ_SCENES, PhexConfig, PhexPipeline, PolyMesh,
+    SheetOptions, TriangulationMethod, face_info, face_planarity, max_planarity, panel_schedule,
+    panel_schedule_svg, phex_scene, pq_scene, surface_catalog, write_obj,
 };
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use wasm_bindgen::prelude::*;
 
-/// `new Session(config)`: `{ scene }` or `{ surface, params, method, size }`.
-#[derive(Deserialize)]
+/// `new Session(config)`: `{ scene }` or `{ surface, params, method, size, bound, lambda, mu,
+/// init }`.
+#[derive(Deserialize, Serialize, Clone)]
 #[serde(deny_unknown_fields)]
 struct SessionConfig {
     scene: Option<String>,
@@ -19,10 +21,25 @@ struct SessionConfig {
     params: BTreeMap<String, f64>,
     method: Option<String>,
     size: Option<f64>,
+    /// Parabolic lower bound b (section 5.3).
+    bound: Option<f64>,
+    /// Initial fairness weight (section 7).
+    lambda: Option<f64>,
+    /// Initial surface-distance weight (section 7).
+    mu: Option<f64>,
+    /// Hexagon initialisation: `tangent-duality` (default, section 4.1) or `dupin-duality`
+    /// (section 6; starts non-planar, so the optimisation runs).
+    init: Option<String>,
 }
 
+/// Histogram bins of log10(face planarity): `HIST_BINS` bins over [HIST_LO, HIST_HI]; values
+/// below and above land in the first and last bin.
+const HIST_BINS: usize = 14;
+const HIST_LO: f64 = -16.0;
+const HIST_HI: f64 = -2.0;
+
 /// What `step()` and `metrics()` return.
-#[derive(Serialize, Clone, Copy)]
+#[derive(Serialize, Clone)]
 #[serde(rename_all = "camelCase")]
 struct Metrics {
     phase: &'static str,
@@ -31,7 +48,12 @@ struct Metrics {
     faces: usize,
     vertices: usize,
     max_planarity: f64,
+    mean_planarity: f64,
     invalid_faces: usize,
+    /// Face counts per bin of log10(planarity), see `histLog10`.
+    histogram: Vec<u32>,
+    /// `[lo, hi]` of the histogram's log10 axis.
+    hist_log10: [f64; 2],
 }
 
 enum Run {
@@ -48,6 +70,7 @@ enum Run {
 #[wasm_bindgen]
 pub struct Session {
     run: Run,
+    config: SessionConfig,
 }
 
 /// Every scene a `Session` accepts: the P-Hex scenes, then the PQ scenes.
@@ -58,6 +81,148 @@ pub fn scene_names() -> Vec<String> {
         .chain(PQ_SCENES)
         .map(|s| s.to_string())
         .collect()
+}
+
+#[derive(Serialize)]
+struct ParamOut {
+    key: &'static str,
+    default: f64,
+    min: f64,
+    max: f64,
+    integer: bool,
+    doc: &'static str,
+}
+
+#[derive(Serialize)]
+struct SurfaceOut {
+    name: &'static str,
+    parametrisation: &'static str,
+    params: Vec<ParamOut>,
+}
+
+/// The core's surface library for the free mode: `[{ name, parametrisation, params: [{ key,
+/// default, min, max, integer, doc }] }]` (ranges are the registry's, inclusive).
+#[wasm_bindgen(js_name = surfaceCatalog)]
+pub fn surface_catalog_js() -> Result<JsValue, JsError> {
+    let list: Vec<SurfaceOut> = surface_catalog()
+        .iter()
+        .map(|s| SurfaceOut {
+            name: s.name,
+            parametrisation: s.parametrisation,
+            params: s
+                .params
+                .iter()
+                .map(|p| ParamOut {
+                    key: p.key,
+                    default: p.default,
+                    min: p.min,
+                    max: p.max,
+                    integer: p.integer,
+                    doc: p.doc,
+                })
+                .collect(),
+        })
+        .collect();
+    to_js(&list)
+}
+
+/// The free mode's defaults: `{ bound, lambda, mu }` as the core uses them.
+#[wasm_bindgen(js_name = freeDefaults)]
+pub fn free_defaults() -> Result<JsValue, JsError> {
+    let c = PhexConfig::for_surface("torus", &[], TriangulationMethod::Progressive, None);
+    let bound = match c.rule {
+        LayerRule::Ideal { bound } => bound,
+        _ => 0.3,
+    };
+    #[derive(Serialize)]
+    struct D {
+        bound: f64,
+        lambda: f64,
+        mu: f64,
+    }
+    to_js(&D {
+        bound,
+        lambda: c.lambda,
+        mu: c.mu,
+    })
+}
+
+/// Colour stops of a colour mode for the page's legend: `[{ label, color: [r, g, b] }]` (linear
+/// RGB in 0..1, the same colours the panels get).
+#[wasm_bindgen(js_name = colorLegend)]
+pub fn color_legend(mode: &str) -> Result<JsValue, JsError> {
+    #[derive(Serialize)]
+    struct Stop {
+        label: String,
+        color: [f32; 3],
+    }
+    let stops: Vec<Stop> = match ColorMode::parse(mode)? {
+        ColorMode::Planarity => [-12.0, -9.5, -7.0, -4.5, -2.0]
+            .iter()
+            .map(|&e| Stop {
+                label: format!("1e{e}"),
+                color: planarity_color(10f64.powf(e)),
+            })
+            .collect(),
+        ColorMode::Convexity => vec![
+            Stop {
+                label: "convex".into(),
+                color: CONVEX,
+            },
+            Stop {
+                label: "non-convex".into(),
+                color: NONCONVEX,
+            },
+            Stop {
+                label: "self-intersecting".into(),
+                color: INVALID,
+            },
+        ],
+        ColorMode::Regularity => {
+            let mut v: Vec<Stop> = [0.0, 0.1, 0.2, 0.3, 0.4]
+                .iter()
+                .map(|&d| Stop {
+                    label: format!("{d:.1}"),
+                    color: regularity_color(d),
+                })
+                .collect();
+            v.push(Stop {
+                label: "not a hexagon".into(),
+                color: NOT_HEX,
+            });
+            v
+        }
+    };
+    to_js(&stops)
+}
+
+fn to_js<T: Serialize>(v: &T) -> Result<JsValue, JsError> {
+    v.serialize(&serde_wasm_bindgen::Serializer::json_compatible())
+        .map_err(|e| JsError::new(&e.to_string()))
+}
+
+fn err(e: impl std::fmt::Display) -> JsError {
+    JsError::new(&e.to_string())
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum ColorMode {
+    Planarity,
+    Convexity,
+    Regularity,
+}
+
+impl ColorMode {
+    fn parse(s: &str) -> Result<Self, JsError> {
+        match s {
+            "" | "planarity" => Ok(ColorMode::Planarity),
+            "convexity" => Ok(ColorMode::Convexity),
+            "regularity" => Ok(ColorMode::Regularity),
+            other => Err(JsError::new(&format!(
+                "colour mode must be `planarity`, `convexity` or `regularity`, not `{other}`"
+            ))),
+        }
+    }
 }
 
 #[wasm_bindgen]
@@ -74,10 +239,8 @@ impl Session {
                 iterations: 0,
             },
             (Some(scene), None) => {
-                let scene = phex_scene(scene).map_err(|e| JsError::new(&e.to_string()))?;
-                Run::Phex(Box::new(
-                    PhexPipeline::new(scene.config).map_err(|e| JsError::new(&e.to_string()))?,
-                ))
+                let scene = phex_scene(scene).map_err(err)?;
+                Run::Phex(Box::new(PhexPipeline::new(scene.config).map_err(err)?))
             }
             (None, Some(surface)) => {
                 let method = match cfg.method.as_deref().unwrap_or("progressive") {
@@ -89,11 +252,28 @@ impl Session {
                         )));
                     }
                 };
-                let params: Vec<(String, f64)> = cfg.params.into_iter().collect();
-                let config = PhexConfig::for_surface(surface, &params, method, cfg.size);
-                Run::Phex(Box::new(
-                    PhexPipeline::new(config).map_err(|e| JsError::new(&e.to_string()))?,
-                ))
+                let params: Vec<(String, f64)> =
+                    cfg.params.iter().map(|(k, v)| (k.clone(), *v)).collect();
+                let mut config = PhexConfig::for_surface(surface, &params, method, cfg.size);
+                if let Some(b) = cfg.bound {
+                    config.rule = LayerRule::Ideal { bound: b };
+                }
+                if let Some(l) = cfg.lambda {
+                    config.lambda = l;
+                }
+                if let Some(m) = cfg.mu {
+                    config.mu = m;
+                }
+                config.initialisation = match cfg.init.as_deref().unwrap_or("tangent-duality") {
+                    "tangent-duality" => Initialisation::TangentDuality,
+                    "dupin-duality" => Initialisation::DupinDuality,
+                    other => {
+                        return Err(JsError::new(&format!(
+                            "init must be `tangent-duality` or `dupin-duality`, not `{other}`"
+                        )));
+                    }
+                };
+                Run::Phex(Box::new(PhexPipeline::new(config).map_err(err)?))
             }
             _ => {
                 return Err(JsError::new(
@@ -101,7 +281,7 @@ impl Session {
                 ));
             }
         };
-        Ok(Session { run })
+        Ok(Session { run, config: cfg })
     }
 
     /// Advances one observable step (a triangulation layer, the dual mesh, one Gauss-Newton
@@ -110,7 +290,7 @@ impl Session {
         match &mut self.run {
             Run::Phex(p) => {
                 if !p.done() {
-                    p.step().map_err(|e| JsError::new(&e.to_string()))?;
+                    p.step().map_err(err)?;
                 }
             }
             Run::Pq {
@@ -119,7 +299,7 @@ impl Session {
                 iterations,
             } => {
                 if mesh.is_none() {
-                    let r = pq_scene(name).map_err(|e| JsError::new(&e.to_string()))?;
+                    let r = pq_scene(name).map_err(err)?;
                     *iterations = r.iterations;
                     *mesh = Some(r.mesh);
                 }
@@ -136,10 +316,10 @@ impl Session {
         }
     }
 
-    /// `{ phase, layer, iteration, faces, vertices, maxPlanarity, invalidFaces }`.
+    /// `{ phase, layer, iteration, faces, vertices, maxPlanarity, meanPlanarity, invalidFaces,
+    /// histogram, histLog10 }`.
     pub fn metrics(&self) -> Result<JsValue, JsError> {
-        serde_wasm_bindgen::to_value(&self.metrics_struct())
-            .map_err(|e| JsError::new(&e.to_string()))
+        to_js(&self.metrics_struct())
     }
 
     /// The current mesh as OBJ text (faces at their true size).
@@ -150,14 +330,131 @@ impl Session {
             .unwrap_or_default()
     }
 
-    /// The current mesh for the viewer: flat panels coloured by planarity error (blue planar,
-    /// through white, to red at 1e-2 and above, on a log scale) and their edges.
-    pub fn mesh(&self) -> MeshData {
+    /// The current mesh and its report as JSON text: `{ config, metrics, report, mesh: {
+    /// vertices: [[x, y, z]], faces: [[i, ...]] } }` (0-based faces). The P-Hex report has the
+    /// contract's fields plus `per_face` (planarity, simple, convex, gaussian, shape_deviation).
+    #[wasm_bindgen(js_name = exportJson)]
+    pub fn export_json(&self) -> Result<String, JsError> {
+        let mesh = self.current_mesh().unwrap_or_default();
+        let metrics = self.metrics_struct();
+        let report = match &self.run {
+            Run::Phex(p) => p.report().map(|r| {
+                serde_json::json!({
+                    "vertices": r.vertices,
+                    "faces": r.faces,
+                    "face_sizes": r.face_sizes,
+                    "max_planarity": r.max_planarity,
+                    "invalid_faces": r.invalid_faces,
+                    "iterations": r.iterations,
+                    "max_surface_distance": r.max_surface_distance,
+                    "bbox_diagonal": r.bbox_diagonal,
+                    "per_face": r.per_face.iter().map(|f| serde_json::json!({
+                        "planarity": f.planarity,
+                        "simple": f.simple,
+                        "convex": f.convex,
+                        "gaussian": f.gaussian,
+                        "shape_deviation": f.shape_deviation,
+                    })).collect::<Vec<_>>(),
+                })
+            }),
+            Run::Pq { .. } => None,
+        };
+        let report = report.unwrap_or_else(|| {
+            let mut sizes = BTreeMap::new();
+            for i in 0..mesh.num_faces() {
+                *sizes.entry(mesh.face(i).len()).or_insert(0usize) += 1;
+            }
+            serde_json::json!({
+                "vertices": mesh.num_vertices(),
+                "faces": mesh.num_faces(),
+                "face_sizes": sizes,
+                "max_planarity": metrics.max_planarity,
+                "invalid_faces": metrics.invalid_faces,
+                "iterations": metrics.iteration,
+            })
+        });
+        let doc = serde_json::json!({
+            "config": self.config,
+            "metrics": metrics,
+            "report": report,
+            "mesh": {
+                "vertices": mesh.positions.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
+                "faces": (0..mesh.num_faces()).map(|i| mesh.face(i).to_vec()).collect::<Vec<_>>(),
+            },
+        });
+        serde_json::to_string(&doc).map_err(err)
+    }
+
+    /// The SVG panel schedule of the current mesh: every panel flattened into its plane,
+    /// numbered by face index, edge lengths in mm for panels scaled so the mean edge is
+    /// `panel_edge_m` metres, packed on square sheets (see `dupin_core::panel_schedule`).
+    #[wasm_bindgen(js_name = exportSvg)]
+    pub fn export_svg(&self, panel_edge_m: f64) -> Result<String, JsError> {
+        if !(panel_edge_m.is_finite() && panel_edge_m > 0.0) {
+            return Err(JsError::new(&format!(
+                "panel edge must be a positive length in metres, got {panel_edge_m}"
+            )));
+        }
+        let mesh = self.current_mesh().unwrap_or_default();
+        let sched = panel_schedule(
+            &mesh,
+            &SheetOptions {
+                sheet: None,
+                gap: None,
+            },
+        )
+        .map_err(err)?;
+        let mean_edge = mean_edge(&mesh);
+        let scale = if mean_edge > 0.0 {
+            panel_edge_m * 1000.0 / mean_edge
+        } else {
+            1.0
+        };
+        Ok(panel_schedule_svg(&sched, scale))
+    }
+
+    /// The current mesh for the viewer: flat panels coloured by `mode` (`planarity`: blue
+    /// planar, through white, to red at 1e-2 and above, log scale; `convexity`; `regularity`:
+    /// the P-Hex paper's section 4.2 deviation from the affine (quasi-)regular hexagon) and
+    /// their edges.
+    pub fn mesh(&self, mode: Option<String>) -> Result<MeshData, JsError> {
+        let mode = ColorMode::parse(mode.as_deref().unwrap_or(""))?;
         let m = self.current_mesh().unwrap_or_default();
-        let colors: Vec<[f32; 3]> = (0..m.num_faces())
-            .map(|i| planarity_color(face_planarity(&m, i)))
-            .collect();
-        MeshData::panels(m, &colors)
+        let colors: Vec<[f32; 3]> = match mode {
+            ColorMode::Planarity => (0..m.num_faces())
+                .map(|i| planarity_color(face_planarity(&m, i)))
+                .collect(),
+            ColorMode::Convexity => (0..m.num_faces())
+                .map(|i| {
+                    let f = face_info(&m, i, 0.0);
+                    if !f.simple {
+                        INVALID
+                    } else if f.convex {
+                        CONVEX
+                    } else {
+                        NONCONVEX
+                    }
+                })
+                .collect(),
+            ColorMode::Regularity => {
+                // The regularity measure depends on the sign of K at the face: the P-Hex report
+                // has it per face; other meshes are compared with the affine-regular hexagon.
+                let report = match &self.run {
+                    Run::Phex(p) => p.report(),
+                    Run::Pq { .. } => None,
+                };
+                (0..m.num_faces())
+                    .map(|i| {
+                        let d = match &report {
+                            Some(r) => r.per_face.get(i).and_then(|f| f.shape_deviation),
+                            None => face_info(&m, i, 1.0).shape_deviation,
+                        };
+                        d.map_or(NOT_HEX, regularity_color)
+                    })
+                    .collect()
+            }
+        };
+        Ok(MeshData::panels(m, &colors))
     }
 }
 
@@ -170,6 +467,17 @@ impl Session {
     }
 
     fn metrics_struct(&self) -> Metrics {
+        let mesh = self.current_mesh().unwrap_or_default();
+        let per_face: Vec<f64> = (0..mesh.num_faces())
+            .map(|i| face_planarity(&mesh, i))
+            .collect();
+        let mean_planarity = if per_face.is_empty() {
+            0.0
+        } else {
+            per_face.iter().sum::<f64>() / per_face.len() as f64
+        };
+        let histogram = planarity_histogram(&per_face);
+        let hist_log10 = [HIST_LO, HIST_HI];
         match &self.run {
             Run::Phex(p) => {
                 let m = p.metrics();
@@ -180,27 +488,68 @@ impl Session {
                     faces: m.faces,
                     vertices: m.vertices,
                     max_planarity: m.max_planarity,
+                    mean_planarity,
                     invalid_faces: m.invalid_faces,
+                    histogram,
+                    hist_log10,
                 }
             }
-            Run::Pq {
-                mesh, iterations, ..
-            } => Metrics {
-                phase: if mesh.is_some() { "done" } else { "ready" },
+            Run::Pq { iterations, .. } => Metrics {
+                phase: if self.done() { "done" } else { "ready" },
                 layer: 0,
                 iteration: *iterations,
-                faces: mesh.as_ref().map_or(0, |m| m.num_faces()),
-                vertices: mesh.as_ref().map_or(0, |m| m.num_vertices()),
-                max_planarity: mesh.as_ref().map_or(0.0, max_planarity),
+                faces: mesh.num_faces(),
+                vertices: mesh.num_vertices(),
+                max_planarity: max_planarity(&mesh),
+                mean_planarity,
                 // Self-intersecting panels, tested in each face's least-squares plane.
-                invalid_faces: mesh.as_ref().map_or(0, |m| {
-                    (0..m.num_faces())
-                        .filter(|&i| !face_info(m, i, 0.0).simple)
-                        .count()
-                }),
+                invalid_faces: (0..mesh.num_faces())
+                    .filter(|&i| !face_info(&mesh, i, 0.0).simple)
+                    .count(),
+                histogram,
+                hist_log10,
             },
         }
     }
+}
+
+/// Face counts per bin of log10(planarity) over [HIST_LO, HIST_HI] (exact zeros and values
+/// below go to the first bin, values above to the last).
+fn planarity_histogram(per_face: &[f64]) -> Vec<u32> {
+    let mut h = vec![0u32; HIST_BINS];
+    let w = (HIST_HI - HIST_LO) / HIST_BINS as f64;
+    for &p in per_face {
+        let x = if p > 0.0 { p.log10() } else { HIST_LO };
+        let b = ((x - HIST_LO) / w)
+            .floor()
+            .clamp(0.0, (HIST_BINS - 1) as f64) as usize;
+        h[b] += 1;
+    }
+    h
+}
+
+fn mean_edge(m: &PolyMesh) -> f64 {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for i in 0..m.num_faces() {
+        let f = m.face(i);
+        for k in 0..f.len() {
+            sum += (m.positions[f[(k + 1) % f.len()] as usize] - m.positions[f[k] as usize]).norm();
+            n += 1;
+        }
+    }
+    if n == 0 { 0.0 } else { sum / n as f64 }
+}
+
+const CONVEX: [f32; 3] = [0.25, 0.6, 0.35];
+const NONCONVEX: [f32; 3] = [0.9, 0.65, 0.15];
+const INVALID: [f32; 3] = [0.85, 0.15, 0.15];
+const NOT_HEX: [f32; 3] = [0.45, 0.45, 0.48];
+
+/// Shape deviation 0 (regular: blue) -> 0.4 and above (red), linear.
+fn regularity_color(d: f64) -> [f32; 3] {
+    let t = (d / 0.4).clamp(0.0, 1.0) as f32;
+    let (a, b) = ([0.20, 0.45, 0.85], [0.85, 0.20, 0.15]);
+    [0, 1, 2].map(|k| a[k] + (b[k] - a[k]) * t)
 }
 
 /// Blue (planar to 1e-12) -> white (1e-7) -> red (1e-2 and worse), log scale; linear RGB.
@@ -212,5 +561,28 @@ fn planarity_color(p: f64) -> [f32; 3] {
         mix(blue, white, t * 2.0)
     } else {
         mix(white, red, t * 2.0 - 1.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn histogram_counts_every_face_in_its_decade() {
+        let h = planarity_histogram(&[0.0, 1e-20, 3e-15, 2e-12, 1e-3, 1.0]);
+        assert_eq!(h.len(), HIST_BINS);
+        assert_eq!(h.iter().sum::<u32>(), 6);
+        assert_eq!((h[0], h[1], h[4], h[HIST_BINS - 1]), (2, 1, 1, 2));
+    }
+
+    #[test]
+    fn colour_ramps_are_ordered_and_clamped() {
+        assert_eq!(planarity_color(0.0), planarity_color(1e-12));
+        assert_eq!(planarity_color(1.0), planarity_color(1e-2));
+        assert!(planarity_color(1e-12)[2] > planarity_color(1e-12)[0]);
+        assert!(planarity_color(1e-2)[0] > planarity_color(1e-2)[2]);
+        assert_eq!(regularity_color(0.4), regularity_color(3.0));
+        assert!(regularity_color(0.0)[2] > regularity_color(0.0)[0]);
     }
 }

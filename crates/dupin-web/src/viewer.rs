@@ -104,6 +104,31 @@ impl Viewer {
         self.camera.orbit(dx, dy);
     }
 
+    /// The camera as `[target x, y, z, distance, yaw, pitch]` (for the URL hash).
+    pub fn camera(&self) -> Vec<f32> {
+        let c = &self.camera;
+        vec![
+            c.target.x, c.target.y, c.target.z, c.distance, c.yaw, c.pitch,
+        ]
+    }
+
+    /// Sets the camera from [`Viewer::camera`]'s six numbers. Throws for a wrong length,
+    /// non-finite values or a distance that is not positive.
+    #[wasm_bindgen(js_name = setCamera)]
+    pub fn set_camera(&mut self, v: Vec<f32>) -> Result<(), JsError> {
+        if v.len() != 6 || !v.iter().all(|x| x.is_finite()) || v[3] <= 0.0 {
+            return Err(JsError::new(
+                "camera needs 6 finite numbers: target x, y, z, distance > 0, yaw, pitch",
+            ));
+        }
+        self.camera.target = glam::Vec3::new(v[0], v[1], v[2]);
+        self.camera.distance = v[3];
+        self.camera.yaw = v[4];
+        // The orbit camera's own pitch limits.
+        self.camera.pitch = v[5].clamp(-1.55, 1.55);
+        Ok(())
+    }
+
     /// Moves the camera closer (`factor` < 1) or farther (`factor` > 1).
     pub fn zoom(&mut self, factor: f32) {
         self.camera.zoom(factor);

@@ -56,7 +56,26 @@ fn session_steps_a_phex_scene_to_planar_hexagons() {
     let faces = get("faces").as_f64().unwrap() as usize;
     let obj = s.export_obj();
     assert_eq!(obj.lines().filter(|l| l.starts_with("f ")).count(), faces);
-    assert!(s.mesh().edges().length() > 0);
+    assert!(s.mesh(None).unwrap().edges().length() > 0);
+    // Colour modes colour every vertex; an unknown mode is an error.
+    for mode in ["planarity", "convexity", "regularity"] {
+        let md = s.mesh(Some(mode.into())).unwrap();
+        assert_eq!(md.colors().length(), md.positions().length(), "{mode}");
+    }
+    assert!(s.mesh(Some("rainbow".into())).is_err());
+    // JSON: the report's face count and one face list per face.
+    let json: serde_json::Value = serde_json::from_str(&s.export_json().unwrap()).unwrap();
+    assert_eq!(json["report"]["faces"].as_u64(), Some(faces as u64));
+    assert_eq!(json["mesh"]["faces"].as_array().unwrap().len(), faces);
+    assert_eq!(json["report"]["per_face"].as_array().unwrap().len(), faces);
+    // SVG schedule: one numbered polygon per panel.
+    let svg = s.export_svg(1.5).unwrap();
+    assert_eq!(svg.matches("<polygon").count(), faces);
+    assert!(s.export_svg(-1.0).is_err());
+    // Histogram: every face counted.
+    let hist = js_sys::Array::from(&get("histogram"));
+    let total: f64 = hist.iter().map(|v| v.as_f64().unwrap()).sum();
+    assert_eq!(total as usize, faces);
 }
 
 #[wasm_bindgen_test]
@@ -67,6 +86,12 @@ fn bad_session_configs_throw_readable_errors() {
         (r#"{"surface":"torus","method":"sideways"}"#, "method"),
         (r#"{}"#, "scene"),
         (r#"{"scene":1}"#, "bad session config"),
+        (r#"{"surface":"torus","lambda":-1}"#, "lambda"),
+        (r#"{"surface":"torus","mu":-0.5}"#, "mu"),
+        (r#"{"surface":"torus","bound":7}"#, "lower bound b"),
+        (r#"{"surface":"torus","params":{"r":-1}}"#, "r"),
+        (r#"{"surface":"torus","size":1000}"#, "size"),
+        (r#"{"surface":"torus","init":"magic"}"#, "init"),
     ] {
         let err = match Session::new(js_sys::JSON::parse(json).unwrap()) {
             Err(e) => wasm_bindgen::JsValue::from(e),
@@ -77,5 +102,42 @@ fn bad_session_configs_throw_readable_errors() {
             .as_string()
             .unwrap();
         assert!(msg.contains(needle), "{json}: {msg}");
+    }
+}
+
+#[wasm_bindgen_test]
+fn mesh_arrays_round_trip_and_reject_bad_lengths() {
+    use dupin_web::MeshData;
+    let m = torus_mesh(2.0, 0.5, 12, 8).unwrap();
+    let back = MeshData::from_arrays(
+        m.positions().to_vec(),
+        m.normals().to_vec(),
+        m.indices().to_vec(),
+        vec![],
+        vec![],
+    )
+    .unwrap();
+    assert_eq!(back.triangle_count(), m.triangle_count());
+    assert!(MeshData::from_arrays(vec![0.0; 4], vec![0.0; 4], vec![], vec![], vec![]).is_err());
+    assert!(
+        MeshData::from_arrays(vec![0.0; 9], vec![0.0; 9], vec![0, 1, 3], vec![], vec![]).is_err()
+    );
+}
+
+#[wasm_bindgen_test]
+fn surface_catalog_lists_every_library_surface_with_ranges() {
+    let cat = js_sys::Array::from(&dupin_web::surface_catalog_js().unwrap());
+    assert_eq!(cat.length() as usize, dupin_core::surface_catalog().len());
+    for s in cat.iter() {
+        let params = js_sys::Array::from(&js_sys::Reflect::get(&s, &"params".into()).unwrap());
+        for p in params.iter() {
+            let f = |k: &str| {
+                js_sys::Reflect::get(&p, &k.into())
+                    .unwrap()
+                    .as_f64()
+                    .unwrap()
+            };
+            assert!(f("min") <= f("default") && f("default") <= f("max"));
+        }
     }
 }

@@ -52,6 +52,10 @@ pub struct PhexConfig {
     /// field against the first principal direction (the u direction at umbilics); the second
     /// field is its conjugate. `None`: the parameter lines (which must be conjugate).
     pub field_angle: Option<f64>,
+    /// Initial fairness weight lambda of the planarity optimisation (section 7; >= 0).
+    pub lambda: f64,
+    /// Initial surface-distance weight mu of the planarity optimisation (section 7; >= 0).
+    pub mu: f64,
 }
 
 impl PhexConfig {
@@ -82,6 +86,8 @@ impl PhexConfig {
             initialisation: super::Initialisation::TangentDuality,
             boundary_faces: true,
             field_angle: None,
+            lambda: PlanarityOptions::default().fairness,
+            mu: PlanarityOptions::default().distance,
         }
     }
 }
@@ -214,6 +220,20 @@ impl PhexPipeline {
             return Err(PhexError::BadParameter(format!(
                 "{} iterations; use at most 1000",
                 config.iterations
+            )));
+        }
+        for (name, w) in [("lambda", config.lambda), ("mu", config.mu)] {
+            if !(w.is_finite() && w >= 0.0) {
+                return Err(PhexError::BadParameter(format!(
+                    "{name} = {w} must be a finite weight >= 0"
+                )));
+            }
+        }
+        if let LayerRule::Ideal { bound } = config.rule
+            && !(bound.is_finite() && (0.0..=1.0).contains(&bound))
+        {
+            return Err(PhexError::BadParameter(format!(
+                "lower bound b = {bound} must be in [0, 1]"
             )));
         }
         let surface = build_surface(&config)?;
@@ -475,6 +495,8 @@ impl PhexPipeline {
                     Some(&d.vertex_uv),
                     PlanarityOptions {
                         max_iterations: self.config.iterations,
+                        fairness: self.config.lambda,
+                        distance: self.config.mu,
                         ..PlanarityOptions::default()
                     },
                 )?;

@@ -70,6 +70,8 @@ fn cfg(
         initialisation: super::Initialisation::TangentDuality,
         boundary_faces: true,
         field_angle: None,
+        lambda: super::PlanarityOptions::default().fairness,
+        mu: super::PlanarityOptions::default().distance,
     }
 }
 

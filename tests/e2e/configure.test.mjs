@@ -1,0 +1,181 @@
+// Configure, watch and share: the worker keeps the page responsive on a 10k-face run, the free
+// mode's fields reject bad input inline, the URL restores a run exactly, JSON and SVG exports
+// parse, colour modes change the picture and legend, and WebGL2 steps a scene too.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { byId, drag, exportText, metrics, openPage, pixelStats, shot, waitDone, waitSteps } from './harness.mjs';
+
+// About 10k hexagons (BENCHMARKS.md: torus-bound at size 0.155), initialised by Dupin duality so
+// that the Gauss-Newton optimisation runs several iterations.
+const BIG = '#scene=free&surface=torus&method=prescribed&size=0.155&init=dupin-duality';
+
+test('a 10k-face run in the worker leaves no main-thread task over 50 ms', async () => {
+  const { browser, page, errors } = await openPage({ hash: BIG });
+  try {
+    await page.evaluate(() => {
+      window.__long = [];
+      new PerformanceObserver((l) => window.__long.push(...l.getEntries().map((e) => e.duration))).observe({ type: 'longtask' });
+    });
+    // The observer does see a main-thread task of 80 ms (so an empty list below means something).
+    await page.evaluate(() => { setTimeout(() => { const t = performance.now(); while (performance.now() - t < 80); }, 0); });
+    await page.waitForFunction(() => window.__long.length > 0);
+    await page.evaluate(() => { window.__long.length = 0; });
+    await byId(page, 'play').click();
+    await waitDone(page, 300_000);
+    const m = await metrics(page);
+    assert.ok(Number(m.faces) >= 9000, `only ${m.faces} faces`);
+    assert.ok(Number(m.maxPlanarity) <= 1e-10, `max planarity ${m.maxPlanarity}`);
+    const long = await page.evaluate(() => window.__long);
+    const log = await page.evaluate(() => window.dupin.stepLog);
+    const opt = log.filter((s) => s.phase === 'optimisation' || s.phase === 'done');
+    assert.ok(Number(m.iteration) >= 2, `only ${m.iteration} optimisation iterations ran`);
+    const slow = await page.evaluate(() => window.dupin.slowTasks);
+    console.log(JSON.stringify({ faces: m.faces, steps: log.length, longTasks: long, slowTasks: slow, optimisationStepMs: opt.map((s) => Math.round(s.ms)) }));
+    assert.ok(long.every((d) => d <= 50), `main-thread tasks over 50 ms: ${long.map(Math.round).join(', ')}`);
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
+
+test('a copied URL restores scene, steps, colour mode and camera exactly', async () => {
+  const { browser, page, errors } = await openPage();
+  try {
+    await byId(page, 'scene-select').selectOption('sphere-spiral');
+    await waitSteps(page, 1);
+    for (let k = 2; k <= 4; k++) { await byId(page, 'step').click(); await waitSteps(page, k); }
+    await byId(page, 'color-mode').selectOption('convexity');
+    await drag(page, 120, -30);
+    await page.waitForFunction(() => location.hash.includes('cam='));
+    const url = page.url();
+    assert.match(url, /steps=4/);
+    assert.match(url, /color=convexity/);
+    const m1 = await metrics(page);
+    const cam1 = await page.evaluate(() => Array.from(window.dupin.viewer.camera()));
+    const shot1 = await shot(page, 'restore-original');
+    const again = await page.context().newPage();
+    await again.goto(url);
+    await again.waitForFunction(() => document.body.dataset.ready === 'true', null, { timeout: 90_000 });
+    await waitSteps(again, 4);
+    assert.deepEqual(await metrics(again), m1);
+    assert.deepEqual(await again.evaluate(() => Array.from(window.dupin.viewer.camera())), cam1);
+    assert.equal(await byId(again, 'color-mode').inputValue(), 'convexity');
+    const shot2 = await shot(again, 'restore-copy');
+    const { differing } = await pixelStats(page, shot2, shot1);
+    assert.ok(differing < 0.001, `restored view differs in ${(differing * 100).toFixed(2)}% of pixels`);
+
+    // A free configuration, run to the end.
+    const free = '#scene=free&surface=torus&p.R=2&p.r=0.6&method=progressive&size=0.45&bound=0.2&lambda=1e-7&mu=1e-5';
+    await page.goto(new URL(free, page.url()).href);
+    await page.waitForFunction(() => document.body.dataset.ready === 'true');
+    await waitSteps(page, 1);
+    await byId(page, 'play').click();
+    await waitDone(page);
+    const f1 = await metrics(page);
+    assert.ok(Number(f1.maxPlanarity) <= 1e-10);
+    const freeUrl = page.url();
+    assert.match(freeUrl, /lambda=1e-7/);
+    const third = await page.context().newPage();
+    await third.goto(freeUrl);
+    await third.waitForFunction(() => document.body.dataset.ready === 'true');
+    await waitSteps(third, Number(f1.steps));
+    assert.deepEqual(await metrics(third), f1);
+    assert.equal(await byId(third, 'free-lambda').inputValue(), '1e-7');
+    assert.equal(await byId(third, 'param-r').inputValue(), '0.6');
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
+
+test('free mode: bad input in any field shows the core error inline and the page stays usable', async () => {
+  const { browser, page, errors } = await openPage({ hash: '#scene=free&surface=torus&size=0.6' });
+  try {
+    await waitSteps(page, 1);
+    // Every library surface is offered, with a slider and a field per parameter.
+    const surfaces = await byId(page, 'free-surface').evaluate((s) => [...s.options].map((o) => o.value));
+    assert.ok(surfaces.length >= 8 && surfaces.includes('hyperboloid') && surfaces.includes('sphere'), surfaces.join());
+    assert.equal(await byId(page, 'param-R-slider').count(), 1);
+    const before = await metrics(page);
+    const bad = [['param-r', '-1'], ['param-R', '1e9'], ['free-size', '-2'], ['free-size', '1e6'], ['free-bound', '5'],
+      ['free-lambda', '-1'], ['free-mu', '-3'], ['panel-edge', '-1']];
+    for (const [id, value] of bad) {
+      const good = await byId(page, id).inputValue();
+      await byId(page, id).fill(value);
+      await byId(page, id).dispatchEvent('change');
+      const err = byId(page, `${id}-error`);
+      await page.waitForFunction((t) => document.querySelector(`[data-testid="${t}-error"]`).textContent !== '', id);
+      const text = await err.textContent();
+      assert.ok(text.length > 5, `${id}=${value}: ${text}`);
+      assert.deepEqual(await metrics(page), before, `${id}=${value} changed the run`);
+      await byId(page, id).fill(good);
+      await byId(page, id).dispatchEvent('change');
+      await page.waitForFunction((t) => document.querySelector(`[data-testid="${t}-error"]`).textContent === '', id);
+    }
+    // The run still steps, and a new surface loads with its own parameters.
+    const n = Number((await metrics(page)).steps);
+    await byId(page, 'step').click();
+    await waitSteps(page, n + 1);
+    await byId(page, 'free-surface').selectOption('hyperboloid');
+    await page.waitForFunction(() => location.hash.includes('surface=hyperboloid'));
+    assert.equal(await byId(page, 'param-a').count(), 1);
+    assert.equal((await byId(page, 'status').textContent()).trim(), 'WebGPU');
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
+
+test('JSON and SVG exports parse and match the face count; colour modes change picture and legend', async () => {
+  const { browser, page, errors } = await openPage({ hash: '#scene=cyclide-prescribed' });
+  try {
+    await waitSteps(page, 1);
+    await byId(page, 'play').click();
+    await waitDone(page);
+    const m = await metrics(page);
+    const json = JSON.parse(await exportText(page, 'export-json'));
+    assert.equal(json.report.faces, Number(m.faces));
+    assert.equal(json.mesh.faces.length, Number(m.faces));
+    assert.equal(json.report.max_planarity, Number(m.maxPlanarity));
+    const svg = await exportText(page, 'export-svg');
+    const parsed = await page.evaluate((text) => {
+      const doc = new DOMParser().parseFromString(text, 'image/svg+xml');
+      return { error: doc.querySelector('parsererror')?.textContent ?? null, polygons: doc.querySelectorAll('polygon').length, sheets: doc.querySelectorAll('rect[data-sheet]').length };
+    }, svg);
+    assert.equal(parsed.error, null);
+    assert.equal(parsed.polygons, Number(m.faces));
+    assert.ok(parsed.sheets >= 1);
+    const pics = {};
+    for (const mode of ['planarity', 'convexity', 'regularity']) {
+      await byId(page, 'color-mode').selectOption(mode);
+      await page.waitForFunction((md) => location.hash.includes(md === 'planarity' ? 'scene=' : `color=${md}`), mode);
+      await page.waitForTimeout(300);
+      pics[mode] = { shot: await shot(page, `colour-${mode}`), legend: await byId(page, 'legend').textContent() };
+    }
+    assert.match(pics.convexity.legend, /self-intersecting/);
+    assert.match(pics.regularity.legend, /not a hexagon/);
+    assert.notEqual(pics.planarity.legend, pics.convexity.legend);
+    const { differing } = await pixelStats(page, pics.convexity.shot, pics.planarity.shot);
+    assert.ok(differing > 0.01, `convexity colours changed only ${(differing * 100).toFixed(2)}% of pixels`);
+    assert.equal(await byId(page, 'histogram').getAttribute('data-total'), m.faces);
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
+
+test('WebGL2 fallback steps a scene in the worker', async () => {
+  const { browser, page, errors } = await openPage({ webgpu: false, hash: '#scene=sphere-spiral&steps=3' });
+  try {
+    assert.equal((await byId(page, 'status').textContent()).trim(), 'WebGL2');
+    await waitSteps(page, 3);
+    const { covered } = await pixelStats(page, await shot(page, 'webgl2-sphere-spiral'));
+    assert.ok(covered > 0.01, `only ${(covered * 100).toFixed(1)}% covered`);
+    await byId(page, 'play').click();
+    await waitDone(page);
+    assert.ok(Number((await metrics(page)).maxPlanarity) <= 1e-10);
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});

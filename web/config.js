@@ -1,0 +1,75 @@
+// The page's whole configuration and its URL-hash form. One object describes what is on
+// screen: `scene` ('torus' preview, a contract scene, or 'free'), the torus or free-surface
+// parameters, the free mode's run settings, the step count, colour mode, panel edge for mm
+// figures, camera and backend.
+export const FREE = 'free';
+
+export function defaults() {
+  return {
+    scene: 'torus',
+    params: {},
+    free: { surface: 'torus', method: 'progressive', init: 'tangent-duality', size: null, bound: null, lambda: null, mu: null },
+    steps: 1,
+    color: 'planarity',
+    panelEdge: 1.5,
+    camera: null,
+    backend: 'auto',
+  };
+}
+
+const num = (s) => (s === null || s.trim() === '' ? NaN : Number(s));
+
+/** Parses a hash; unknown or malformed entries fall back to defaults (the page reports them). */
+export function readHash(hash, { scenes, catalog, torusParams }) {
+  const h = new URLSearchParams(hash.replace(/^#/, ''));
+  const c = defaults();
+  const name = h.get('scene');
+  if (name === FREE || scenes.includes(name) || name === 'torus') c.scene = name;
+  if (c.scene === 'torus') {
+    for (const [k, spec] of Object.entries(torusParams)) c.params[k] = h.has(k) ? num(h.get(k)) : spec.value;
+  }
+  if (c.scene === FREE) {
+    const surface = catalog.find((s) => s.name === h.get('surface')) ?? catalog.find((s) => s.name === 'torus') ?? catalog[0];
+    c.free.surface = surface.name;
+    for (const p of surface.params) c.params[p.key] = h.has(`p.${p.key}`) ? num(h.get(`p.${p.key}`)) : p.default;
+    if (h.get('method') === 'prescribed') c.free.method = 'prescribed';
+    if (h.get('init') === 'dupin-duality') c.free.init = 'dupin-duality';
+    for (const k of ['size', 'bound', 'lambda', 'mu']) if (h.has(k)) c.free[k] = num(h.get(k));
+  }
+  const steps = Number(h.get('steps'));
+  if (Number.isInteger(steps) && steps >= 1 && steps <= 100000) c.steps = steps;
+  if (['planarity', 'convexity', 'regularity'].includes(h.get('color'))) c.color = h.get('color');
+  const edge = Number(h.get('edge'));
+  if (h.has('edge') && Number.isFinite(edge) && edge > 0) c.panelEdge = edge;
+  const cam = (h.get('cam') ?? '').split(',').map(Number);
+  if (cam.length === 6 && cam.every(Number.isFinite)) c.camera = cam;
+  if (h.get('backend') === 'webgl2') c.backend = 'webgl2';
+  return c;
+}
+
+export function writeHash(c) {
+  const h = new URLSearchParams({ scene: c.scene });
+  if (c.scene === 'torus') for (const [k, v] of Object.entries(c.params)) h.set(k, String(v));
+  if (c.scene === FREE) {
+    h.set('surface', c.free.surface);
+    for (const [k, v] of Object.entries(c.params)) h.set(`p.${k}`, String(v));
+    h.set('method', c.free.method);
+    if (c.free.init !== 'tangent-duality') h.set('init', c.free.init);
+    for (const k of ['size', 'bound', 'lambda', 'mu']) if (c.free[k] !== null) h.set(k, String(c.free[k]));
+  }
+  if (c.scene !== 'torus') h.set('steps', String(c.steps));
+  if (c.color !== 'planarity') h.set('color', c.color);
+  if (c.panelEdge !== 1.5) h.set('edge', String(c.panelEdge));
+  if (c.camera) h.set('cam', c.camera.map(String).join(','));
+  if (c.backend !== 'auto') h.set('backend', c.backend);
+  return '#' + h.toString();
+}
+
+/** The `Session` config of a stepped scene or free configuration (null for the torus preview). */
+export function sessionConfig(c) {
+  if (c.scene === 'torus') return null;
+  if (c.scene !== FREE) return { scene: c.scene };
+  const out = { surface: c.free.surface, params: { ...c.params }, method: c.free.method, init: c.free.init };
+  for (const k of ['size', 'bound', 'lambda', 'mu']) if (c.free[k] !== null) out[k] = c.free[k];
+  return out;
+}

@@ -1,0 +1,124 @@
+// Configuration controls: the scene picker and the parameter fields (torus preview, or the free
+// mode's surface, parameters with slider + numeric field, method, size, b, lambda, mu). Every
+// field has an inline message slot; `showFieldError` puts the core's error text there.
+import { FREE } from './config.js';
+
+const el = (tag, props = {}, ...children) => {
+  const e = Object.assign(document.createElement(tag), props);
+  e.append(...children);
+  return e;
+};
+
+/** Fills the scene picker: torus preview, every contract scene, the free mode. */
+export function fillScenePicker(select, scenes) {
+  select.replaceChildren(
+    new Option('Torus (surface preview)', 'torus'),
+    ...scenes.map((n) => new Option(n, n)),
+    new Option('free: surface, method, size, b, λ, μ', FREE),
+  );
+}
+
+// One labelled field: a numeric input (optionally with a slider) and its message slot.
+function numberField({ id, label, value, min, max, step = 'any', slider = false, title = '', onCommit }) {
+  const input = el('input', { type: 'number', step, value: value ?? '', title });
+  if (min !== undefined) input.min = min;
+  if (max !== undefined) input.max = max;
+  input.dataset.testid = id;
+  const msg = el('span', { className: 'field-error' });
+  msg.dataset.testid = `${id}-error`;
+  msg.dataset.for = id;
+  const parts = [el('span', { className: 'field-label', textContent: label })];
+  let range = null;
+  if (slider && Number.isFinite(min) && Number.isFinite(max)) {
+    range = el('input', { type: 'range', min, max, step: step === 'any' ? (max - min) / 200 : step, value });
+    range.dataset.testid = `${id}-slider`;
+    range.addEventListener('input', () => { input.value = range.value; });
+    range.addEventListener('change', () => { input.value = range.value; commit(); });
+    parts.push(range);
+  }
+  const commit = () => {
+    const text = input.value.trim();
+    const v = text === '' ? null : Number(text);
+    if (v !== null && !Number.isFinite(v)) { setError(msg, input, `${label} must be a number`); return; }
+    if (range && v !== null) range.value = v;
+    onCommit(v, id);
+  };
+  input.addEventListener('change', commit);
+  return el('label', { className: 'field' }, ...parts, input, msg);
+}
+
+function setError(msg, input, text) {
+  msg.textContent = text;
+  input?.classList.toggle('invalid', text !== '');
+}
+
+/** Shows `text` next to field `id` ('' clears it); returns false when there is no such field. */
+export function showFieldError(box, id, text) {
+  const msg = box.querySelector(`[data-for="${id}"]`);
+  if (!msg) return false;
+  setError(msg, box.querySelector(`[data-testid="${id}"]`), text);
+  return true;
+}
+
+export function clearFieldErrors(box) {
+  for (const m of box.querySelectorAll('.field-error')) m.textContent = '';
+  for (const i of box.querySelectorAll('.invalid')) i.classList.remove('invalid');
+}
+
+/**
+ * Rebuilds the parameter box for config `c`. `onChange(patch, fieldId)` receives a function
+ * applying one field's new value to a config copy.
+ */
+export function buildFields(box, c, { catalog, torusParams, defaults, onChange }) {
+  box.replaceChildren();
+  if (c.scene === 'torus') {
+    for (const [k, spec] of Object.entries(torusParams)) {
+      box.append(numberField({
+        id: `param-${k}`, label: spec.label, value: c.params[k],
+        onCommit: (v, id) => onChange((n) => { n.params[k] = v ?? NaN; }, id),
+      }));
+    }
+    return;
+  }
+  if (c.scene !== FREE) return;
+  const surface = catalog.find((s) => s.name === c.free.surface);
+  const pick = el('select', { title: surface?.parametrisation ?? '' });
+  pick.dataset.testid = 'free-surface';
+  pick.append(...catalog.map((s) => new Option(s.name, s.name)));
+  pick.value = c.free.surface;
+  pick.addEventListener('change', () => onChange((n) => {
+    n.free.surface = pick.value;
+    n.params = Object.fromEntries(catalog.find((s) => s.name === pick.value).params.map((p) => [p.key, p.default]));
+  }, 'free-surface', true));
+  const method = el('select');
+  method.dataset.testid = 'free-method';
+  method.append(new Option('progressive', 'progressive'), new Option('prescribed', 'prescribed'));
+  method.value = c.free.method;
+  method.addEventListener('change', () => onChange((n) => { n.free.method = method.value; }, 'free-method'));
+  const init = el('select', { title: 'hexagon initialisation: tangent duality (sec. 4.1, starts planar) or Dupin duality (sec. 6, the optimisation makes it planar)' });
+  init.dataset.testid = 'free-init';
+  init.append(new Option('tangent duality', 'tangent-duality'), new Option('Dupin duality', 'dupin-duality'));
+  init.value = c.free.init;
+  init.addEventListener('change', () => onChange((n) => { n.free.init = init.value; }, 'free-init'));
+  const labelled = (text, e) => el('label', { className: 'field' }, el('span', { className: 'field-label', textContent: text }), e);
+  box.append(labelled('surface', pick), labelled('method', method), labelled('init', init));
+  for (const p of surface?.params ?? []) {
+    box.append(numberField({
+      id: `param-${p.key}`, label: p.key, value: c.params[p.key], min: p.min, max: p.max,
+      step: p.integer ? 1 : 'any', slider: true, title: `${p.doc} [${p.min}, ${p.max}]`,
+      onCommit: (v, id) => onChange((n) => { n.params[p.key] = v ?? NaN; }, id),
+    }));
+  }
+  const run = [
+    ['size', 'panel size', 'target edge length of the base curve (empty: 1/48 of its length)'],
+    ['bound', 'b', `parabolic lower bound b of section 5.3 (default ${defaults.bound})`],
+    ['lambda', 'λ', `fairness weight of section 7 (default ${defaults.lambda})`],
+    ['mu', 'μ', `surface-distance weight of section 7 (default ${defaults.mu})`],
+  ];
+  for (const [k, label, title] of run) {
+    box.append(numberField({
+      id: `free-${k}`, label, value: c.free[k] ?? (k === 'size' ? '' : defaults[k]), title,
+      onCommit: (v, id) => onChange((n) => { n.free[k] = v; }, id),
+    }));
+  }
+}

@@ -1,0 +1,106 @@
+// The solver thread: a module worker that owns the `Session` (state and geometry in Rust) so
+// the page's thread only draws. Protocol (all messages carry the load generation `gen`; stale
+// ones are dropped on both sides):
+//   in:  load {config, steps, mode} | step | play | pause | ack | mode {mode} | export {kind, panelEdge}
+//   out: ready | state {metrics, steps, done, mesh: typed arrays (transferred)} | error {message, field}
+//        | export {kind, text}
+import init, { Session } from './pkg/dupin_web.js';
+
+let session = null;
+let gen = 0;
+let steps = 0;
+let mode = 'planarity';
+let playing = false;
+let lastMetrics = null;
+
+function meshMessage() {
+  const m = session.mesh(mode);
+  const mesh = { positions: m.positions, normals: m.normals, indices: m.indices, colors: m.colors, edges: m.edges };
+  m.free();
+  return mesh;
+}
+
+function send() {
+  const mesh = meshMessage();
+  const done = session.done();
+  postMessage({ type: 'state', gen, metrics: lastMetrics, steps, done, playing: playing && !done, mesh },
+    [mesh.positions.buffer, mesh.normals.buffer, mesh.indices.buffer, mesh.colors.buffer, mesh.edges.buffer]);
+}
+
+function stepOnce() {
+  const t = performance.now();
+  const m = session.step();
+  m.ms = performance.now() - t;
+  steps += 1;
+  lastMetrics = m;
+}
+
+function fail(e, field = null) {
+  playing = false;
+  postMessage({ type: 'error', gen, message: e?.message ?? String(e), field });
+}
+
+const handlers = {
+  // A new configuration: built first, so a bad one leaves the running session untouched.
+  load(msg) {
+    let next;
+    try {
+      next = new Session(msg.config);
+    } catch (e) {
+      postMessage({ type: 'error', gen: msg.gen, active: gen, message: e?.message ?? String(e), field: msg.field ?? null, load: true });
+      return;
+    }
+    session?.free();
+    session = next;
+    gen = msg.gen;
+    mode = msg.mode ?? mode;
+    playing = false;
+    steps = 0;
+    try {
+      // Replays `steps` steps (a restored URL); the first step is always taken.
+      const target = Math.max(1, msg.steps ?? 1);
+      while (steps < target && !session.done()) stepOnce();
+      send();
+    } catch (e) { fail(e); }
+  },
+  step() {
+    if (!session || session.done()) return;
+    playing = false;
+    try { stepOnce(); send(); } catch (e) { fail(e); }
+  },
+  play() {
+    if (!session || session.done()) return;
+    playing = true;
+    try { stepOnce(); send(); } catch (e) { fail(e); }
+  },
+  pause() { playing = false; },
+  // The page has drawn the last state: take the next step while playing (back-pressure keeps
+  // the page from queueing meshes it cannot draw).
+  ack(msg) {
+    if (msg.gen !== gen || !playing || !session || session.done()) return;
+    setTimeout(() => {
+      if (!playing || !session || session.done()) return;
+      try { stepOnce(); send(); } catch (e) { fail(e); }
+    }, 0);
+  },
+  mode(msg) {
+    mode = msg.mode;
+    if (session) { try { send(); } catch (e) { fail(e, 'color-mode'); } }
+  },
+  export(msg) {
+    if (!session) return;
+    try {
+      const text = msg.kind === 'obj' ? session.exportObj()
+        : msg.kind === 'json' ? session.exportJson()
+          : session.exportSvg(msg.panelEdge);
+      postMessage({ type: 'export', gen, kind: msg.kind, text });
+    } catch (e) { fail(e, `export-${msg.kind}`); }
+  },
+};
+
+const queue = [];
+onmessage = (e) => queue.push(e.data);
+await init();
+onmessage = (e) => handlers[e.data.type]?.(e.data);
+for (const m of queue) handlers[m.type]?.(m);
+postMessage({ type: 'ready' });
