@@ -38,7 +38,10 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
 };
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use crate::nested_dissection::nested_dissection;
+use faer::perm::PermRef;
+use faer::sparse::linalg::amd;
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Conj, Par};
 
 /// Settings of the planarity optimisation.
@@ -192,6 +195,99 @@ impl BlockPattern {
     }
 }
 
+/// Fill-reducing orderings of the normal matrix for the sparse Cholesky factorisation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum FillOrdering {
+    /// faer's AMD on the 3V x 3V scalar pattern.
+    ScalarAmd,
+    /// AMD on the V-vertex graph, expanded to 3 x 3 blocks.
+    VertexAmd,
+    /// Geometric nested dissection on the vertex graph, expanded to 3 x 3 blocks.
+    NestedDissection,
+}
+
+/// The scalar permutation (`fwd[new] = old`, `inv[old] = new`) for `ordering` (identity for
+/// [`FillOrdering::ScalarAmd`], which faer computes itself).
+fn fill_ordering(
+    mesh: &PolyMesh,
+    pattern: &BlockPattern,
+    ordering: FillOrdering,
+) -> (Vec<u32>, Vec<u32>) {
+    let nv = mesh.num_vertices();
+    let vertex_order: Vec<u32> = match ordering {
+        FillOrdering::ScalarAmd => (0..nv as u32).collect(),
+        FillOrdering::VertexAmd => {
+            let col_ptr: Vec<u32> = pattern.block_ptr.iter().map(|&c| c as u32).collect();
+            let graph =
+                SymbolicSparseColMatRef::new_checked(nv, nv, &col_ptr, None, &pattern.blocks);
+            let mut perm = vec![0u32; nv];
+            let mut perm_inv = vec![0u32; nv];
+            let mut mem = MemBuffer::new(amd::order_maybe_unsorted_scratch::<u32>(
+                nv,
+                pattern.blocks.len(),
+            ));
+            match amd::order_maybe_unsorted(
+                &mut perm,
+                &mut perm_inv,
+                graph,
+                amd::Control::default(),
+                MemStack::new(&mut mem),
+            ) {
+                Ok(_) => perm,
+                Err(_) => (0..nv as u32).collect(),
+            }
+        }
+        FillOrdering::NestedDissection => {
+            // Symmetric adjacency from the upper block pattern.
+            let mut degree = vec![0usize; nv + 1];
+            for j in 0..nv {
+                for &i in &pattern.blocks[pattern.block_ptr[j]..pattern.block_ptr[j + 1]] {
+                    if i as usize != j {
+                        degree[i as usize + 1] += 1;
+                        degree[j + 1] += 1;
+                    }
+                }
+            }
+            for v in 0..nv {
+                degree[v + 1] += degree[v];
+            }
+            let xadj = degree;
+            let mut next = xadj.clone();
+            let mut adj = vec![0u32; xadj[nv]];
+            for j in 0..nv {
+                for &i in &pattern.blocks[pattern.block_ptr[j]..pattern.block_ptr[j + 1]] {
+                    if i as usize != j {
+                        adj[next[i as usize]] = j as u32;
+                        next[i as usize] += 1;
+                        adj[next[j]] = i;
+                        next[j] += 1;
+                    }
+                }
+            }
+            nested_dissection(&mesh.positions, &xadj, &adj)
+        }
+    };
+    let mut fwd = Vec::with_capacity(3 * nv);
+    for &v in &vertex_order {
+        fwd.extend([3 * v, 3 * v + 1, 3 * v + 2]);
+    }
+    let mut inv = vec![0u32; 3 * nv];
+    for (new, &old) in fwd.iter().enumerate() {
+        inv[old as usize] = new as u32;
+    }
+    (fwd, inv)
+}
+
+fn cg_max() -> usize {
+    std::env::var("CG_MAX").ok().and_then(|v| v.parse().ok()).unwrap_or(200)
+}
+fn cg_eta() -> f64 {
+    std::env::var("CG_ETA").ok().and_then(|v| v.parse().ok()).unwrap_or(1e-4)
+}
+fn cg_tol() -> f64 {
+    std::env::var("CG_TOL").ok().and_then(|v| v.parse().ok()).unwrap_or(1e-3)
+}
+
 /// Tetrahedron volume of four points and its gradients with respect to each of them.
 #[inline]
 fn volume_and_gradients(a: Vec3, b: Vec3, c: Vec3, d: Vec3) -> (f64, [Vec3; 4]) {
@@ -209,6 +305,13 @@ fn quads(n: usize) -> usize {
     if n == 4 { 1 } else { n }
 }
 
+/// Symbolic sparse Cholesky analysis with its numeric storage and workspace.
+struct Factor {
+    symbolic: SymbolicCholesky<u32>,
+    values: Vec<f64>,
+    scratch: MemBuffer,
+}
+
 /// Stateful Gauss-Newton planarity optimisation (one [`PlanarityOptimiser::step`] per
 /// iteration, so a UI can watch it).
 pub struct PlanarityOptimiser {
@@ -224,10 +327,10 @@ pub struct PlanarityOptimiser {
     num_faces: usize,
     pattern: BlockPattern,
     symbolic_matrix: SymbolicSparseColMat<u32>,
-    symbolic: SymbolicCholesky<u32>,
-    factor_values: Vec<f64>,
-    scratch: MemBuffer,
+    factor: Option<Factor>,
     values: Vec<f64>,
+    cg_iterations: usize,
+    g_vol: Vec<f64>,
     damping: f64,
     factorizations: usize,
 }
@@ -245,6 +348,16 @@ impl PlanarityOptimiser {
         mesh: &PolyMesh,
         start_uv: Option<&[Vec2]>,
         options: PlanarityOptions,
+    ) -> Result<Self, PhexError> {
+        Self::with_ordering(mesh, start_uv, options, Some(FillOrdering::NestedDissection))
+    }
+
+    /// [`PlanarityOptimiser::new`] with a chosen fill-reducing ordering (for measurements).
+    pub(crate) fn with_ordering(
+        mesh: &PolyMesh,
+        start_uv: Option<&[Vec2]>,
+        options: PlanarityOptions,
+        ordering: Option<FillOrdering>,
     ) -> Result<Self, PhexError> {
         if !(options.tolerance > 0.0) || !(options.fairness >= 0.0) || !(options.distance >= 0.0) {
             return Err(PhexError::BadParameter(
@@ -283,10 +396,19 @@ impl PlanarityOptimiser {
             None,
             pattern.row_indices(),
         );
+        let factor = match ordering {
+            None => None,
+            Some(ordering) => {
+        let (fwd, inv) = fill_ordering(mesh, &pattern, ordering);
+        let perm = PermRef::new_checked(&fwd, &inv, n);
         let symbolic = factorize_symbolic_cholesky(
             symbolic_matrix.as_ref(),
             Side::Upper,
-            SymmetricOrdering::Amd,
+            if ordering == FillOrdering::ScalarAmd {
+                SymmetricOrdering::Amd
+            } else {
+                SymmetricOrdering::Custom(perm)
+            },
             CholeskySymbolicParams {
                 // faer's automatic choice picks the simplicial kernel for mesh matrices, several
                 // times slower here.
@@ -299,6 +421,9 @@ impl PlanarityOptimiser {
             .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
             .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
         let scratch = MemBuffer::try_new(req).map_err(|e| fe(&e))?;
+        Some(Factor { values: vec![0.0; symbolic.len_val()], symbolic, scratch })
+            }
+        };
         Ok(PlanarityOptimiser {
             options,
             neighbours,
@@ -313,12 +438,12 @@ impl PlanarityOptimiser {
             iteration: 0,
             max_planarity: max_planarity(mesh),
             num_faces: mesh.num_faces(),
-            factor_values: vec![0.0; symbolic.len_val()],
             values: vec![0.0; pattern.nnz()],
             pattern,
             symbolic_matrix,
-            symbolic,
-            scratch,
+            factor,
+            cg_iterations: 0,
+            g_vol: vec![],
             damping: INITIAL_DAMPING,
             factorizations: 0,
         })
@@ -332,6 +457,16 @@ impl PlanarityOptimiser {
     /// Sparse Cholesky factorisations done so far (one per tried damping).
     pub fn factorizations(&self) -> usize {
         self.factorizations
+    }
+
+    /// Stored entries of the Cholesky factor (nnz(L), supernodal blocks included).
+    pub fn factor_len(&self) -> usize {
+        self.factor.as_ref().map_or(0, |f| f.symbolic.len_val())
+    }
+
+    /// Conjugate-gradient iterations done so far.
+    pub fn cg_iterations(&self) -> usize {
+        self.cg_iterations
     }
 
     /// Current `max_planarity`.
@@ -421,6 +556,7 @@ impl PlanarityOptimiser {
                 }
             }
         }
+        self.g_vol = g.clone();
         let wl = self.lambda.sqrt() / self.edge;
         let wm = self.mu.sqrt() / self.edge;
         for (v, nb) in self.neighbours.iter().enumerate() {
@@ -472,24 +608,116 @@ impl PlanarityOptimiser {
             damped[self.pattern.diagonal(c)] += delta;
         }
         let mat = SparseColMatRef::new(self.symbolic_matrix.as_ref(), &damped);
+        let Some(factor) = self.factor.as_mut() else {
+            return self.solve_cg(g, delta);
+        };
         self.factorizations += 1;
-        let f = self
+        let f = factor
             .symbolic
             .factorize_numeric_llt(
-                &mut self.factor_values,
+                &mut factor.values,
                 mat,
                 Side::Upper,
                 LltRegularization::default(),
                 Par::Seq,
-                MemStack::new(&mut self.scratch),
+                MemStack::new(&mut factor.scratch),
                 Default::default(),
             )
             .map_err(|e| SolverError::Factorization(format!("{e:?}")))?;
         let mut h: Vec<f64> = g.iter().map(|v| -v).collect();
         let rhs = faer::MatMut::from_column_major_slice_mut(&mut h, g.len(), 1);
-        f.solve_in_place_with_conj(Conj::No, rhs, Par::Seq, MemStack::new(&mut self.scratch));
+        f.solve_in_place_with_conj(Conj::No, rhs, Par::Seq, MemStack::new(&mut factor.scratch));
         if h.iter().all(|v| v.is_finite()) {
             Ok(h)
+        } else {
+            Err(SolverError::Factorization(
+                "the solve produced non-finite values".into(),
+            ))
+        }
+    }
+
+    /// y = (A + delta I) x for the symmetric matrix stored as its upper triangle in `values`.
+    fn matvec(&self, x: &[f64], delta: f64, y: &mut [f64]) {
+        let cp = self.symbolic_matrix.col_ptr();
+        let rows = self.symbolic_matrix.row_idx();
+        for (c, yc) in y.iter_mut().enumerate() {
+            *yc = delta * x[c];
+        }
+        for c in 0..x.len() {
+            let xc = x[c];
+            let mut acc = 0.0;
+            let end = cp[c + 1] as usize - 1;
+            for k in cp[c] as usize..end {
+                let r = rows[k] as usize;
+                let a = self.values[k];
+                y[r] += a * xc;
+                acc += a * x[r];
+            }
+            y[c] += acc + self.values[end] * xc;
+        }
+    }
+
+    /// Solves (A + delta I) h = -g by conjugate gradients with a 3 x 3 block-Jacobi
+    /// preconditioner, from h = 0.
+    fn solve_cg(&mut self, g: &[f64], delta: f64) -> Result<Vec<f64>, SolverError> {
+        let n = g.len();
+        let nv = n / 3;
+        let mut pinv = Vec::with_capacity(nv);
+        for j in 0..nv {
+            let mut m = nalgebra::Matrix3::<f64>::zeros();
+            for l in 0..3 {
+                let base = self.pattern.col_ptr[3 * j + l + 1] - (l + 1);
+                for k in 0..=l {
+                    m[(k, l)] = self.values[base + k];
+                    m[(l, k)] = self.values[base + k];
+                }
+                m[(l, l)] += delta;
+            }
+            pinv.push(m.try_inverse().unwrap_or_else(nalgebra::Matrix3::identity));
+        }
+        let precond = |r: &[f64], z: &mut [f64]| {
+            for j in 0..nv {
+                let v = pinv[j] * Vec3::new(r[3 * j], r[3 * j + 1], r[3 * j + 2]);
+                z[3 * j..3 * j + 3].copy_from_slice(v.as_slice());
+            }
+        };
+        let mut x = vec![0.0; n];
+        let mut r: Vec<f64> = g.iter().map(|v| -v).collect();
+        let bnorm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let mut z = vec![0.0; n];
+        precond(&r, &mut z);
+        let mut p = z.clone();
+        let mut rz: f64 = r.iter().zip(&z).map(|(a, b)| a * b).sum();
+        let mut ap = vec![0.0; n];
+        let mut total = 0.0;
+        for _ in 0..cg_max() {
+            self.cg_iterations += 1;
+            self.matvec(&p, delta, &mut ap);
+            let pap: f64 = p.iter().zip(&ap).map(|(a, b)| a * b).sum();
+            if !(pap > 0.0) {
+                break;
+            }
+            let alpha = rz / pap;
+            for i in 0..n {
+                x[i] += alpha * p[i];
+                r[i] -= alpha * ap[i];
+            }
+            let dec = 0.5 * alpha * rz;
+            total += dec;
+            let rn = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+            if rn <= cg_tol() * bnorm || dec <= cg_eta() * total {
+                break;
+            }
+            precond(&r, &mut z);
+            let rz_new: f64 = r.iter().zip(&z).map(|(a, b)| a * b).sum();
+            let beta = rz_new / rz;
+            rz = rz_new;
+            for i in 0..n {
+                p[i] = z[i] + beta * p[i];
+            }
+        }
+        if x.iter().all(|v| v.is_finite()) {
+            Ok(x)
         } else {
             Err(SolverError::Factorization(
                 "the solve produced non-finite values".into(),
@@ -545,7 +773,8 @@ impl PlanarityOptimiser {
         if cost_before > 0.0 {
             let mut trial = x.clone();
             for _ in 0..=MAX_RETRIES {
-                let h = match self.solve(&g, self.damping * scale) {
+                let gg = if std::env::var("PLAN_ONLY").is_ok() { self.g_vol.clone() } else { g.clone() };
+                let h = match self.solve(&gg, self.damping * scale) {
                     Ok(h) => h,
                     Err(_) => {
                         self.damping = (self.damping * 10.0).max(1e-12);
@@ -692,6 +921,87 @@ mod tests {
             let scale = gd.abs() + (2.0 * cost * dhd).sqrt();
             assert!((slope - gd).abs() <= 1e-4 * scale, "{slope} vs {gd}");
             assert!((curv - dhd).abs() <= 1e-3 * dhd, "{curv} vs {dhd}");
+        }
+    }
+
+    /// Measurement of the fill-reducing orderings (not a check): `DUPIN_ND_SIZES=0.49,0.155
+    /// cargo test -p dupin-core --lib ordering_measurement -- --ignored --nocapture`.
+    #[test]
+    #[ignore]
+    fn ordering_measurement() {
+        use crate::{LayerRule, TriangulationMethod, TriangulationSpec, dual_mesh, triangulate};
+        let torus = crate::surface_by_name("torus", &[]).unwrap();
+        let sizes = std::env::var("DUPIN_ND_SIZES").unwrap_or("0.49,0.155".into());
+        for size in sizes.split(',').map(|s| s.parse::<f64>().unwrap()) {
+            let len = 2.0 * std::f64::consts::PI * 2.7;
+            let sp = TriangulationSpec {
+                method: TriangulationMethod::Prescribed,
+                rule: LayerRule::Ideal { bound: 0.3 },
+                samples: (len / size).round() as usize,
+                swap: false,
+                start: 0.0,
+                end: std::f64::consts::TAU,
+                along: (0.0, std::f64::consts::TAU),
+                max_layers: 4000,
+            };
+            let d = dual_mesh(&triangulate(torus.as_ref(), &sp).unwrap()).unwrap();
+            let mut noisy = d.mesh.clone();
+            let mut rng = ChaCha8Rng::seed_from_u64(7);
+            let e = noisy.face_mean_edge(0);
+            for p in noisy.positions.iter_mut() {
+                for k in 0..3 {
+                    p[k] += rng.random_range(-1.0..1.0) * 1e-3 * e;
+                }
+            }
+            let cpu = || {
+                std::fs::read_to_string("/proc/thread-self/schedstat")
+                    .ok()
+                    .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
+                    .unwrap_or(0.0)
+                    * 1e-9
+            };
+            let ords: Vec<Option<FillOrdering>> = std::env::var("ORDS")
+                .unwrap_or("cg".into())
+                .split(',')
+                .map(|o| match o {
+                    "scalar" => Some(FillOrdering::ScalarAmd),
+                    "vertex" => Some(FillOrdering::VertexAmd),
+                    "nd" => Some(FillOrdering::NestedDissection),
+                    _ => None,
+                })
+                .collect();
+            for ord in ords {
+                let c0 = cpu();
+                let t0 = std::time::Instant::now();
+                let mut m = noisy.clone();
+                let mut o = PlanarityOptimiser::with_ordering(
+                    &m,
+                    Some(&d.vertex_uv),
+                    PlanarityOptions::default(),
+                    ord,
+                )
+                .unwrap();
+                let t_new = t0.elapsed();
+                while !o.done() {
+                    let st = o.step(&mut m, torus.as_ref()).unwrap();
+                    if std::env::var("STEPS").is_ok() {
+                        eprintln!("  step {} planarity {:.2e} cost {:.2e} -> {:.2e} cg {} fact {}", st.iteration, st.max_planarity, st.cost_before, st.cost_after, o.cg_iterations(), o.factorizations());
+                    }
+                }
+                eprintln!(
+                    "cpu {:.3}s {} faces {ord:?}: cg {} nnz(A) {} nnz(L) {} new {:.3}s total {:.3}s it {} fact {} max_planarity {:.2e}",
+                    cpu() - c0,
+                    o.cg_iterations(),
+                    m.num_faces(),
+                    o.values.len(),
+                    o.factor_len(),
+                    t_new.as_secs_f64(),
+                    t0.elapsed().as_secs_f64(),
+                    o.iteration(),
+                    o.factorizations(),
+                    o.max_planarity()
+                );
+            }
         }
     }
 
