@@ -74,9 +74,11 @@ fn bench(c: &mut Criterion) {
                 o.step(&mut m, torus.as_ref()).unwrap();
             }
             eprintln!(
-                "phex torus-bound {label} optimisation from 1e-3 noise: {} iterations, {} factorisations, max_planarity {:.2e}",
+                "phex torus-bound {label} optimisation from 1e-3 noise: {} iterations, {} CG iterations, {} factorisations (nnz(L) {}), max_planarity {:.2e}",
                 o.iteration(),
+                o.cg_iterations(),
                 o.factorizations(),
+                o.factor_len(),
                 o.max_planarity()
             );
         }

@@ -35,7 +35,6 @@ mod ideal_triangle;
 mod math;
 mod mesh;
 mod mesh_topology;
-mod nested_dissection;
 mod obj;
 mod offset;
 mod phex;
