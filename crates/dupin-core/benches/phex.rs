@@ -85,7 +85,8 @@ fn bench(c: &mut Criterion) {
             eprintln!(
                 "phex torus-bound {label} optimisation from 1e-3 noise: {} faces, thread CPU {:.3} s, {} iterations, {} CG iterations, {} factorisations (nnz(L) {}), max_planarity {:.2e}",
                 m.num_faces(),
-                c0.and_then(|c| Some(thread_cpu_seconds()? - c)).unwrap_or(f64::NAN),
+                c0.and_then(|c| Some(thread_cpu_seconds()? - c))
+                    .unwrap_or(f64::NAN),
                 o.iteration(),
                 o.cg_iterations(),
                 o.factorizations(),

@@ -402,12 +402,13 @@ impl PlanarityOptimiser {
         self.iteration
     }
 
-    /// Sparse Cholesky factorisations done so far (one per tried damping).
+    /// Sparse Cholesky factorisations done so far (fallback only; one per tried damping).
     pub fn factorizations(&self) -> usize {
         self.factorizations
     }
 
-    /// Stored entries of the Cholesky factor (nnz(L), supernodal blocks included).
+    /// Stored entries of the Cholesky factor (nnz(L), supernodal blocks included); 0 until the
+    /// Cholesky fallback is first used.
     pub fn factor_len(&self) -> usize {
         self.factor.as_ref().map_or(0, |f| f.symbolic.len_val())
     }
