@@ -11,6 +11,14 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::hint::black_box;
 
+/// CPU time of this thread in seconds (Linux `schedstat`), to separate our own work from the
+/// waiting caused by other processes on a shared machine; `None` elsewhere.
+fn thread_cpu_seconds() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    let ns: f64 = s.split_whitespace().next()?.parse().ok()?;
+    Some(ns * 1e-9)
+}
+
 /// Base-curve edge lengths that give about 1k, 10k and 50k hexagons on the default torus.
 const SIZES: [(&str, f64); 3] = [("1k", 0.49), ("10k", 0.155), ("50k", 0.069)];
 
@@ -66,6 +74,7 @@ fn bench(c: &mut Criterion) {
             }
         }
         {
+            let c0 = thread_cpu_seconds();
             let mut m = noisy.clone();
             let mut o =
                 PlanarityOptimiser::new(&m, Some(&d.vertex_uv), PlanarityOptions::default())
@@ -74,9 +83,14 @@ fn bench(c: &mut Criterion) {
                 o.step(&mut m, torus.as_ref()).unwrap();
             }
             eprintln!(
-                "phex torus-bound {label} optimisation from 1e-3 noise: {} iterations, {} factorisations, max_planarity {:.2e}",
+                "phex torus-bound {label} optimisation from 1e-3 noise: {} faces, thread CPU {:.3} s, {} iterations, {} CG iterations, {} factorisations (nnz(L) {}), max_planarity {:.2e}",
+                m.num_faces(),
+                c0.and_then(|c| Some(thread_cpu_seconds()? - c))
+                    .unwrap_or(f64::NAN),
                 o.iteration(),
+                o.cg_iterations(),
                 o.factorizations(),
+                o.factor_len(),
                 o.max_planarity()
             );
         }
