@@ -26,6 +26,7 @@
 
 mod dual;
 mod error;
+mod extended_refinement;
 mod hierarchy;
 mod lattice;
 mod min_enclosing_circle;

@@ -126,25 +126,70 @@ pub(crate) fn check_simple(points: &[Vec2], what: &str) -> usize {
 
 /// Checks every guarantee of the simple refinement on a result for `points`.
 pub(crate) fn check_triangulation(t: &HexTriangulation, points: &[Vec2], what: &str) -> usize {
+    check_with(t, points, what, HexDelaunayMode::Simple)
+}
+
+/// Largest circumradius/(2·inradius) with angles in [α, 90°] (section 6.2): the right
+/// triangle with legs 1 and 3√3/5, 2ρ/φ ≈ 1.20787.
+const EXTENDED_ASPECT: f64 = 1.207_87;
+
+/// Section 6.3: shortest edge >= d_min · √7 / (12 √3).
+fn extended_min_edge(d: f64) -> f64 {
+    d * 7f64.sqrt() / (12.0 * 3f64.sqrt())
+}
+
+/// Checks every guarantee of `mode` on a result for `points`; returns the triangle count.
+pub(crate) fn check_with(
+    t: &HexTriangulation,
+    points: &[Vec2],
+    what: &str,
+    mode: HexDelaunayMode,
+) -> usize {
     let q = triangulation_quality(&t.vertices, &t.triangles);
     assert_eq!(q.inverted, 0, "{what}: inverted triangles");
     assert_eq!(q.nonmanifold_edges, 0, "{what}: non-manifold edges");
+    let (lo, hi, aspect) = match mode {
+        HexDelaunayMode::Simple => (29.99, 120.01, SIMPLE_ASPECT),
+        HexDelaunayMode::Extended => (43.89, 90.0001, EXTENDED_ASPECT),
+    };
+    // Per triangle, the angle tolerance also allows for the rounding of its corners to f64:
+    // 4 ulp of the coordinates' magnitude over its shortest edge, in degrees (only matters for
+    // points 1e-9 apart at unit offset, where an exact right angle of the lattice reads
+    // 90.0001x after rounding).
+    for tri in &t.triangles {
+        let p = tri.map(|i| t.vertices[i as usize]);
+        let mag = p.iter().map(|v| v.x.abs().max(v.y.abs())).fold(0.0, f64::max);
+        let short = (0..3)
+            .map(|i| (p[i] - p[(i + 1) % 3]).norm())
+            .fold(f64::INFINITY, f64::min);
+        let rel = 4.0 * f64::EPSILON * mag / short;
+        let tol = rel.to_degrees();
+        let (la, lb, lc) = (
+            (p[1] - p[2]).norm(),
+            (p[2] - p[0]).norm(),
+            (p[0] - p[1]).norm(),
+        );
+        let area = 0.5 * (p[1] - p[0]).perp(&(p[2] - p[0])).abs();
+        let ratio = la * lb * lc / (4.0 * area) / (2.0 * area / (0.5 * (la + lb + lc)));
+        assert!(
+            ratio <= aspect * (1.0 + 1e-6 + 16.0 * rel),
+            "{what}: aspect ratio {ratio}"
+        );
+        for i in 0..3 {
+            let a = (p[(i + 1) % 3] - p[i]).angle(&(p[(i + 2) % 3] - p[i])).to_degrees();
+            assert!(
+                a >= lo - tol && a <= hi + tol,
+                "{what}: angle {a} outside [{lo}, {hi}] (rounding tolerance {tol})"
+            );
+        }
+    }
     assert!(
-        q.min_angle_deg >= 29.99,
-        "{what}: min angle {}",
-        q.min_angle_deg
-    );
-    assert!(
-        q.max_angle_deg <= 120.01,
-        "{what}: max angle {}",
+        q.min_angle_deg >= lo - 1e-3 && q.max_angle_deg <= hi + 1e-3,
+        "{what}: angles {}..{}",
+        q.min_angle_deg,
         q.max_angle_deg
     );
     assert_eq!(q.delaunay_violations, 0, "{what}: not Delaunay");
-    assert!(
-        q.max_aspect_ratio <= SIMPLE_ASPECT * (1.0 + 1e-6),
-        "{what}: aspect ratio {}",
-        q.max_aspect_ratio
-    );
     // Tiling: the signed areas add up to Ω's area and the boundary edges lie on Ω's boundary.
     // Tolerance: 1e-9 relative, plus the rounding of boundary vertices to f64 (64 ulp of the
     // coordinates' magnitude along the perimeter), which dominates only for tiny offset domains.
@@ -206,7 +251,10 @@ pub(crate) fn check_triangulation(t: &HexTriangulation, points: &[Vec2], what: &
     // 0.0908 d).
     let d = d_min(points);
     if d.is_finite() {
-        let bound = d * 3f64.sqrt() / (8.0 * (3f64.sqrt() + 1.0));
+        let bound = match mode {
+            HexDelaunayMode::Simple => d * 3f64.sqrt() / (8.0 * (3f64.sqrt() + 1.0)),
+            HexDelaunayMode::Extended => extended_min_edge(d),
+        };
         assert!(
             q.min_edge >= bound * (1.0 - 1e-9),
             "{what}: shortest edge {} below {}",
@@ -458,5 +506,124 @@ fn paper_data_sets_take_fewer_triangles_than_table_1() {
         };
         println!("{name}: {n} triangles (paper, extended mode: {paper})");
         assert!(n < paper, "{name}: {n} triangles, paper {paper}");
+    }
+}
+
+
+/// Checks every guarantee of the extended refinement on one input; returns the triangle count.
+pub(crate) fn check_extended(points: &[Vec2], what: &str) -> usize {
+    let t = hex_delaunay(points, &[], HexDelaunayMode::Extended)
+        .unwrap_or_else(|e| panic!("{what}: {e}"));
+    check_with(&t, points, what, HexDelaunayMode::Extended)
+}
+
+fn run_families_extended(per_family: usize, seed: u64) {
+    for (fi, family) in FAMILIES.iter().enumerate() {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed + fi as u64);
+        for case in 0..per_family {
+            let pts = sample(*family, &mut rng);
+            check_extended(&pts, &format!("extended {family:?} case {case} (seed {seed})"));
+        }
+    }
+}
+
+#[test]
+fn extended_guarantees_over_seeded_families() {
+    run_families_extended(200, 3000);
+}
+
+#[test]
+#[ignore = "the issue's full 10^4 inputs per family; run with --ignored --release"]
+fn extended_guarantees_over_seeded_families_full() {
+    run_families_extended(10_000, 4000);
+}
+
+#[test]
+#[ignore = "exploration: counts failures per family instead of stopping at the first"]
+fn explore_extended() {
+    let per: usize = std::env::var("HEXD_PER")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(200);
+    let seed: u64 = std::env::var("HEXD_SEED")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(4000);
+    std::panic::set_hook(Box::new(|_| {}));
+    for (fi, family) in FAMILIES.iter().enumerate() {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed + fi as u64);
+        let mut fails = 0;
+        for case in 0..per {
+            let pts = sample(*family, &mut rng);
+            let what = format!("{family:?} case {case}");
+            let r = std::panic::catch_unwind(|| check_extended(&pts, &what));
+            if let Err(e) = r {
+                fails += 1;
+                if fails <= 3 {
+                    let msg = e
+                        .downcast_ref::<String>()
+                        .cloned()
+                        .unwrap_or_else(|| "?".into());
+                    println!("FAIL {msg}");
+                }
+            }
+        }
+        println!("{family:?}: {fails}/{per} failed");
+    }
+}
+
+#[test]
+#[ignore = "exploration: shortest edge over closest pair, per family"]
+fn explore_edge_ratio() {
+    for (fi, family) in FAMILIES.iter().enumerate() {
+        let mut rng = ChaCha8Rng::seed_from_u64(4000 + fi as u64);
+        let mut worst = f64::INFINITY;
+        for _ in 0..200 {
+            let pts = sample(*family, &mut rng);
+            let d = d_min(&pts);
+            if !d.is_finite() {
+                continue;
+            }
+            let t = hex_delaunay(&pts, &[], HexDelaunayMode::Extended).unwrap();
+            let q = triangulation_quality(&t.vertices, &t.triangles);
+            worst = worst.min(q.min_edge / d);
+        }
+        println!("{family:?}: min edge / d = {worst:.4} (bound {:.4})", extended_min_edge(1.0));
+    }
+}
+
+#[test]
+#[ignore = "exploration: where the shortest edge is"]
+fn explore_short_edge() {
+    let mut rng = ChaCha8Rng::seed_from_u64(4000 + 8);
+    for case in 0..3 {
+        let pts = sample(Family::Two, &mut rng);
+        let d = d_min(&pts);
+        let t = hex_delaunay(&pts, &[], HexDelaunayMode::Extended).unwrap();
+        let inp: std::collections::HashSet<u32> = t.input_vertex.iter().copied().collect();
+        let o = (t.domain[0] + t.domain[3]) * 0.5;
+        let big_r = (t.domain[0] - o).norm() / 3f64.sqrt() * 2.0;
+        let rr = big_r / 2f64.powi(t.depth as i32);
+        println!("case {case}: d {d}, depth {}, finest r {rr}, d/r {}", t.depth, d / rr);
+        let mut best = (f64::INFINITY, 0, 0);
+        for tri in &t.triangles {
+            for i in 0..3 {
+                let (a, b) = (tri[i], tri[(i + 1) % 3]);
+                let l = (t.vertices[a as usize] - t.vertices[b as usize]).norm();
+                if l < best.0 {
+                    best = (l, a, b);
+                }
+            }
+        }
+        let (l, a, b) = best;
+        let rel = |v: u32| {
+            let q = (t.vertices[v as usize] - o) / rr;
+            (q.x, q.y, inp.contains(&v))
+        };
+        println!("  shortest {} (= {} r, {} d): {:?} {:?}", l, l / rr, l / d, rel(a), rel(b));
+        for p in &pts {
+            let q = (p - o) / rr;
+            println!("  point {:?}", (q.x, q.y));
+        }
     }
 }
