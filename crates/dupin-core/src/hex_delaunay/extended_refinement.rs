@@ -117,25 +117,35 @@ fn classify(r: &Refinement) -> Pass {
     let mut ring1_fixed: FxHashSet<(u32, Axial)> = FxHashSet::default();
     let mut ring1_moved: FxHashMap<(u32, Axial), Vec2> = FxHashMap::default();
     let mut ring2: FxHashSet<(u32, Axial)> = FxHashSet::default();
-    let occ2 = |k: u32, x: Axial, p: Vec2| !in_half_hexagon(p, f.position(k, x), f.radius(k));
+    let mut verify: Vec<(u32, Axial, f64)> = Vec::new();
     for (&(k, x), &p) in &occupied {
         let c = f.position(k, x);
         let rad = f.radius(k);
-        let occ2 = occ2(k, x, p);
+        let occ2 = !in_half_hexagon(p, c, rad);
         // Ring conflicts between occupied hexagons of one level (section 5.1's rings must not
-        // overlap with different roles): two steps apart, one ring hexagon would be moved by
-        // one and fixed (or occupied) for the other unless both are OCCUPIED_1; three steps
-        // apart, a 2-ring (fixed) of one OCCUPIED_2 meets the moved 1-ring of the other.
-        // Four steps apart the rings only share fixed 2-ring hexagons (the paper's Fig. 7).
-        let conflict = |dist: i64, need_both: bool| {
-            ring(x, dist).any(|z| {
-                occupied.get(&(k, z)).is_some_and(|&q| {
+        // overlap with different roles). Two OCCUPIED_2 two steps apart would move a shared
+        // ring hexagon twice: split. Two steps apart with one OCCUPIED_2 (a fixed ring hexagon
+        // of the other is moved), or three steps apart with both OCCUPIED_2 (a moved 1-ring
+        // hexagon lies in the other's fixed 2-ring): ours, kept when the triangles around the
+        // 1-ring still meet the bounds (checked below), else split. Splitting every such pair
+        // would put the points in cells too small for section 6.3's edge bound. Four steps
+        // apart the rings only share fixed 2-ring hexagons (the paper's Fig. 7).
+        let mut must_split = false;
+        for dist in 2..=3 {
+            for z in ring(x, dist) {
+                if let Some(&q) = occupied.get(&(k, z)) {
                     let other = !in_half_hexagon(q, f.position(k, z), rad);
-                    if need_both { occ2 && other } else { occ2 || other }
-                })
-            })
-        };
-        if conflict(2, false) || conflict(3, true) {
+                    match (dist, occ2, other) {
+                        (2, true, true) => must_split = true,
+                        (2, true, false) | (2, false, true) | (3, true, true) => {
+                            verify.push((k, x, (p - q).norm()));
+                        }
+                        _ => {}
+                    }
+                }
+            }
+        }
+        if must_split {
             split.insert((k, x));
             continue;
         }
@@ -250,6 +260,40 @@ fn classify(r: &Refinement) -> Pass {
         }
         moved.insert(pack(k, v), c + (target - c) * w);
     });
+    // The waived ring conflicts: every triangle around the 1-ring of such an occupied hexagon
+    // (all lattice triangles of its level, by the 2-ring rule) must keep its angles in
+    // [α, 90°] and its edges at least section 6.3's d·√7/(12√3) for the pair's distance d.
+    let at = |k: u32, v: Axial| -> Vec2 {
+        if let Some(&p) = occupied.get(&(k, v)) {
+            p
+        } else {
+            moved
+                .get(&pack(k, v))
+                .copied()
+                .unwrap_or_else(|| f.position(k, v))
+        }
+    };
+    let cos_lo = (ANGLE_MIN - 1e-9).to_radians().cos();
+    for &(k, x, dist) in &verify {
+        if split.contains(&(k, x)) {
+            continue;
+        }
+        // Section 6.3's bound for the pair.
+        let min_edge = dist * 7f64.sqrt() / (12.0 * SQRT3) * (1.0 + 1e-9);
+        let ok = ring(x, 1).all(|y| {
+            (0..6).all(|i| {
+                let p = [y, add(y, DIRS[i]), add(y, DIRS[(i + 1) % 6])].map(|v| at(k, v));
+                (0..3).all(|j| {
+                    let (u, w) = (p[(j + 1) % 3] - p[j], p[(j + 2) % 3] - p[j]);
+                    let c = u.dot(&w) / (u.norm() * w.norm());
+                    u.perp(&w) > 0.0 && c >= -1e-12 && c <= cos_lo && u.norm() >= min_edge
+                })
+            })
+        });
+        if !ok {
+            split.insert((k, x));
+        }
+    }
     let mut split: Vec<_> = split.into_iter().collect();
     split.sort_unstable();
     let mut present: Vec<_> = present.into_iter().collect();
