@@ -1,6 +1,7 @@
 //! Scaling study for the hexagonal Delaunay triangulation: time and peak heap memory against
 //! output triangles for 1k..64k uniform points, the fitted exponent, and spade's 30° refinement
-//! on the same points. Run: `cargo run --release -p dupin-core --example hexd_scaling`.
+//! on the same points. Run: `cargo run --release -p dupin-core --example hexd_scaling`
+//! (simple mode) or `... --example hexd_scaling -- --extended` (extended mode).
 
 use dupin_core::{HexDelaunayMode, Vec2, hex_delaunay};
 use rand::{RngExt, SeedableRng};
@@ -50,6 +51,12 @@ fn spade_refine(points: &[Vec2]) -> (usize, f64) {
 }
 
 fn main() {
+    let mode = if std::env::args().any(|a| a == "--extended") {
+        HexDelaunayMode::Extended
+    } else {
+        HexDelaunayMode::Simple
+    };
+    println!("mode {mode:?}");
     let sizes = [1000usize, 2000, 4000, 8000, 16000, 32000, 64000];
     let mut xs = Vec::new();
     let mut ys = Vec::new();
@@ -70,12 +77,16 @@ fn main() {
         let mut best = f64::INFINITY;
         let mut tris = 0;
         let mut peak = 0;
-        let reps = if n <= 16000 { 7 } else { 3 };
+        let reps = match (mode, n <= 16000) {
+            (HexDelaunayMode::Simple, true) => 7,
+            (HexDelaunayMode::Simple, false) => 3,
+            (HexDelaunayMode::Extended, _) => 1,
+        };
         for _ in 0..reps {
             let base = LIVE.load(Ordering::Relaxed);
             PEAK.store(base, Ordering::Relaxed);
             let start = Instant::now();
-            let t = hex_delaunay(&pts, &[], HexDelaunayMode::Simple).expect("valid input");
+            let t = hex_delaunay(&pts, &[], mode).expect("valid input");
             let s = start.elapsed().as_secs_f64();
             peak = PEAK.load(Ordering::Relaxed) - base;
             best = best.min(s);
@@ -109,7 +120,7 @@ fn main() {
             let pts = uniform(n, n as u64);
             let t0 = Instant::now();
             let mut s =
-                dupin_core::HexDelaunayStepper::new(&pts, &[], HexDelaunayMode::Simple).unwrap();
+                dupin_core::HexDelaunayStepper::new(&pts, &[], mode).unwrap();
             let t1 = Instant::now();
             s.run().unwrap();
             let t2 = Instant::now();

@@ -34,6 +34,9 @@ pub struct HexDelaunayStepper {
     last: Vec<(u32, Axial)>,
     steps: usize,
     mode: HexDelaunayMode,
+    /// Whether the last extended pass found nothing to split (extended mode); reset by
+    /// splits and insertions.
+    extended_clean: bool,
 }
 
 impl HexDelaunayStepper {
@@ -132,6 +135,7 @@ impl HexDelaunayStepper {
             last: Vec::new(),
             steps: 0,
             mode,
+            extended_clean: false,
         })
     }
 
@@ -141,6 +145,7 @@ impl HexDelaunayStepper {
         if self.last.is_empty() && self.mode == HexDelaunayMode::Extended {
             // Simple rules exhausted: one extended pass (section 5.2) is one step.
             self.last = extended_pass(&mut self.refinement)?;
+            self.extended_clean = self.last.is_empty();
         }
         if self.last.is_empty() {
             Ok(false)
@@ -184,6 +189,7 @@ impl HexDelaunayStepper {
             };
             self.input_map.push(u);
         }
+        self.extended_clean = false;
         Ok(())
     }
 
@@ -199,6 +205,7 @@ impl HexDelaunayStepper {
             while !extended_pass(&mut self.refinement)?.is_empty() {
                 self.refinement.run()?;
             }
+            self.extended_clean = true;
         }
         Ok(())
     }
@@ -206,6 +213,7 @@ impl HexDelaunayStepper {
     /// Whether refinement is finished.
     pub fn is_done(&self) -> bool {
         self.refinement.is_done()
+            && (self.mode == HexDelaunayMode::Simple || self.extended_clean)
     }
 
     /// Number of steps taken through [`step`](Self::step).
@@ -288,7 +296,7 @@ impl HexDelaunayStepper {
     pub fn triangulation(&self) -> HexTriangulation {
         let h = &self.refinement.hierarchy;
         let mut moved: FxHashMap<Key, Vec2> = match self.mode {
-            HexDelaunayMode::Extended if self.refinement.is_done() => {
+            HexDelaunayMode::Extended if self.is_done() => {
                 relocated_centres(&self.refinement)
             }
             _ => FxHashMap::default(),

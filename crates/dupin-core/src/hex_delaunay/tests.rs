@@ -307,10 +307,15 @@ fn larger_uniform_sets() {
 #[test]
 fn stepper_matches_one_shot_and_cells_tile() {
     let mut rng = ChaCha8Rng::seed_from_u64(5);
-    for case in 0..50 {
+    for case in 0..60 {
         let pts = sample(FAMILIES[case % 9], &mut rng);
-        let one = hex_delaunay(&pts, &[], HexDelaunayMode::Simple).unwrap();
-        let mut s = HexDelaunayStepper::new(&pts, &[], HexDelaunayMode::Simple).unwrap();
+        let mode = if case % 2 == 0 {
+            HexDelaunayMode::Simple
+        } else {
+            HexDelaunayMode::Extended
+        };
+        let one = hex_delaunay(&pts, &[], mode).unwrap();
+        let mut s = HexDelaunayStepper::new(&pts, &[], mode).unwrap();
         let mut steps = 0;
         while s.step().unwrap() {
             steps += 1;
@@ -398,8 +403,17 @@ fn bad_input_is_refused() {
         Err(HexDelaunayError::DegenerateSegment { segment: 0 })
     );
     assert!(matches!(
-        hex_delaunay(&pts, &[], HexDelaunayMode::Extended),
+        hex_delaunay(&pts, &[[0, 2]], HexDelaunayMode::Extended),
         Err(HexDelaunayError::Unsupported(_))
+    ));
+    // Bad input is refused the same way in the extended mode.
+    assert_eq!(
+        hex_delaunay(&nan, &[], HexDelaunayMode::Extended),
+        Err(HexDelaunayError::NonFinite { index: 1 })
+    );
+    assert!(matches!(
+        hex_delaunay(&close, &[], HexDelaunayMode::Extended),
+        Err(HexDelaunayError::DepthLimit { .. })
     ));
 }
 
@@ -407,6 +421,11 @@ fn bad_input_is_refused() {
 fn incremental_insertion_keeps_the_guarantees() {
     let mut rng = ChaCha8Rng::seed_from_u64(77);
     for case in 0..300 {
+        let mode = if case % 3 == 2 {
+            HexDelaunayMode::Extended
+        } else {
+            HexDelaunayMode::Simple
+        };
         let first = sample(FAMILIES[case % 5], &mut rng);
         // Further points inside the hull of the first batch (hence inside Ω), some duplicates,
         // none closer than 1e-6 of the batch's extent to another (or the depth cap is hit).
@@ -435,7 +454,7 @@ fn incremental_insertion_keeps_the_guarantees() {
                 more.push(c);
             }
         }
-        let mut s = HexDelaunayStepper::new(&first, &[], HexDelaunayMode::Simple).unwrap();
+        let mut s = HexDelaunayStepper::new(&first, &[], mode).unwrap();
         s.run().unwrap();
         let before = s.triangulation();
         s.insert(&more).unwrap();
@@ -444,7 +463,7 @@ fn incremental_insertion_keeps_the_guarantees() {
         assert_eq!(after.domain, before.domain);
         assert!(after.triangles.len() >= before.triangles.len());
         let all: Vec<Vec2> = first.iter().chain(&more).copied().collect();
-        check_triangulation(&after, &all, &format!("incremental case {case}"));
+        check_with(&after, &all, &format!("incremental case {case}"), mode);
     }
     // Outside Ω: refused, nothing inserted.
     let pts = [Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0)];
@@ -494,25 +513,37 @@ pub(crate) fn paper_data_sets() -> Vec<(&'static str, Vec<Vec2>, usize)> {
     ]
 }
 
+/// Triangle count of one of the paper's data sets in `mode`, every guarantee checked.
+pub(crate) fn paper_count(name: &str, pts: &[Vec2], mode: HexDelaunayMode) -> usize {
+    let t = if name == "2 close pts" {
+        // The paper's set-up: a hexagon of unit (circum)radius around the pair.
+        let mut s =
+            HexDelaunayStepper::new_in_domain(pts, mode, Vec2::new(0.01, 0.0), 3f64.sqrt() / 2.0)
+                .unwrap();
+        s.run().unwrap();
+        s.triangulation()
+    } else {
+        hex_delaunay(pts, &[], mode).unwrap()
+    };
+    check_with(&t, pts, name, mode)
+}
+
 #[test]
 fn paper_data_sets_take_fewer_triangles_than_table_1() {
     for (name, pts, paper) in paper_data_sets() {
-        let n = if name == "2 close pts" {
-            // The paper's set-up: a hexagon of unit (circum)radius around the pair.
-            let mut s = HexDelaunayStepper::new_in_domain(
-                &pts,
-                HexDelaunayMode::Simple,
-                Vec2::new(0.01, 0.0),
-                3f64.sqrt() / 2.0,
-            )
-            .unwrap();
-            s.run().unwrap();
-            check_triangulation(&s.triangulation(), &pts, name)
-        } else {
-            check_simple(&pts, name)
-        };
-        println!("{name}: {n} triangles (paper, extended mode: {paper})");
-        assert!(n < paper, "{name}: {n} triangles, paper {paper}");
+        let simple = paper_count(name, &pts, HexDelaunayMode::Simple);
+        if pts.len() > 100 {
+            // 1k / 2k in the extended mode: the ignored test below (too slow for debug runs).
+            println!("{name}: simple {simple} triangles (paper: {paper})");
+            assert!(simple < paper, "{name}: {simple} triangles, paper {paper}");
+            continue;
+        }
+        let extended = paper_count(name, &pts, HexDelaunayMode::Extended);
+        println!("{name}: simple {simple}, extended {extended} triangles (paper: {paper})");
+        assert!(simple < paper, "{name}: {simple} triangles, paper {paper}");
+        // The extended mode subdivides MOVED_CENTER_3 hexagons and builds no blossoms (see
+        // extended_refinement.rs), so it is not below the paper's counts everywhere; its counts
+        // are reported in BENCHMARKS.md, its guarantees checked above.
     }
 }
 
@@ -636,6 +667,17 @@ fn explore_short_edge() {
         for p in &pts {
             let q = (p - o) / rr;
             println!("  point {:?}", (q.x, q.y));
+        }
+    }
+}
+
+#[test]
+#[ignore = "extended mode on the paper's 1k / 2k sets, all guarantees checked; run with --release"]
+fn paper_data_sets_extended_large() {
+    for (name, pts, paper) in paper_data_sets() {
+        if pts.len() > 100 {
+            let n = paper_count(name, &pts, HexDelaunayMode::Extended);
+            println!("{name}: extended {n} triangles (paper: {paper})");
         }
     }
 }
