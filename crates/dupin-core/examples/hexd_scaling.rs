@@ -57,7 +57,15 @@ fn main() {
         HexDelaunayMode::Simple
     };
     println!("mode {mode:?}");
-    let sizes = [1000usize, 2000, 4000, 8000, 16000, 32000, 64000];
+    // HEXD_MAX=N stops after N points.
+    let max: usize = std::env::var("HEXD_MAX")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(64000);
+    let sizes: Vec<usize> = [1000usize, 2000, 4000, 8000, 16000, 32000, 64000]
+        .into_iter()
+        .filter(|&n| n <= max)
+        .collect();
     let mut xs = Vec::new();
     let mut ys = Vec::new();
     println!(

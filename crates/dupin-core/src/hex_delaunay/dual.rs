@@ -44,9 +44,6 @@ pub struct DualBuilder<'h> {
     pub positions: Vec<Vec2>,
     /// Triangles, counter-clockwise.
     pub triangles: Vec<[u32; 3]>,
-    /// When asked for ([`build_with_keys`](Self::build_with_keys)): the lattice position
-    /// `(level, v)` each vertex was created at.
-    pub keys: Option<Vec<(u32, Axial)>>,
 }
 
 impl<'h> DualBuilder<'h> {
@@ -54,15 +51,6 @@ impl<'h> DualBuilder<'h> {
     /// the new positions of occupied centres. Storage is reserved exactly up front (one vertex
     /// per leaf full hexagon, at most two triangles per vertex), so nothing is reallocated.
     pub fn build(h: &'h Hierarchy, moved: &'h FxHashMap<Key, Vec2>) -> Self {
-        Self::build_inner(h, moved, false)
-    }
-
-    /// Like [`build`](Self::build), also recording every vertex's lattice position.
-    pub fn build_with_keys(h: &'h Hierarchy, moved: &'h FxHashMap<Key, Vec2>) -> Self {
-        Self::build_inner(h, moved, true)
-    }
-
-    fn build_inner(h: &'h Hierarchy, moved: &'h FxHashMap<Key, Vec2>, with_keys: bool) -> Self {
         let leaves = h.leaf_count();
         let mut b = DualBuilder {
             h,
@@ -71,7 +59,6 @@ impl<'h> DualBuilder<'h> {
             moved_vertex: FxHashMap::default(),
             positions: Vec::with_capacity(leaves),
             triangles: Vec::with_capacity(2 * leaves),
-            keys: with_keys.then(|| Vec::with_capacity(leaves)),
         };
         let o = b.new_vertex(1, (0, 0));
         let corners: [u32; 6] = std::array::from_fn(|i| b.new_vertex(1, DIRS[i]));
@@ -97,9 +84,6 @@ impl<'h> DualBuilder<'h> {
             None => self.h.frame.position(level, v),
         };
         self.positions.push(p);
-        if let Some(keys) = &mut self.keys {
-            keys.push((level, v));
-        }
         n
     }
 

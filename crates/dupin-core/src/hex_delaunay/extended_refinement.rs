@@ -1,26 +1,32 @@
 //! Extended refinement (section 5): classification of the full hexagons by their fins and
-//! occupancy (5.1), the extra refinement rules (5.2) and the centre relocations (5.4) of the
-//! hexagon types this implementation keeps.
+//! occupancy (5.1), the extra refinement rules (5.2) and the centre relocations (5.4).
 //!
-//! Input: a [`Refinement`] whose simple rules (section 4.1) have run to the end. Output: further
-//! splits until no extended rule fires, and the relocated centres of the dual mesh, keyed like
-//! the dual's vertices.
+//! Input: a [`Refinement`] whose simple rules (section 4.1) have run to the end (without rule
+//! 3b). Output: further splits until no extended rule fires, then the relocated centres of the
+//! dual mesh, keyed like the dual's vertices. Angles land in [α, 90°], α = 43.8979°.
 //!
-//! Kept types and formulas: MOVED_CENTER_1 (Ĉ = 5/6 C + 1/6 C_f0), MOVED_CENTER_2
+//! Types and formulas: MOVED_CENTER_1 (Ĉ = 5/6 C + 1/6 C_f0), MOVED_CENTER_2
 //! (Ĉ = 3/5 C + 2/5 C_f01), OCCUPIED_1/2 (point inside / outside the half-sized hexagon),
 //! MOVED_CENTER_IN_RING (shifted by half the vector from the occupied centre to the corner
-//! nearest its point), FIXED_CENTER_IN_RING and FIXED_CENTER_REGULAR (not moved).
-//! Deviation: MOVED_CENTER_3 hexagons are subdivided like SUBDIVIDE ones, so MOVED_CENTER_4,
-//! the consecutive-MOVED_CENTER_3 rule and blossoms never arise (more triangles, same bounds).
-//! Added rules (ours, for the bounded domain and for nearby points): a hexagon with fins on Ω's
-//! boundary is subdivided unless its relocation runs along the boundary; an occupied hexagon is
-//! subdivided when another occupied hexagon of its level lies within four steps, or when its
-//! 2-ring is not made of unsplit full hexagons of its level.
+//! nearest its point), FIXED_CENTER_IN_RING and FIXED_CENTER_REGULAR (not moved). Rules of 5.2:
+//! SUBDIVIDE, MOVED_CENTER_x in the 1-ring of an OCCUPIED_1 or the 1-/2-ring of an OCCUPIED_2,
+//! MOVED_CENTER_x whose fin-adjacent full hexagons are not fixed.
+//!
+//! Deviations (see docs/hexdelaunay.md): MOVED_CENTER_3 hexagons are subdivided like SUBDIVIDE
+//! ones, so MOVED_CENTER_4, the consecutive-MOVED_CENTER_3 rule and blossoms (with split
+//! counters, merge and break) never arise: more triangles, same bounds. Rules added:
+//! (a) opposite-facing fin strips: a MOVED_CENTER hexagon is subdivided when an unsplit
+//! same-level neighbour has fins none of which is at or next to its own fin directions (two
+//! such centres move apart and leave a 35° triangle between them, a case Fig. 10 lacks);
+//! (b) ring conflicts between occupied hexagons of one level, resolved by splitting or by a
+//! local check of the triangles around the rings (see `classify`); (c) the 2-ring of an
+//! occupied hexagon is made of unsplit full hexagons of its level; (d) on Ω's boundary a centre
+//! may only slide along the boundary, Ω's corners and an OCCUPIED_2's moved ring stay off it.
 //!
 //! Each pass classifies every leaf full hexagon in O(1) expected hash look-ups, so a pass costs
-//! O(T) for T output triangles; passes repeat until no rule fires.
+//! O(T) for T current triangles; passes repeat until no rule fires.
 
-use super::dual::{DualBuilder, Key, pack};
+use super::dual::{Key, pack};
 use super::error::HexDelaunayError;
 use super::hierarchy::{Cell, Hierarchy};
 use super::lattice::{Axial, DIRS, add, in_domain, on_boundary, parents_of_midpoint};
@@ -101,7 +107,8 @@ struct Pass {
     moved: FxHashMap<Key, Vec2>,
 }
 
-fn classify(r: &Refinement) -> Pass {
+/// Classifies the leaves (all of them, or those in `region`) and the occupied hexagons.
+fn classify(r: &Refinement, region: Option<&FxHashSet<(u32, Axial)>>) -> Pass {
     let h = &r.hierarchy;
     let f = &h.frame;
     let mut occupied: FxHashMap<(u32, Axial), Vec2> = FxHashMap::default();
@@ -200,7 +207,7 @@ fn classify(r: &Refinement) -> Pass {
             && !ring1_moved.contains_key(&(k, v))
     };
     let mut moved: FxHashMap<Key, Vec2> = FxHashMap::default();
-    for_each_leaf(h, |k, v| {
+    let mut visit = |k: u32, v: Axial| {
         let mask = fin_mask(h, k, v);
         if mask == 0 {
             if let Some(s) = ring1_moved.get(&(k, v)) {
@@ -259,7 +266,20 @@ fn classify(r: &Refinement) -> Pass {
             return;
         }
         moved.insert(pack(k, v), c + (target - c) * w);
-    });
+    };
+    match region {
+        None => for_each_leaf(h, &mut visit),
+        Some(set) => {
+            // The fans checked below need the relocations of the occupied hexagons' 2-rings.
+            let extra = verify.iter().flat_map(|&(k, x, _)| disc(x, 2).map(move |z| (k, z)));
+            let mut seen: FxHashSet<(u32, Axial)> = FxHashSet::default();
+            for (k, v) in set.iter().copied().chain(extra) {
+                if h.is_present(k, v) && !h.is_split(k, v) && seen.insert((k, v)) {
+                    visit(k, v);
+                }
+            }
+        }
+    }
     // The waived ring conflicts: every triangle around the 1-ring of such an occupied hexagon
     // (all lattice triangles of its level, by the 2-ring rule) must keep its angles in
     // [α, 90°] and its edges at least section 6.3's d·√7/(12√3) for the pair's distance d.
@@ -305,78 +325,83 @@ fn classify(r: &Refinement) -> Pass {
     }
 }
 
-/// Runs one extended pass on a refinement whose simple rules are exhausted: splits every
-/// hexagon an extended rule marks. Returns the splits made (empty once finished).
-pub fn extended_pass(r: &mut Refinement) -> Result<Vec<(u32, Axial)>, HexDelaunayError> {
-    let pass = classify(r);
-    let mut made = Vec::new();
-    for (k, x) in pass.split {
-        made.extend(r.split_now(k, x)?);
+/// Which leaves the next extended pass must classify: after splits, only those near them
+/// (the work-queue design of the simple refinement, one pass per wave of splits); otherwise
+/// all of them. A run ends only after a full pass finds nothing, so the result is the same
+/// fixed point a sequence of full passes reaches, at O(changes) cost per incremental pass.
+#[derive(Debug, Clone, Default)]
+pub struct ExtendedState {
+    changes: Option<Vec<(u32, Axial)>>,
+}
+
+impl ExtendedState {
+    /// Forces a full pass next (after insertions).
+    pub fn reset(&mut self) {
+        self.changes = None;
     }
-    for (k, x) in pass.present {
-        made.extend(r.make_present(k, x)?);
-    }
-    if false && made.is_empty() && r.is_done() {
-        // Ours: verification. The paper proves its bounds only by a sample of configurations
-        // (Fig. 10) and this implementation keeps a subset of its types, so the dual is built
-        // with the relocated centres and every triangle with an angle outside
-        // [ANGLE_MIN, ANGLE_MAX] gets its coarsest corner hexagon subdivided.
-        for (k, x) in bad_corners(r, &pass.moved) {
-            made.extend(r.split_now(k, x)?);
+
+    /// Records splits made outside the extended passes (simple rules, balancing).
+    pub fn record(&mut self, made: &[(u32, Axial)]) {
+        if let Some(c) = &mut self.changes {
+            c.extend_from_slice(made);
         }
     }
-    Ok(made)
+}
+
+/// Lattice points within hexagonal distance `r` of `v`.
+fn disc(v: Axial, r: i64) -> impl Iterator<Item = Axial> {
+    (-r..=r).flat_map(move |a| {
+        ((-r).max(-a - r)..=r.min(-a + r)).map(move |b| (v.0 + a, v.1 + b))
+    })
+}
+
+/// Leaves whose classification a split of `(k, x)` may change: its level within two steps
+/// (fins, neighbours' fins, rings), the coarser level within three, the finer within four
+/// (new leaves and the fin-adjacent hexagons of 5.2's fourth rule).
+fn candidates(changes: &[(u32, Axial)]) -> FxHashSet<(u32, Axial)> {
+    let mut out = FxHashSet::default();
+    for &(k, x) in changes {
+        out.extend(disc(x, 2).map(|z| (k, z)));
+        if k >= 1 {
+            out.extend(disc((x.0.div_euclid(2), x.1.div_euclid(2)), 3).map(|z| (k - 1, z)));
+        }
+        out.extend(disc((2 * x.0, 2 * x.1), 4).map(|z| (k + 1, z)));
+    }
+    out
+}
+
+/// One extended step on a refinement whose simple rules are exhausted: classifies (near the
+/// last changes, or everywhere) and splits every hexagon an extended rule marks. Returns the
+/// splits made; empty once a full pass finds nothing.
+pub fn extended_pass(
+    r: &mut Refinement,
+    state: &mut ExtendedState,
+) -> Result<Vec<(u32, Axial)>, HexDelaunayError> {
+    loop {
+        let region = state.changes.take().map(|c| candidates(&c));
+        let full = region.is_none();
+        let pass = classify(r, region.as_ref());
+        let mut made = Vec::new();
+        for (k, x) in pass.split {
+            made.extend(r.split_now(k, x)?);
+        }
+        for (k, x) in pass.present {
+            made.extend(r.make_present(k, x)?);
+        }
+        if !made.is_empty() {
+            state.changes = Some(made.clone());
+            return Ok(made);
+        }
+        if full {
+            return Ok(made);
+        }
+    }
 }
 
 /// Lower angle bound of the extended refinement, degrees (tan α = 5/(3√3), section 5.4).
 pub const ANGLE_MIN: f64 = 43.897_886_248_013_99;
-/// Upper angle bound, degrees (section 6.1), with room for rounding.
-pub const ANGLE_MAX: f64 = 90.0 + 1e-7;
-
-/// Leaf hexagons (level, centre) at the coarsest corner of every dual triangle whose angles
-/// leave the bounds.
-fn bad_corners(r: &Refinement, relocated: &FxHashMap<Key, Vec2>) -> Vec<(u32, Axial)> {
-    let h = &r.hierarchy;
-    let mut moved = relocated.clone();
-    for (i, c) in r.cell_of.iter().enumerate() {
-        if let Cell::Full(k, x) = *c {
-            moved.insert(pack(k, x), r.points[i]);
-        }
-    }
-    let dual = DualBuilder::build_with_keys(h, &moved);
-    let keys = dual.keys.as_ref().expect("keys were asked for");
-    let leaf = |(mut k, mut v): (u32, Axial)| {
-        while h.is_split(k, v) {
-            v = (2 * v.0, 2 * v.1);
-            k += 1;
-        }
-        (k, v)
-    };
-    let mut out: FxHashSet<(u32, Axial)> = FxHashSet::default();
-    let cos_min = ANGLE_MIN.to_radians().cos();
-    let cos_max = ANGLE_MAX.to_radians().cos();
-    for t in &dual.triangles {
-        let p = t.map(|i| dual.positions[i as usize]);
-        let bad = (0..3).any(|i| {
-            let (a, b) = (p[(i + 1) % 3] - p[i], p[(i + 2) % 3] - p[i]);
-            let c = a.dot(&b) / (a.norm() * b.norm());
-            !(cos_max..=cos_min).contains(&c)
-        });
-        if bad {
-            let corner = t
-                .iter()
-                .map(|&i| leaf(keys[i as usize]))
-                .min_by_key(|&(k, v)| (k, v))
-                .expect("three corners");
-            out.insert(corner);
-        }
-    }
-    let mut out: Vec<_> = out.into_iter().collect();
-    out.sort_unstable();
-    out
-}
 
 /// The relocated centres (section 5.4) of the finished extended refinement.
 pub fn relocated_centres(r: &Refinement) -> FxHashMap<Key, Vec2> {
-    classify(r).moved
+    classify(r, None).moved
 }

@@ -3,7 +3,7 @@
 
 use super::dual::{DualBuilder, Key, pack};
 use super::error::HexDelaunayError;
-use super::extended_refinement::{extended_pass, relocated_centres};
+use super::extended_refinement::{ExtendedState, extended_pass, relocated_centres};
 use super::hierarchy::{Cell, Hierarchy};
 use super::lattice::{Axial, DIRS, Frame, add, parents_of_midpoint};
 use super::min_enclosing_circle::min_enclosing_circle;
@@ -37,6 +37,7 @@ pub struct HexDelaunayStepper {
     /// Whether the last extended pass found nothing to split (extended mode); reset by
     /// splits and insertions.
     extended_clean: bool,
+    extended: ExtendedState,
 }
 
 impl HexDelaunayStepper {
@@ -136,16 +137,21 @@ impl HexDelaunayStepper {
             steps: 0,
             mode,
             extended_clean: false,
+            extended: ExtendedState::default(),
         })
     }
 
     /// One subdivision step. Returns `Ok(false)` once refinement is finished.
     pub fn step(&mut self) -> Result<bool, HexDelaunayError> {
         self.last = self.refinement.step()?;
-        if self.last.is_empty() && self.mode == HexDelaunayMode::Extended {
-            // Simple rules exhausted: one extended pass (section 5.2) is one step.
-            self.last = extended_pass(&mut self.refinement)?;
-            self.extended_clean = self.last.is_empty();
+        if self.mode == HexDelaunayMode::Extended {
+            if self.last.is_empty() {
+                // Simple rules exhausted: one extended pass (section 5.2) is one step.
+                self.last = extended_pass(&mut self.refinement, &mut self.extended)?;
+                self.extended_clean = self.last.is_empty();
+            } else {
+                self.extended.record(&self.last);
+            }
         }
         if self.last.is_empty() {
             Ok(false)
@@ -190,6 +196,7 @@ impl HexDelaunayStepper {
             self.input_map.push(u);
         }
         self.extended_clean = false;
+        self.extended.reset();
         Ok(())
     }
 
@@ -200,13 +207,10 @@ impl HexDelaunayStepper {
 
     /// Runs all remaining steps.
     pub fn run(&mut self) -> Result<(), HexDelaunayError> {
-        self.refinement.run()?;
-        if self.mode == HexDelaunayMode::Extended {
-            while !extended_pass(&mut self.refinement)?.is_empty() {
-                self.refinement.run()?;
-            }
-            self.extended_clean = true;
+        if self.mode == HexDelaunayMode::Simple {
+            return self.refinement.run();
         }
+        while self.step()? {}
         Ok(())
     }
 
