@@ -77,7 +77,15 @@ fn main() {
     let mut ys = Vec::new();
     println!(
         "{:>7} {:>10} {:>9} {:>9} {:>10} {:>12} {:>9} | {:>10} {:>9}",
-        "points", "triangles", "seconds", "cpu s", "ns/tri", "peak MB", "B/tri", "spade tri", "spade s"
+        "points",
+        "triangles",
+        "seconds",
+        "cpu s",
+        "ns/tri",
+        "peak MB",
+        "B/tri",
+        "spade tri",
+        "spade s"
     );
     for &n in &sizes {
         let pts = uniform(n, n as u64);
@@ -142,8 +150,7 @@ fn main() {
         for &n in &[16000usize, 64000] {
             let pts = uniform(n, n as u64);
             let t0 = Instant::now();
-            let mut s =
-                dupin_core::HexDelaunayStepper::new(&pts, &[], mode).unwrap();
+            let mut s = dupin_core::HexDelaunayStepper::new(&pts, &[], mode).unwrap();
             let t1 = Instant::now();
             s.run().unwrap();
             let t2 = Instant::now();

@@ -77,7 +77,9 @@ fn fin_mask(h: &Hierarchy, k: u32, v: Axial) -> u8 {
 fn consecutive(mask: u8) -> Option<(usize, usize)> {
     match mask.count_ones() {
         1 => Some((mask.trailing_zeros() as usize, 1)),
-        2 => (0..6).find(|&j| mask == (1 << j) | (1 << ((j + 1) % 6))).map(|j| (j, 2)),
+        2 => (0..6)
+            .find(|&j| mask == (1 << j) | (1 << ((j + 1) % 6)))
+            .map(|j| (j, 2)),
         _ => None,
     }
 }
@@ -231,7 +233,8 @@ fn classify(r: &Refinement, region: Option<&FxHashSet<(u32, Axial)>>) -> Pass {
             let y = add(v, d);
             if h.is_present(k, y) && !h.is_split(k, y) {
                 let my = fin_mask(h, k, y);
-                let adjacent_fins = mask | (mask << 1) | (mask >> 1) | ((mask & 1) << 5) | ((mask >> 5) & 1);
+                let adjacent_fins =
+                    mask | (mask << 1) | (mask >> 1) | ((mask & 1) << 5) | ((mask >> 5) & 1);
                 if my != 0 && my & adjacent_fins == 0 {
                     split.insert((k, v));
                     return;
@@ -271,7 +274,9 @@ fn classify(r: &Refinement, region: Option<&FxHashSet<(u32, Axial)>>) -> Pass {
         None => for_each_leaf(h, &mut visit),
         Some(set) => {
             // The fans checked below need the relocations of the occupied hexagons' 2-rings.
-            let extra = verify.iter().flat_map(|&(k, x, _)| disc(x, 2).map(move |z| (k, z)));
+            let extra = verify
+                .iter()
+                .flat_map(|&(k, x, _)| disc(x, 2).map(move |z| (k, z)));
             let mut seen: FxHashSet<(u32, Axial)> = FxHashSet::default();
             for (k, v) in set.iter().copied().chain(extra) {
                 if h.is_present(k, v) && !h.is_split(k, v) && seen.insert((k, v)) {
@@ -350,9 +355,7 @@ impl ExtendedState {
 
 /// Lattice points within hexagonal distance `r` of `v`.
 fn disc(v: Axial, r: i64) -> impl Iterator<Item = Axial> {
-    (-r..=r).flat_map(move |a| {
-        ((-r).max(-a - r)..=r.min(-a + r)).map(move |b| (v.0 + a, v.1 + b))
-    })
+    (-r..=r).flat_map(move |a| ((-r).max(-a - r)..=r.min(-a + r)).map(move |b| (v.0 + a, v.1 + b)))
 }
 
 /// Leaves whose classification a split of `(k, x)` may change: its level within two steps

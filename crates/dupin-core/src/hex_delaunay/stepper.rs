@@ -216,8 +216,7 @@ impl HexDelaunayStepper {
 
     /// Whether refinement is finished.
     pub fn is_done(&self) -> bool {
-        self.refinement.is_done()
-            && (self.mode == HexDelaunayMode::Simple || self.extended_clean)
+        self.refinement.is_done() && (self.mode == HexDelaunayMode::Simple || self.extended_clean)
     }
 
     /// Number of steps taken through [`step`](Self::step).
@@ -300,9 +299,7 @@ impl HexDelaunayStepper {
     pub fn triangulation(&self) -> HexTriangulation {
         let h = &self.refinement.hierarchy;
         let mut moved: FxHashMap<Key, Vec2> = match self.mode {
-            HexDelaunayMode::Extended if self.is_done() => {
-                relocated_centres(&self.refinement)
-            }
+            HexDelaunayMode::Extended if self.is_done() => relocated_centres(&self.refinement),
             _ => FxHashMap::default(),
         };
         let mut point_key = Vec::with_capacity(self.refinement.points.len());

@@ -165,7 +165,10 @@ pub(crate) fn check_with(
     // 90.0001x after rounding).
     for tri in &t.triangles {
         let p = tri.map(|i| t.vertices[i as usize]);
-        let mag = p.iter().map(|v| v.x.abs().max(v.y.abs())).fold(0.0, f64::max);
+        let mag = p
+            .iter()
+            .map(|v| v.x.abs().max(v.y.abs()))
+            .fold(0.0, f64::max);
         let short = (0..3)
             .map(|i| (p[i] - p[(i + 1) % 3]).norm())
             .fold(f64::INFINITY, f64::min);
@@ -183,7 +186,9 @@ pub(crate) fn check_with(
             "{what}: aspect ratio {ratio}"
         );
         for i in 0..3 {
-            let a = (p[(i + 1) % 3] - p[i]).angle(&(p[(i + 2) % 3] - p[i])).to_degrees();
+            let a = (p[(i + 1) % 3] - p[i])
+                .angle(&(p[(i + 2) % 3] - p[i]))
+                .to_degrees();
             assert!(
                 a >= lo - tol && a <= hi + tol,
                 "{what}: angle {a} outside [{lo}, {hi}] (rounding tolerance {tol})"
@@ -547,7 +552,6 @@ fn paper_data_sets_take_fewer_triangles_than_table_1() {
     }
 }
 
-
 /// Checks every guarantee of the extended refinement on one input; returns the triangle count.
 pub(crate) fn check_extended(points: &[Vec2], what: &str) -> usize {
     let t = hex_delaunay(points, &[], HexDelaunayMode::Extended)
@@ -560,7 +564,10 @@ fn run_families_extended(per_family: usize, seed: u64) {
         let mut rng = ChaCha8Rng::seed_from_u64(seed + fi as u64);
         for case in 0..per_family {
             let pts = sample(*family, &mut rng);
-            check_extended(&pts, &format!("extended {family:?} case {case} (seed {seed})"));
+            check_extended(
+                &pts,
+                &format!("extended {family:?} case {case} (seed {seed})"),
+            );
         }
     }
 }
@@ -626,7 +633,10 @@ fn explore_edge_ratio() {
             let q = triangulation_quality(&t.vertices, &t.triangles);
             worst = worst.min(q.min_edge / d);
         }
-        println!("{family:?}: min edge / d = {worst:.4} (bound {:.4})", extended_min_edge(1.0));
+        println!(
+            "{family:?}: min edge / d = {worst:.4} (bound {:.4})",
+            extended_min_edge(1.0)
+        );
     }
 }
 
@@ -647,7 +657,11 @@ fn explore_short_edge() {
         let o = (t.domain[0] + t.domain[3]) * 0.5;
         let big_r = (t.domain[0] - o).norm() / 3f64.sqrt() * 2.0;
         let rr = big_r / 2f64.powi(t.depth as i32);
-        println!("case {case}: d {d}, depth {}, finest r {rr}, d/r {}", t.depth, d / rr);
+        println!(
+            "case {case}: d {d}, depth {}, finest r {rr}, d/r {}",
+            t.depth,
+            d / rr
+        );
         let mut best = (f64::INFINITY, 0, 0);
         for tri in &t.triangles {
             for i in 0..3 {
@@ -663,7 +677,14 @@ fn explore_short_edge() {
             let q = (t.vertices[v as usize] - o) / rr;
             (q.x, q.y, inp.contains(&v))
         };
-        println!("  shortest {} (= {} r, {} d): {:?} {:?}", l, l / rr, l / d, rel(a), rel(b));
+        println!(
+            "  shortest {} (= {} r, {} d): {:?} {:?}",
+            l,
+            l / rr,
+            l / d,
+            rel(a),
+            rel(b)
+        );
         for p in &pts {
             let q = (p - o) / rr;
             println!("  point {:?}", (q.x, q.y));
