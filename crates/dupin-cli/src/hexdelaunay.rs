@@ -15,7 +15,7 @@ use std::time::Instant;
 pub enum Mode {
     /// Section 4: angles in [30, 120] degrees.
     Simple,
-    /// Section 5: angles in [43.9, 90] degrees (not implemented yet).
+    /// Section 5: angles in [43.9, 90] degrees.
     Extended,
 }
 

@@ -103,6 +103,41 @@ fn triangulates_and_reports_contract_fields() {
 }
 
 #[test]
+fn extended_mode_keeps_43_9_to_90_degrees() {
+    let text = "0 0\n1 0\n0.25 0.5\n0.7 0.9\n0.7 0.9\n0.123456789012345678 0.3\n0.5 0.5\n";
+    let pts = temp("pts.txt", Some(text));
+    let out = temp("out.obj", None);
+    let rep = temp("r.json", None);
+    let (code, stdout, stderr) = run(&[
+        "hexdelaunay",
+        "--points",
+        pts.to_str().unwrap(),
+        "--mode",
+        "extended",
+        "--out",
+        out.to_str().unwrap(),
+        "--report",
+        rep.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("hexdelaunay"));
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&rep).unwrap()).unwrap();
+    assert_eq!(r["input_points"], 7);
+    assert!(r["min_angle_deg"].as_f64().unwrap() >= 43.89, "{r}");
+    assert!(r["max_angle_deg"].as_f64().unwrap() <= 90.0001, "{r}");
+    assert_eq!(r["delaunay"], true);
+    let mesh = dupin_core::parse_obj(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    assert_eq!(mesh.num_faces() as u64, r["triangles"].as_u64().unwrap());
+    for p in dupin_core::parse_points(text).unwrap() {
+        assert!(
+            mesh.positions.iter().any(|v| v.x == p.x && v.y == p.y),
+            "input point {p:?} is not an exact vertex"
+        );
+    }
+}
+
+#[test]
 fn bad_input_exits_2_with_one_error_line() {
     assert!(bad("", None, &[]).contains("no points"));
     assert!(bad("# only a comment\n\n", None, &[]).contains("no points"));
@@ -117,7 +152,8 @@ fn bad_input_exits_2_with_one_error_line() {
     assert!(bad(square, Some("0 1\n2 3\n"), &[]).contains("cross"));
     assert!(bad(square, Some("0 9\n"), &[]).contains("point 9"));
     assert!(bad(square, Some("0 1\nx\n"), &[]).contains("line 2"));
-    assert!(bad(square, None, &["--mode", "extended"]).contains("not implemented"));
+    // PSLG refinement (section 7) is not implemented: valid segments are refused clearly.
+    assert!(bad(square, Some("0 2\n"), &[]).contains("not implemented"));
     assert!(bad(square, None, &["--mode", "fancy"]).contains("error"));
     let missing = temp("missing.txt", None);
     let out = temp("out.obj", None);

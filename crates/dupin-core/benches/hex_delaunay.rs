@@ -1,5 +1,5 @@
-//! Criterion benchmarks of the hexagonal Delaunay triangulation (simple refinement) on seeded
-//! uniform points, with spade's constrained Delaunay refinement at its default 30° bound on the
+//! Criterion benchmarks of the hexagonal Delaunay triangulation (simple and extended
+//! refinement) on seeded uniform points, with spade's constrained Delaunay refinement at its default 30° bound on the
 //! same points as the peer. Run: `cargo bench -p dupin-core --bench hex_delaunay -- --quick`.
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
@@ -33,13 +33,31 @@ fn bench(c: &mut Criterion) {
             .expect("valid input")
             .triangles
             .len();
+        // The extended mode only at 2k points: at 16k one run takes minutes (BENCHMARKS.md).
+        let extended = (n <= 2000).then(|| {
+            hex_delaunay(&pts, &[], HexDelaunayMode::Extended)
+                .expect("valid input")
+                .triangles
+                .len()
+        });
         let theirs = spade_refine(&pts);
-        eprintln!("{n} points: hex_delaunay {ours} triangles, spade 30deg {theirs} triangles");
+        eprintln!(
+            "{n} points: hex_delaunay simple {ours}, extended {extended:?} triangles, spade \
+             30deg {theirs} triangles"
+        );
         g.bench_with_input(BenchmarkId::new("simple", n), &pts, |b, p| {
             b.iter(|| {
                 hex_delaunay(black_box(p), &[], HexDelaunayMode::Simple).map(|t| t.triangles.len())
             })
         });
+        if extended.is_some() {
+            g.bench_with_input(BenchmarkId::new("extended", n), &pts, |b, p| {
+                b.iter(|| {
+                    hex_delaunay(black_box(p), &[], HexDelaunayMode::Extended)
+                        .map(|t| t.triangles.len())
+                })
+            });
+        }
         g.bench_with_input(BenchmarkId::new("spade_refine_30deg", n), &pts, |b, p| {
             b.iter(|| spade_refine(black_box(p)))
         });

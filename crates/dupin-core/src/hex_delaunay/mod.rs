@@ -3,7 +3,8 @@
 //! Input: points in the plane (optionally segments, see below). Output: a triangulation of a
 //! bounding hexagon Ω in which every input point is a vertex with its exact coordinates, dual to
 //! an adaptive hexagon subdivision (sections 3 and 4). With [`HexDelaunayMode::Simple`] every
-//! angle lies in [30°, 120°] and the mesh is Delaunay.
+//! angle lies in [30°, 120°], with [`HexDelaunayMode::Extended`] (section 5) in
+//! [43.8979°, 90°]; both meshes are Delaunay.
 //!
 //! Bounding hexagon (section 4.1): the minimum enclosing circle (Welzl) of the points, radius
 //! ρ, is the inner circle of the hexagon the paper places around the points; here Ω is that
@@ -19,13 +20,14 @@
 //! that costs O(1) per output triangle. See `hierarchy.rs`, `simple_refinement.rs`, `dual.rs`.
 //!
 //! Not implemented yet (each returns [`HexDelaunayError::Unsupported`] where it is asked for):
-//! the extended refinement of section 5 (43.9°..90°), PSLG input (section 7, segments are
-//! validated, then refused) and the reverse operations with split counters (section 3.2, needed
-//! only for the extended refinement's blossoms). Incremental insertion is
-//! [`HexDelaunayStepper::insert`].
+//! PSLG input (section 7: segments are validated, then refused); in the extended refinement,
+//! MOVED_CENTER_3/4 relocations and blossom coarsening with split counters, merge and break
+//! (sections 3.2, 5.3; MOVED_CENTER_3 hexagons are subdivided instead, see
+//! `extended_refinement.rs`). Incremental insertion is [`HexDelaunayStepper::insert`].
 
 mod dual;
 mod error;
+mod extended_refinement;
 mod hierarchy;
 mod lattice;
 mod min_enclosing_circle;
@@ -47,7 +49,7 @@ pub enum HexDelaunayMode {
     /// Section 4: angles in [30°, 120°].
     #[default]
     Simple,
-    /// Section 5: angles in [43.9°, 90°]. Not implemented yet.
+    /// Section 5: angles in [43.9°, 90°] (Ω with inradius 3ρ instead of 1.5ρ).
     Extended,
 }
 

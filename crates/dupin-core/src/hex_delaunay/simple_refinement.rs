@@ -44,6 +44,9 @@ pub struct Refinement {
     queue: VecDeque<u32>,
     queued: Vec<bool>,
     scratch: Vec<(u32, Axial)>,
+    /// Whether rule 3b applies (simple mode). The extended refinement replaces it by its ring
+    /// conflict rules, which allow two OCCUPIED_1 hexagons two steps apart.
+    pub rule_3b: bool,
 }
 
 enum Action {
@@ -68,6 +71,7 @@ impl Refinement {
             queue: (0..n as u32).collect(),
             queued: vec![true; n],
             scratch: Vec::new(),
+            rule_3b: true,
         }
     }
 
@@ -123,7 +127,7 @@ impl Refinement {
                 // Rule 3b (ours): no other occupied hexagon of this level shares a ring
                 // hexagon, else two relocated centres face each other across one ring edge and
                 // the two opposite angles (up to 120° each) break the Delaunay property.
-                for (j, d) in DIRS.iter().enumerate() {
+                for (j, d) in DIRS.iter().enumerate().filter(|_| self.rule_3b) {
                     let e = DIRS[(j + 1) % 6];
                     for z in [add(x, add(*d, *d)), add(x, add(*d, e))] {
                         if self.occupied(&Cell::Full(k, z)) > 0 && !h.is_split(k, z) {
@@ -162,6 +166,32 @@ impl Refinement {
             }
         }
         Ok(Vec::new())
+    }
+
+    /// Splits the full hexagon `x` at level `k` now (with its balancing splits), re-locating
+    /// the displaced points and queueing the affected ones. Returns the splits made.
+    pub fn split_now(&mut self, k: u32, x: Axial) -> Result<Vec<(u32, Axial)>, HexDelaunayError> {
+        let mut out = Vec::new();
+        self.hierarchy.ensure_split(k, x, &mut out)?;
+        for &(k, x) in &out {
+            self.after_split(k, x);
+        }
+        Ok(out)
+    }
+
+    /// Makes `x` at level `k` a full hexagon now (splitting the coarser hexagon on it, with
+    /// balancing), re-locating displaced points. Returns the splits made.
+    pub fn make_present(
+        &mut self,
+        k: u32,
+        x: Axial,
+    ) -> Result<Vec<(u32, Axial)>, HexDelaunayError> {
+        let mut out = Vec::new();
+        self.hierarchy.ensure_present(k, x, &mut out)?;
+        for &(k, x) in &out {
+            self.after_split(k, x);
+        }
+        Ok(out)
     }
 
     /// Runs the refinement to the end.

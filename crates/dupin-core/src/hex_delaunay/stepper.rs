@@ -3,6 +3,7 @@
 
 use super::dual::{DualBuilder, Key, pack};
 use super::error::HexDelaunayError;
+use super::extended_refinement::{ExtendedState, extended_pass, relocated_centres};
 use super::hierarchy::{Cell, Hierarchy};
 use super::lattice::{Axial, DIRS, Frame, add, parents_of_midpoint};
 use super::min_enclosing_circle::min_enclosing_circle;
@@ -32,6 +33,11 @@ pub struct HexDelaunayStepper {
     by_bits: FxHashMap<(u64, u64), u32>,
     last: Vec<(u32, Axial)>,
     steps: usize,
+    mode: HexDelaunayMode,
+    /// Whether the last extended pass found nothing to split (extended mode); reset by
+    /// splits and insertions.
+    extended_clean: bool,
+    extended: ExtendedState,
 }
 
 impl HexDelaunayStepper {
@@ -48,11 +54,6 @@ impl HexDelaunayStepper {
                 "PSLG segments (section 7); triangulate the points alone",
             ));
         }
-        if mode == HexDelaunayMode::Extended {
-            return Err(HexDelaunayError::Unsupported(
-                "extended refinement (section 5, 43.9..90 degrees); use the simple mode",
-            ));
-        }
         let circle = min_enclosing_circle(&unique).ok_or(HexDelaunayError::Empty)?;
         let rho = if unique.len() > 1 {
             if circle.radius < MIN_EXTENT {
@@ -65,8 +66,15 @@ impl HexDelaunayStepper {
         } else {
             circle.center.x.abs().max(circle.center.y.abs()).max(1.0)
         };
-        // Ω has inradius 1.5 rho = 3R/4.
-        Self::build(unique, input_map, circle.center, 2.0 * rho)
+        // Ω has inradius 3R/4: 1.5 rho in the simple mode. The extended mode's rings and
+        // fin rules need about three hexagons between a point and Ω's boundary, which with
+        // 1.5 rho forces cells finer than the closest pair asks for (section 6.3's bound then
+        // fails for sparse sets); inradius 3 rho leaves that room at the pair's own level.
+        let root = match mode {
+            HexDelaunayMode::Simple => 2.0 * rho,
+            HexDelaunayMode::Extended => 4.0 * rho,
+        };
+        Self::build(unique, input_map, circle.center, root, mode)
     }
 
     /// Like [`new`](Self::new) but triangulating a given bounding hexagon Ω (centre `center`,
@@ -81,11 +89,6 @@ impl HexDelaunayStepper {
         inradius: f64,
     ) -> Result<Self, HexDelaunayError> {
         let (unique, input_map) = check_points(points)?;
-        if mode == HexDelaunayMode::Extended {
-            return Err(HexDelaunayError::Unsupported(
-                "extended refinement (section 5, 43.9..90 degrees); use the simple mode",
-            ));
-        }
         let valid = (MIN_EXTENT..=MAX_COORDINATE).contains(&inradius)
             && center.x.is_finite()
             && center.y.is_finite();
@@ -95,7 +98,7 @@ impl HexDelaunayStepper {
                 limit: MIN_EXTENT,
             });
         }
-        let mut s = Self::build(Vec::new(), Vec::new(), center, inradius / 0.75)?;
+        let mut s = Self::build(Vec::new(), Vec::new(), center, inradius / 0.75, mode)?;
         s.insert(&unique)?;
         s.input_map = input_map;
         Ok(s)
@@ -106,6 +109,7 @@ impl HexDelaunayStepper {
         input_map: Vec<u32>,
         center: Vec2,
         root_radius: f64,
+        mode: HexDelaunayMode,
     ) -> Result<Self, HexDelaunayError> {
         let frame = Frame {
             origin: center,
@@ -122,17 +126,33 @@ impl HexDelaunayStepper {
             .map(|(i, p)| (bits(p), i as u32))
             .collect();
         Ok(HexDelaunayStepper {
-            refinement: Refinement::new(hierarchy, unique),
+            refinement: {
+                let mut r = Refinement::new(hierarchy, unique);
+                r.rule_3b = mode == HexDelaunayMode::Simple;
+                r
+            },
             input_map,
             by_bits,
             last: Vec::new(),
             steps: 0,
+            mode,
+            extended_clean: false,
+            extended: ExtendedState::default(),
         })
     }
 
     /// One subdivision step. Returns `Ok(false)` once refinement is finished.
     pub fn step(&mut self) -> Result<bool, HexDelaunayError> {
         self.last = self.refinement.step()?;
+        if self.mode == HexDelaunayMode::Extended {
+            if self.last.is_empty() {
+                // Simple rules exhausted: one extended pass (section 5.2) is one step.
+                self.last = extended_pass(&mut self.refinement, &mut self.extended)?;
+                self.extended_clean = self.last.is_empty();
+            } else {
+                self.extended.record(&self.last);
+            }
+        }
         if self.last.is_empty() {
             Ok(false)
         } else {
@@ -175,6 +195,8 @@ impl HexDelaunayStepper {
             };
             self.input_map.push(u);
         }
+        self.extended_clean = false;
+        self.extended.reset();
         Ok(())
     }
 
@@ -185,12 +207,16 @@ impl HexDelaunayStepper {
 
     /// Runs all remaining steps.
     pub fn run(&mut self) -> Result<(), HexDelaunayError> {
-        self.refinement.run()
+        if self.mode == HexDelaunayMode::Simple {
+            return self.refinement.run();
+        }
+        while self.step()? {}
+        Ok(())
     }
 
     /// Whether refinement is finished.
     pub fn is_done(&self) -> bool {
-        self.refinement.is_done()
+        self.refinement.is_done() && (self.mode == HexDelaunayMode::Simple || self.extended_clean)
     }
 
     /// Number of steps taken through [`step`](Self::step).
@@ -272,7 +298,10 @@ impl HexDelaunayStepper {
     /// points. Input points are exact vertices only once refinement is finished.
     pub fn triangulation(&self) -> HexTriangulation {
         let h = &self.refinement.hierarchy;
-        let mut moved: FxHashMap<Key, Vec2> = FxHashMap::default();
+        let mut moved: FxHashMap<Key, Vec2> = match self.mode {
+            HexDelaunayMode::Extended if self.is_done() => relocated_centres(&self.refinement),
+            _ => FxHashMap::default(),
+        };
         let mut point_key = Vec::with_capacity(self.refinement.points.len());
         for (i, c) in self.refinement.cell_of.iter().enumerate() {
             let key = match *c {

@@ -126,25 +126,82 @@ pub(crate) fn check_simple(points: &[Vec2], what: &str) -> usize {
 
 /// Checks every guarantee of the simple refinement on a result for `points`.
 pub(crate) fn check_triangulation(t: &HexTriangulation, points: &[Vec2], what: &str) -> usize {
+    check_with(t, points, what, HexDelaunayMode::Simple)
+}
+
+/// Largest circumradius/(2·inradius) with angles in [α, 90°] (section 6.2): the right
+/// triangle with legs 1 and 3√3/5, 2ρ/φ ≈ 1.20787.
+const EXTENDED_ASPECT: f64 = 1.207_87;
+
+/// Shortest edge of the extended mode in terms of the closest pair d. Section 6.3 claims
+/// d·√7/(12√3) ≈ 0.1273·d, assuming points are never split apart while six hexagons lie
+/// between them; its own ring rules (an OCCUPIED_2's 2-ring fixed) split OCCUPIED_2 pairs three
+/// steps apart, where d reaches (3√3 + 2) r. What holds here: every split at the deepest level
+/// K is made for a pair with d <= (3√3 + 2) r_K (rule 1: 2 r_K, rule 3: (√3 + 2) r_K, ring
+/// conflicts: two or three steps), so leaves have r >= d / (2 (3√3 + 2)), and every edge is at
+/// least Fig. 8's √7/2 r: bound √7 d / (4 (3√3 + 2)) ≈ 0.0919·d (measured minimum over the
+/// families: see docs/hexdelaunay.md).
+fn extended_min_edge(d: f64) -> f64 {
+    d * 7f64.sqrt() / (4.0 * (3.0 * 3f64.sqrt() + 2.0))
+}
+
+/// Checks every guarantee of `mode` on a result for `points`; returns the triangle count.
+pub(crate) fn check_with(
+    t: &HexTriangulation,
+    points: &[Vec2],
+    what: &str,
+    mode: HexDelaunayMode,
+) -> usize {
     let q = triangulation_quality(&t.vertices, &t.triangles);
     assert_eq!(q.inverted, 0, "{what}: inverted triangles");
     assert_eq!(q.nonmanifold_edges, 0, "{what}: non-manifold edges");
+    let (lo, hi, aspect) = match mode {
+        HexDelaunayMode::Simple => (29.99, 120.01, SIMPLE_ASPECT),
+        HexDelaunayMode::Extended => (43.89, 90.0001, EXTENDED_ASPECT),
+    };
+    // Per triangle, the angle tolerance also allows for the rounding of its corners to f64:
+    // 4 ulp of the coordinates' magnitude over its shortest edge, in degrees (only matters for
+    // points 1e-9 apart at unit offset, where an exact right angle of the lattice reads
+    // 90.0001x after rounding).
+    for tri in &t.triangles {
+        let p = tri.map(|i| t.vertices[i as usize]);
+        let mag = p
+            .iter()
+            .map(|v| v.x.abs().max(v.y.abs()))
+            .fold(0.0, f64::max);
+        let short = (0..3)
+            .map(|i| (p[i] - p[(i + 1) % 3]).norm())
+            .fold(f64::INFINITY, f64::min);
+        let rel = 4.0 * f64::EPSILON * mag / short;
+        let tol = rel.to_degrees();
+        let (la, lb, lc) = (
+            (p[1] - p[2]).norm(),
+            (p[2] - p[0]).norm(),
+            (p[0] - p[1]).norm(),
+        );
+        let area = 0.5 * (p[1] - p[0]).perp(&(p[2] - p[0])).abs();
+        let ratio = la * lb * lc / (4.0 * area) / (2.0 * area / (0.5 * (la + lb + lc)));
+        assert!(
+            ratio <= aspect * (1.0 + 1e-6 + 16.0 * rel),
+            "{what}: aspect ratio {ratio}"
+        );
+        for i in 0..3 {
+            let a = (p[(i + 1) % 3] - p[i])
+                .angle(&(p[(i + 2) % 3] - p[i]))
+                .to_degrees();
+            assert!(
+                a >= lo - tol && a <= hi + tol,
+                "{what}: angle {a} outside [{lo}, {hi}] (rounding tolerance {tol})"
+            );
+        }
+    }
     assert!(
-        q.min_angle_deg >= 29.99,
-        "{what}: min angle {}",
-        q.min_angle_deg
-    );
-    assert!(
-        q.max_angle_deg <= 120.01,
-        "{what}: max angle {}",
+        q.min_angle_deg >= lo - 1e-3 && q.max_angle_deg <= hi + 1e-3,
+        "{what}: angles {}..{}",
+        q.min_angle_deg,
         q.max_angle_deg
     );
     assert_eq!(q.delaunay_violations, 0, "{what}: not Delaunay");
-    assert!(
-        q.max_aspect_ratio <= SIMPLE_ASPECT * (1.0 + 1e-6),
-        "{what}: aspect ratio {}",
-        q.max_aspect_ratio
-    );
     // Tiling: the signed areas add up to Ω's area and the boundary edges lie on Ω's boundary.
     // Tolerance: 1e-9 relative, plus the rounding of boundary vertices to f64 (64 ulp of the
     // coordinates' magnitude along the perimeter), which dominates only for tiny offset domains.
@@ -206,7 +263,10 @@ pub(crate) fn check_triangulation(t: &HexTriangulation, points: &[Vec2], what: &
     // 0.0908 d).
     let d = d_min(points);
     if d.is_finite() {
-        let bound = d * 3f64.sqrt() / (8.0 * (3f64.sqrt() + 1.0));
+        let bound = match mode {
+            HexDelaunayMode::Simple => d * 3f64.sqrt() / (8.0 * (3f64.sqrt() + 1.0)),
+            HexDelaunayMode::Extended => extended_min_edge(d),
+        };
         assert!(
             q.min_edge >= bound * (1.0 - 1e-9),
             "{what}: shortest edge {} below {}",
@@ -252,10 +312,15 @@ fn larger_uniform_sets() {
 #[test]
 fn stepper_matches_one_shot_and_cells_tile() {
     let mut rng = ChaCha8Rng::seed_from_u64(5);
-    for case in 0..50 {
+    for case in 0..60 {
         let pts = sample(FAMILIES[case % 9], &mut rng);
-        let one = hex_delaunay(&pts, &[], HexDelaunayMode::Simple).unwrap();
-        let mut s = HexDelaunayStepper::new(&pts, &[], HexDelaunayMode::Simple).unwrap();
+        let mode = if case % 2 == 0 {
+            HexDelaunayMode::Simple
+        } else {
+            HexDelaunayMode::Extended
+        };
+        let one = hex_delaunay(&pts, &[], mode).unwrap();
+        let mut s = HexDelaunayStepper::new(&pts, &[], mode).unwrap();
         let mut steps = 0;
         while s.step().unwrap() {
             steps += 1;
@@ -343,8 +408,17 @@ fn bad_input_is_refused() {
         Err(HexDelaunayError::DegenerateSegment { segment: 0 })
     );
     assert!(matches!(
-        hex_delaunay(&pts, &[], HexDelaunayMode::Extended),
+        hex_delaunay(&pts, &[[0, 2]], HexDelaunayMode::Extended),
         Err(HexDelaunayError::Unsupported(_))
+    ));
+    // Bad input is refused the same way in the extended mode.
+    assert_eq!(
+        hex_delaunay(&nan, &[], HexDelaunayMode::Extended),
+        Err(HexDelaunayError::NonFinite { index: 1 })
+    );
+    assert!(matches!(
+        hex_delaunay(&close, &[], HexDelaunayMode::Extended),
+        Err(HexDelaunayError::DepthLimit { .. })
     ));
 }
 
@@ -352,6 +426,11 @@ fn bad_input_is_refused() {
 fn incremental_insertion_keeps_the_guarantees() {
     let mut rng = ChaCha8Rng::seed_from_u64(77);
     for case in 0..300 {
+        let mode = if case % 3 == 2 {
+            HexDelaunayMode::Extended
+        } else {
+            HexDelaunayMode::Simple
+        };
         let first = sample(FAMILIES[case % 5], &mut rng);
         // Further points inside the hull of the first batch (hence inside Ω), some duplicates,
         // none closer than 1e-6 of the batch's extent to another (or the depth cap is hit).
@@ -380,7 +459,7 @@ fn incremental_insertion_keeps_the_guarantees() {
                 more.push(c);
             }
         }
-        let mut s = HexDelaunayStepper::new(&first, &[], HexDelaunayMode::Simple).unwrap();
+        let mut s = HexDelaunayStepper::new(&first, &[], mode).unwrap();
         s.run().unwrap();
         let before = s.triangulation();
         s.insert(&more).unwrap();
@@ -389,7 +468,7 @@ fn incremental_insertion_keeps_the_guarantees() {
         assert_eq!(after.domain, before.domain);
         assert!(after.triangles.len() >= before.triangles.len());
         let all: Vec<Vec2> = first.iter().chain(&more).copied().collect();
-        check_triangulation(&after, &all, &format!("incremental case {case}"));
+        check_with(&after, &all, &format!("incremental case {case}"), mode);
     }
     // Outside Ω: refused, nothing inserted.
     let pts = [Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0)];
@@ -439,24 +518,128 @@ pub(crate) fn paper_data_sets() -> Vec<(&'static str, Vec<Vec2>, usize)> {
     ]
 }
 
+/// Triangle count of one of the paper's data sets in `mode`, every guarantee checked.
+pub(crate) fn paper_count(name: &str, pts: &[Vec2], mode: HexDelaunayMode) -> usize {
+    let t = if name == "2 close pts" {
+        // The paper's set-up: a hexagon of unit (circum)radius around the pair.
+        let mut s =
+            HexDelaunayStepper::new_in_domain(pts, mode, Vec2::new(0.01, 0.0), 3f64.sqrt() / 2.0)
+                .unwrap();
+        s.run().unwrap();
+        s.triangulation()
+    } else {
+        hex_delaunay(pts, &[], mode).unwrap()
+    };
+    check_with(&t, pts, name, mode)
+}
+
 #[test]
 fn paper_data_sets_take_fewer_triangles_than_table_1() {
     for (name, pts, paper) in paper_data_sets() {
-        let n = if name == "2 close pts" {
-            // The paper's set-up: a hexagon of unit (circum)radius around the pair.
-            let mut s = HexDelaunayStepper::new_in_domain(
+        let simple = paper_count(name, &pts, HexDelaunayMode::Simple);
+        if pts.len() > 100 {
+            // 1k / 2k in the extended mode: the ignored test below (too slow for debug runs).
+            println!("{name}: simple {simple} triangles (paper: {paper})");
+            assert!(simple < paper, "{name}: {simple} triangles, paper {paper}");
+            continue;
+        }
+        let extended = paper_count(name, &pts, HexDelaunayMode::Extended);
+        println!("{name}: simple {simple}, extended {extended} triangles (paper: {paper})");
+        assert!(simple < paper, "{name}: {simple} triangles, paper {paper}");
+        // The extended mode subdivides MOVED_CENTER_3 hexagons and builds no blossoms (see
+        // extended_refinement.rs), so it is not below the paper's counts everywhere; its counts
+        // are reported in BENCHMARKS.md, its guarantees checked above.
+    }
+}
+
+/// Checks every guarantee of the extended refinement on one input; returns the triangle count.
+pub(crate) fn check_extended(points: &[Vec2], what: &str) -> usize {
+    let t = hex_delaunay(points, &[], HexDelaunayMode::Extended)
+        .unwrap_or_else(|e| panic!("{what}: {e}"));
+    check_with(&t, points, what, HexDelaunayMode::Extended)
+}
+
+fn run_families_extended(per_family: usize, seed: u64) {
+    for (fi, family) in FAMILIES.iter().enumerate() {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed + fi as u64);
+        for case in 0..per_family {
+            let pts = sample(*family, &mut rng);
+            check_extended(
                 &pts,
-                HexDelaunayMode::Simple,
-                Vec2::new(0.01, 0.0),
-                3f64.sqrt() / 2.0,
-            )
-            .unwrap();
-            s.run().unwrap();
-            check_triangulation(&s.triangulation(), &pts, name)
-        } else {
-            check_simple(&pts, name)
-        };
-        println!("{name}: {n} triangles (paper, extended mode: {paper})");
-        assert!(n < paper, "{name}: {n} triangles, paper {paper}");
+                &format!("extended {family:?} case {case} (seed {seed})"),
+            );
+        }
+    }
+}
+
+#[test]
+fn extended_guarantees_over_seeded_families() {
+    run_families_extended(60, 3000);
+}
+
+#[test]
+#[ignore = "the issue's full 10^4 inputs per family; run with --ignored --release"]
+fn extended_guarantees_over_seeded_families_full() {
+    run_families_extended(10_000, 4000);
+}
+
+#[test]
+#[ignore = "exploration: counts failures per family (HEXD_PER, HEXD_SEED), fails if any"]
+fn explore_extended() {
+    let per: usize = std::env::var("HEXD_PER")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(200);
+    let seed: u64 = std::env::var("HEXD_SEED")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(4000);
+    std::panic::set_hook(Box::new(|_| {}));
+    let mut total = 0;
+    for (fi, family) in FAMILIES.iter().enumerate() {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed + fi as u64);
+        let mut fails = 0;
+        for case in 0..per {
+            let pts = sample(*family, &mut rng);
+            let what = format!("{family:?} case {case}");
+            let r = std::panic::catch_unwind(|| check_extended(&pts, &what));
+            if let Err(e) = r {
+                fails += 1;
+                if fails <= 3 {
+                    let msg = e
+                        .downcast_ref::<String>()
+                        .cloned()
+                        .unwrap_or_else(|| "?".into());
+                    println!("FAIL {msg}");
+                }
+            }
+        }
+        println!("{family:?}: {fails}/{per} failed");
+        total += fails;
+    }
+    assert_eq!(total, 0, "inputs breaking a guarantee");
+}
+
+#[test]
+#[ignore = "exploration: shortest edge over closest pair, per family"]
+fn explore_edge_ratio() {
+    for (fi, family) in FAMILIES.iter().enumerate() {
+        let mut rng = ChaCha8Rng::seed_from_u64(4000 + fi as u64);
+        let mut worst = f64::INFINITY;
+        for _ in 0..200 {
+            let pts = sample(*family, &mut rng);
+            let d = d_min(&pts);
+            if !d.is_finite() {
+                continue;
+            }
+            let t = hex_delaunay(&pts, &[], HexDelaunayMode::Extended).unwrap();
+            let q = triangulation_quality(&t.vertices, &t.triangles);
+            worst = worst.min(q.min_edge / d);
+        }
+        println!(
+            "{family:?}: min edge / d = {worst:.4} (bound {:.4})",
+            extended_min_edge(1.0)
+        );
+        assert!(worst >= extended_min_edge(1.0), "{family:?}");
     }
 }
