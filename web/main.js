@@ -1,6 +1,9 @@
 // Dupin configurator: a thin shell. Geometry and rendering live in Rust (../crates/dupin-web);
 // this file wires DOM events, the URL hash and the frame loop.
 import init, { Session, Viewer, sceneNames, torusMesh } from './pkg/dupin_web.js';
+import { initTeach } from './teach.js';
+import { initHexd2d } from './hexd2d.js';
+import { initPresent } from './present.js';
 
 const $ = (id) => document.querySelector(`[data-testid="${id}"]`) ?? document.getElementById(id);
 const statusEl = $('status');
@@ -253,6 +256,9 @@ async function main() {
     return;
   }
   buildControls();
+  initTeach();
+  initHexd2d();
+  initPresent(() => mesh);
   $('scene-select').addEventListener('change', (e) => {
     config = { scene: e.target.value, params: {}, backend: config.backend };
     for (const [k, s] of Object.entries(SCENES[config.scene]?.params ?? {})) config.params[k] = s.value;

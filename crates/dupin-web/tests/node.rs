@@ -79,3 +79,6 @@ fn bad_session_configs_throw_readable_errors() {
         assert!(msg.contains(needle), "{json}: {msg}");
     }
 }
+
+#[path = "web_api/teach.rs"]
+mod teach_node;
