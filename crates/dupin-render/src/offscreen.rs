@@ -112,18 +112,20 @@ async fn gpu() -> Result<(wgpu::Adapter, wgpu::Device, wgpu::Queue), RenderError
 }
 
 /// Renders a presentation scene (glass `panels`, metal `frames`, ground and sun shadows; see
-/// [`PresentationRenderer`]) seen by `camera` into a `width` x `height` image. Blocks.
+/// [`PresentationRenderer`]) seen by `camera` into a `width` x `height` image, with or without
+/// the sun's `shadows`. Blocks.
 pub fn render_presentation_offscreen(
     panels: &TriangleBuffers,
     frames: &TriangleBuffers,
     camera: &OrbitCamera,
-    width: u32,
-    height: u32,
+    (width, height): (u32, u32),
+    shadows: bool,
 ) -> Result<OffscreenImage, RenderError> {
     pollster::block_on(async {
         let (adapter, device, queue) = gpu().await?;
         let mut r = PresentationRenderer::new(&device, wgpu::TextureFormat::Rgba8UnormSrgb);
         r.set_scene(&device, &queue, panels, None, frames)?;
+        r.set_shadows(shadows);
         let (tx, rx) = std::sync::mpsc::channel();
         r.begin_snapshot(&device, &queue, width.max(1), height.max(1), camera)
             .read(move |r| {

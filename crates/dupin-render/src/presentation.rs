@@ -84,7 +84,10 @@ pub fn frame_buffers(edges: &[f32], beam: f32, node: f32) -> TriangleBuffers {
                 ] {
                     for s in [1.0f32, -1.0] {
                         let (o, b, w) = (a * s * hn, b * hn, w * hn * s);
-                        quad([c + o - b - w, c + o + b - w, c + o + b + w, c + o - b + w], a * s);
+                        quad(
+                            [c + o - b - w, c + o + b - w, c + o + b + w, c + o - b + w],
+                            a * s,
+                        );
                     }
                 }
             }
@@ -110,6 +113,7 @@ pub struct PresentationRenderer {
     /// Bounding sphere of the scene (centre, radius).
     bounds: (Vec3, f32),
     depth: Option<(wgpu::TextureView, u32, u32)>,
+    shadows: bool,
 }
 
 impl PresentationRenderer {
@@ -300,6 +304,7 @@ impl PresentationRenderer {
             ground: None,
             bounds: (Vec3::ZERO, 1.0),
             depth: None,
+            shadows: true,
         }
     }
 
@@ -343,6 +348,11 @@ impl PresentationRenderer {
         self.frames = upload(device, queue, &metal, &frames.indices);
         self.ground = upload(device, queue, &ground, &[0, 1, 2, 0, 2, 3]);
         Ok(())
+    }
+
+    /// Turns the sun's shadows on (the default) or off (everything fully sunlit).
+    pub fn set_shadows(&mut self, on: bool) {
+        self.shadows = on;
     }
 
     /// Bounding sphere of the current scene (for framing the camera).
@@ -425,7 +435,7 @@ impl PresentationRenderer {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            if let Some(m) = &self.frames {
+            if let Some(m) = self.frames.as_ref().filter(|_| self.shadows) {
                 pass.set_pipeline(&self.shadow_pipeline);
                 pass.set_bind_group(0, &self.shadow_group, &[]);
                 draw(&mut pass, m);

@@ -53,7 +53,9 @@ fn mode_of(name: &str) -> Result<HexDelaunayMode, String> {
     match name {
         "simple" => Ok(HexDelaunayMode::Simple),
         "extended" => Ok(HexDelaunayMode::Extended),
-        other => Err(format!("mode must be `simple` or `extended`, not `{other}`")),
+        other => Err(format!(
+            "mode must be `simple` or `extended`, not `{other}`"
+        )),
     }
 }
 
@@ -92,7 +94,8 @@ impl HexDelaunayLab {
         for c in s.cells() {
             out.sizes.push(c.corners.len() as u32);
             out.occupied.push(c.occupied);
-            out.corners.extend(c.corners.iter().flat_map(|p| [p.x, p.y]));
+            out.corners
+                .extend(c.corners.iter().flat_map(|p| [p.x, p.y]));
         }
         out
     }
@@ -117,7 +120,11 @@ impl HexDelaunayLab {
         Dual {
             vertices: t.vertices.iter().flat_map(|p| [p.x, p.y]).collect(),
             triangles: t.triangles.iter().flatten().copied().collect(),
-            min_angle: if t.triangles.is_empty() { 0.0 } else { q.min_angle_deg },
+            min_angle: if t.triangles.is_empty() {
+                0.0
+            } else {
+                q.min_angle_deg
+            },
             max_angle: q.max_angle_deg,
             histogram,
             bin_deg: BIN_DEG,
@@ -194,7 +201,10 @@ mod tests {
         }
         assert!(steps > 1 && lab.cells_data().sizes.len() > first);
         let d = lab.dual_data();
-        assert!(d.min_angle >= 30.0 - 1e-9 && d.max_angle <= 120.0 + 1e-9, "{d:?}");
+        assert!(
+            d.min_angle >= 30.0 - 1e-9 && d.max_angle <= 120.0 + 1e-9,
+            "{d:?}"
+        );
         let n: u32 = d.histogram.iter().sum();
         assert_eq!(n as usize, d.triangles.len());
         assert_eq!(d.delaunay_violations, 0);

@@ -5,20 +5,20 @@
 //! them with `dupin-render` into a canvas (WebGPU, or WebGL2 where WebGPU is missing).
 //! Errors cross the boundary as JS `Error`s carrying the Rust message.
 
+mod hexd2d;
 mod mesh_data;
 mod present;
-mod hexd2d;
 mod session;
 mod teach;
 // The canvas viewer needs wgpu's browser backends, which exist only on wasm32.
 #[cfg(target_arch = "wasm32")]
 mod viewer;
 
-pub use mesh_data::{MeshData, torus_mesh};
 pub use hexd2d::HexDelaunayLab;
-pub use present::torus_panels_js;
+pub use mesh_data::{MeshData, torus_mesh};
 #[cfg(target_arch = "wasm32")]
 pub use present::Presenter;
+pub use present::torus_panels_js;
 pub use session::{Session, scene_names};
 pub use teach::{DupinLesson, surface_catalog_js};
 #[cfg(target_arch = "wasm32")]

@@ -362,7 +362,10 @@ mod tests {
         assert_eq!(s.beams, 2 * m.num_faces());
         assert_eq!(s.glass.triangle_count(), 2 * m.num_faces());
         // 4 sides per beam and 6 per node, 2 triangles a side.
-        assert_eq!(s.frames.triangle_count(), 2 * (4 * s.beams + 6 * m.num_vertices()));
+        assert_eq!(
+            s.frames.triangle_count(),
+            2 * (4 * s.beams + 6 * m.num_vertices())
+        );
         let o = build_scene(&m, true);
         match &o.offset_error {
             None => {

@@ -166,9 +166,8 @@ impl DupinLesson {
             5 => (q + self.b, self.b),
             _ => return Err(format!("star vertex index must be 0..5, got {index}")),
         };
-        TriangleStar::new(Vec2::zeros(), a, b).map_err(|e| {
-            format!("{e}: the dragged vertex would make the star's triangles flat")
-        })?;
+        TriangleStar::new(Vec2::zeros(), a, b)
+            .map_err(|e| format!("{e}: the dragged vertex would make the star's triangles flat"))?;
         self.a = a;
         self.b = b;
         self.dragged = Some(q);
@@ -201,7 +200,10 @@ impl DupinLesson {
             }
             PointType::Hyperbolic => {
                 let scale = c.scale() / self.ind.k1().abs().max(self.ind.k2().abs()).sqrt();
-                let reach = (4.0 * self.extent / scale.max(1e-300)).max(1.0).acosh().min(6.0);
+                let reach = (4.0 * self.extent / scale.max(1e-300))
+                    .max(1.0)
+                    .acosh()
+                    .min(6.0);
                 [1i8, -1]
                     .iter()
                     .map(|&br| {
@@ -299,11 +301,22 @@ impl DupinLesson {
         st.verdict = if valid { "valid" } else { "invalid" };
         if kind == PointType::Elliptic {
             let inside = star.dupin_center_inside(ind).unwrap_or(false);
-            let open = star.edges_not_enclosed_by_conjugate_pair(ind).unwrap_or(false);
+            let open = star
+                .edges_not_enclosed_by_conjugate_pair(ind)
+                .unwrap_or(false);
             st.conditions = vec![
-                Condition { text: "1) the Dupin hexagon is simple", holds: valid },
-                Condition { text: "2) the Dupin center of the fundamental triangle is inside it", holds: inside },
-                Condition { text: "3) no conjugate pair of directions encloses the three edge directions", holds: open },
+                Condition {
+                    text: "1) the Dupin hexagon is simple",
+                    holds: valid,
+                },
+                Condition {
+                    text: "2) the Dupin center of the fundamental triangle is inside it",
+                    holds: inside,
+                },
+                Condition {
+                    text: "3) no conjugate pair of directions encloses the three edge directions",
+                    holds: open,
+                },
             ];
             st.reason = if valid {
                 "K > 0: the Dupin center lies inside the fundamental triangle, so the Dupin hexagon is simple (Proposition 4, section 4.2).".into()
@@ -314,9 +327,18 @@ impl DupinLesson {
             let branches = star.vertices_on_different_branches(ind).unwrap_or(false);
             let ranges = star.edges_not_in_one_asymptotic_range(ind).unwrap_or(false);
             st.conditions = vec![
-                Condition { text: "1) the Dupin hexagon is simple", holds: valid },
-                Condition { text: "2) the triangle's vertices lie on different branches of its Dupin hyperbola", holds: branches },
-                Condition { text: "3) the edge directions are not all in one range between the asymptotes", holds: ranges },
+                Condition {
+                    text: "1) the Dupin hexagon is simple",
+                    holds: valid,
+                },
+                Condition {
+                    text: "2) the triangle's vertices lie on different branches of its Dupin hyperbola",
+                    holds: branches,
+                },
+                Condition {
+                    text: "3) the edge directions are not all in one range between the asymptotes",
+                    holds: ranges,
+                },
             ];
             st.reason = if valid {
                 "K < 0: the fundamental triangle's vertices lie on both branches of its Dupin hyperbola, so the Dupin hexagon is simple (Proposition 5, section 4.2).".into()

@@ -44,7 +44,10 @@ fn lesson_validity_flips_across_de() {
     // The dragged direction and its conjugate come back with the state.
     let (dx, dy) = pair(&get(&s, "dragged"));
     let (ex, ey) = pair(&get(&s, "conjugate"));
-    let (k1, k2) = (get(&s, "k1").as_f64().unwrap(), get(&s, "k2").as_f64().unwrap());
+    let (k1, k2) = (
+        get(&s, "k1").as_f64().unwrap(),
+        get(&s, "k2").as_f64().unwrap(),
+    );
     assert!((k1 * dx * ex + k2 * dy * ey).abs() < 1e-9);
     let e = l.conjugate_of(dx, dy).unwrap();
     assert!((e[0] - ex).abs() < 1e-12 && (e[1] - ey).abs() < 1e-12);
@@ -80,6 +83,9 @@ fn hex_lab_steps_to_the_simple_bounds() {
         get(&d, "maxAngle").as_f64().unwrap(),
     );
     assert!(lo >= 30.0 - 1e-9 && hi <= 120.0 + 1e-9, "{lo}..{hi}");
-    assert!(lab.set_input_js(vec![0.0, 0.0, 1.0, 1.0], vec![0, 1]).is_err());
+    assert!(
+        lab.set_input_js(vec![0.0, 0.0, 1.0, 1.0], vec![0, 1])
+            .is_err()
+    );
     assert!(HexDelaunayLab::new("other").is_err());
 }
