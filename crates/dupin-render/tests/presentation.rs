@@ -26,10 +26,10 @@ fn panels() -> PolyMesh {
             pos.push(Vec3::new(x, y, 1.2 + 0.12 * (x * x - y * y)));
         }
     }
-    let faces: Vec<[usize; 4]> = (0..nu)
+    let faces: Vec<[u32; 4]> = (0..nu)
         .flat_map(|i| {
             (0..nv).map(move |j| {
-                let k = |a: usize, b: usize| a * (nv + 1) + b;
+                let k = |a: usize, b: usize| (a * (nv + 1) + b) as u32;
                 [k(i, j), k(i + 1, j), k(i + 1, j + 1), k(i, j + 1)]
             })
         })
