@@ -96,24 +96,26 @@ function showError(e) {
   errorEl.textContent = e ? String(e.message ?? e) : '';
 }
 
+// Redrawing replaces the handles, so the drag is tracked on the <svg> itself.
+let dragIndex = -1;
+
 function startDrag(e, i) {
   e.preventDefault();
   e.stopPropagation();
-  const target = e.target;
-  target.setPointerCapture(e.pointerId);
-  const move = (ev) => {
-    const m = layer.getScreenCTM().inverse();
-    const pt = new DOMPoint(ev.clientX, ev.clientY).matrixTransform(m);
-    try {
-      state = lesson.dragVertex(i, pt.x, pt.y);
-      steps = null; stepIndex = -1;
-      showError(null);
-    } catch (err) { showError(err); }
-    draw();
-  };
-  const up = () => { target.removeEventListener('pointermove', move); target.removeEventListener('pointerup', up); };
-  target.addEventListener('pointermove', move);
-  target.addEventListener('pointerup', up);
+  dragIndex = i;
+  svg.setPointerCapture(e.pointerId);
+}
+
+function moveDrag(ev) {
+  if (dragIndex < 0) return;
+  const m = layer.getScreenCTM().inverse();
+  const pt = new DOMPoint(ev.clientX, ev.clientY).matrixTransform(m);
+  try {
+    state = lesson.dragVertex(dragIndex, pt.x, pt.y);
+    steps = null; stepIndex = -1;
+    showError(null);
+  } catch (err) { showError(err); }
+  draw();
 }
 
 function load() {
@@ -167,6 +169,10 @@ export function initTeach() {
   });
   document.querySelector('header .buttons')?.append(toggle);
   for (const c of [surfaceSel, uIn, vIn]) c.addEventListener('change', load);
+  svg.addEventListener('pointermove', moveDrag);
+  const endDrag = () => { dragIndex = -1; };
+  svg.addEventListener('pointerup', endDrag);
+  svg.addEventListener('pointercancel', endDrag);
   stepBtn.addEventListener('click', () => {
     try {
       steps ??= lesson.idealTriangleSteps();

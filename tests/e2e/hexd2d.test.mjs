@@ -27,7 +27,9 @@ test('2D tab: click points, step to completion, angles within [30, 120]', async 
     }
     assert.ok(steps >= 2, `only ${steps} steps`);
     assert.equal(await status.getAttribute('data-done'), 'true');
-    assert.equal(Number(await status.getAttribute('data-steps')), steps);
+    // The last click may only discover that nothing is left to split.
+    const taken = Number(await status.getAttribute('data-steps'));
+    assert.ok(taken >= steps - 1 && taken <= steps, `${taken} steps after ${steps} clicks`);
     const min = Number(await status.getAttribute('data-min-angle'));
     const max = Number(await status.getAttribute('data-max-angle'));
     assert.ok(min >= 30 - 1e-6 && max <= 120 + 1e-6, `angles ${min}..${max}`);
