@@ -70,7 +70,7 @@ impl HexDelaunayLab {
     /// Restarts the refinement on `xy` (x y pairs) and `segments` (index pairs).
     pub(crate) fn set_input(&mut self, xy: &[f64], segments: &[u32]) -> Result<(), String> {
         self.stepper = None;
-        if xy.len() % 2 != 0 || segments.len() % 2 != 0 {
+        if !xy.len().is_multiple_of(2) || !segments.len().is_multiple_of(2) {
             return Err("points and segments come in pairs of numbers".into());
         }
         let points: Vec<Vec2> = xy.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])).collect();

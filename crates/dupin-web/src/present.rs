@@ -3,6 +3,9 @@
 //! offsets: `dupin_core::offset_mesh`) joined by support beams, drawn by
 //! `dupin_render::PresentationRenderer` (sun shadow map, hemisphere light) with a damped orbit.
 
+// Scene building is used by the wasm-only `Presenter` (and the native tests).
+#![cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
+
 use crate::mesh_data::MeshData;
 use dupin_core::{PolyMesh, TriangleBuffers, Vec3, offset_mesh, polymesh_buffers};
 use wasm_bindgen::prelude::*;

@@ -129,9 +129,9 @@ impl DupinLesson {
         // Semi-axes beyond 8x the smaller one are clipped for framing (parabolic: the lines).
         let semi = |k: f64| (1.0 / k.abs().max(kmax / 64.0)).sqrt();
         let (sx, sy) = (semi(k1), semi(k2));
-        let extent = 1.6 * sx.max(sy);
+        let extent = 1.15 * sx.max(sy);
         let ang = 20f64.to_radians();
-        let a = 0.6 * Vec2::new(sx * ang.cos(), sy * ang.sin());
+        let a = 0.7 * Vec2::new(sx * ang.cos(), sy * ang.sin());
         let b = match ideal_triangle(&ind, &Vec2::zeros(), &a) {
             Ok(t) => t.c,
             // K = 0 has no ideal triangle (section 5.3): any non-degenerate star will do.
