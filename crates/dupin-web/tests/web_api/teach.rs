@@ -17,7 +17,7 @@ fn pair(v: &JsValue) -> (f64, f64) {
 /// base midpoint is valid beyond DE and invalid below it (section 5.1).
 #[wasm_bindgen_test]
 fn lesson_validity_flips_across_de() {
-    let params = js_sys::JSON::parse(r#"{"major":2,"minor":0.7}"#).unwrap();
+    let params = js_sys::JSON::parse(r#"{"R":2,"r":0.7}"#).unwrap();
     let mut l = DupinLesson::new("torus", params, 0.3, 0.4).unwrap();
     let s = l.state().unwrap();
     assert_eq!(get(&s, "kind").as_string().as_deref(), Some("elliptic"));
