@@ -26,7 +26,7 @@ fn lesson_validity_flips_across_de() {
     assert_eq!(ring.length(), 6);
     let steps = js_sys::Array::from(&l.ideal_triangle_steps().unwrap());
     assert_eq!(steps.length(), 5);
-    // M from step 2, C from step 5: the apex path is M + s (C - M); DE is at s = 1/3.
+    // M from step 2, C from step 5: the apex path is M + s (C - M); |CM| = sqrt(3) |MD|, so DE is at s = 1/sqrt(3).
     let m = js_sys::Array::from(&get(&steps.get(1), "points")).get(0);
     let c = js_sys::Array::from(&get(&steps.get(4), "points")).get(0);
     let xy = |p: JsValue| {
@@ -35,10 +35,10 @@ fn lesson_validity_flips_across_de() {
     };
     let ((mx, my), (cx, cy)) = (xy(m), xy(c));
     let at = |s: f64| (mx + s * (cx - mx), my + s * (cy - my));
-    let (x, y) = at(0.4);
+    let (x, y) = at(0.7);
     let s = l.drag_vertex(1, x, y).unwrap();
     assert_eq!(get(&s, "verdict").as_string().as_deref(), Some("valid"));
-    let (x, y) = at(0.25);
+    let (x, y) = at(0.45);
     let s = l.drag_vertex(1, x, y).unwrap();
     assert_eq!(get(&s, "verdict").as_string().as_deref(), Some("invalid"));
     // The dragged direction and its conjugate come back with the state.
