@@ -8,6 +8,9 @@ import { FREE, defaults, readHash, sessionConfig, writeHash } from './config.js'
 import { buildFields, clearFieldErrors, fillScenePicker, showFieldError } from './controls.js';
 import { drawHistogram, drawLegend, showMetrics } from './metrics.js';
 import { Solver } from './solver.js';
+import { initTeach } from './teach.js';
+import { initHexd2d } from './hexd2d.js';
+import { initPresent } from './present.js';
 
 const $ = (id) => document.querySelector(`[data-testid="${id}"]`);
 const statusEl = $('status');
@@ -303,6 +306,9 @@ async function main() {
     return;
   }
   fillScenePicker($('scene-select'), ctx.scenes);
+  initTeach();
+  initHexd2d();
+  initPresent(() => mesh);
   $('scene-select').addEventListener('change', (e) => {
     const next = defaults();
     Object.assign(next, { scene: e.target.value, color: config.color, panelEdge: config.panelEdge, backend: config.backend });

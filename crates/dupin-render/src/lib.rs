@@ -9,9 +9,11 @@ mod camera;
 mod mesh_renderer;
 #[cfg(not(target_arch = "wasm32"))]
 mod offscreen;
+mod presentation;
 
 pub use camera::OrbitCamera;
 pub use mesh_renderer::{BACKGROUND, MeshRenderer, PendingSnapshot, RenderError};
 #[cfg(not(target_arch = "wasm32"))]
-pub use offscreen::{OffscreenImage, render_offscreen};
+pub use offscreen::{OffscreenImage, render_offscreen, render_presentation_offscreen};
+pub use presentation::{GLASS_TINT, METAL_COLOR, PresentationRenderer, frame_buffers};
 pub use wgpu;

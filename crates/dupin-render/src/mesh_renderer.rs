@@ -283,58 +283,7 @@ impl MeshRenderer {
         });
         let view = texture.create_view(&Default::default());
         self.render(device, queue, &view, width, height, camera);
-        // Rows of a texture-to-buffer copy are padded to 256 bytes.
-        let padded_row = (width * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
-        let rows_per_band = (READBACK_CHUNK / padded_row).max(1);
-        let mut encoder = device.create_command_encoder(&Default::default());
-        let mut bands = Vec::new();
-        for first_row in (0..height).step_by(rows_per_band as usize) {
-            let rows = rows_per_band.min(height - first_row);
-            let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("dupin readback"),
-                size: (padded_row * rows) as u64,
-                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-                mapped_at_creation: false,
-            });
-            encoder.copy_texture_to_buffer(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &texture,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d {
-                        x: 0,
-                        y: first_row,
-                        z: 0,
-                    },
-                    aspect: wgpu::TextureAspect::All,
-                },
-                wgpu::TexelCopyBufferInfo {
-                    buffer: &buffer,
-                    layout: wgpu::TexelCopyBufferLayout {
-                        offset: 0,
-                        bytes_per_row: Some(padded_row),
-                        rows_per_image: Some(rows),
-                    },
-                },
-                wgpu::Extent3d {
-                    width,
-                    height: rows,
-                    depth_or_array_layers: 1,
-                },
-            );
-            bands.push((buffer, first_row));
-        }
-        queue.submit([encoder.finish()]);
-        PendingSnapshot {
-            bands,
-            width,
-            height,
-            padded_row,
-            rows_per_band,
-            bgra: matches!(
-                self.format,
-                wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
-            ),
-        }
+        read_back(device, queue, &texture, width, height, self.format)
     }
 
     /// Draws the current mesh and lines seen by `camera` into `target` (of this renderer's
@@ -433,6 +382,69 @@ impl MeshRenderer {
     }
 }
 
+/// Copies `texture` (`width` x `height`, `format`) into readback buffers in bands of rows.
+pub(crate) fn read_back(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+    width: u32,
+    height: u32,
+    format: wgpu::TextureFormat,
+) -> PendingSnapshot {
+    // Rows of a texture-to-buffer copy are padded to 256 bytes.
+    let padded_row = (width * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+    let rows_per_band = (READBACK_CHUNK / padded_row).max(1);
+    let mut encoder = device.create_command_encoder(&Default::default());
+    let mut bands = Vec::new();
+    for first_row in (0..height).step_by(rows_per_band as usize) {
+        let rows = rows_per_band.min(height - first_row);
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("dupin readback"),
+            size: (padded_row * rows) as u64,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d {
+                    x: 0,
+                    y: first_row,
+                    z: 0,
+                },
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded_row),
+                    rows_per_image: Some(rows),
+                },
+            },
+            wgpu::Extent3d {
+                width,
+                height: rows,
+                depth_or_array_layers: 1,
+            },
+        );
+        bands.push((buffer, first_row));
+    }
+    queue.submit([encoder.finish()]);
+    PendingSnapshot {
+        bands,
+        width,
+        height,
+        padded_row,
+        rows_per_band,
+        bgra: matches!(
+            format,
+            wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
+        ),
+    }
+}
+
 /// Largest readback buffer: SwiftShader's WebGPU (headless Chromium) fails to map buffers of a
 /// few hundred kilobytes, so a frame comes back in bands of rows.
 const READBACK_CHUNK: u32 = 64 * 1024;
@@ -523,7 +535,7 @@ impl PendingSnapshot {
 
 /// The clear colour in the target's encoding, so the background looks the same on sRGB and
 /// linear targets.
-fn background_for(format: wgpu::TextureFormat) -> wgpu::Color {
+pub(crate) fn background_for(format: wgpu::TextureFormat) -> wgpu::Color {
     if format.is_srgb() {
         BACKGROUND
     } else {

@@ -2,6 +2,7 @@
 
 use crate::camera::OrbitCamera;
 use crate::mesh_renderer::{MeshRenderer, RenderError};
+use crate::presentation::PresentationRenderer;
 use dupin_core::TriangleBuffers;
 
 /// An 8-bit sRGB RGBA image, rows top to bottom.
@@ -44,6 +45,37 @@ async fn render_async(
     width: u32,
     height: u32,
 ) -> Result<OffscreenImage, RenderError> {
+    let (adapter, device, queue) = gpu().await?;
+    let mut renderer = MeshRenderer::new(&device, wgpu::TextureFormat::Rgba8UnormSrgb);
+    renderer.set_mesh(&device, &queue, mesh, None)?;
+    if let Some(l) = lines {
+        renderer.set_lines(&device, &queue, l, [0.05, 0.05, 0.06]);
+    }
+    let (tx, rx) = std::sync::mpsc::channel();
+    renderer
+        .begin_snapshot(&device, &queue, width, height, camera)
+        .read(move |r| {
+            let _ = tx.send(r);
+        });
+    device
+        .poll(wgpu::PollType::Wait {
+            submission_index: None,
+            timeout: None,
+        })
+        .map_err(|e| RenderError::Readback(e.to_string()))?;
+    let rgba = rx
+        .recv()
+        .map_err(|e| RenderError::Readback(e.to_string()))??;
+    Ok(OffscreenImage {
+        width,
+        height,
+        rgba,
+        adapter: adapter.get_info().name,
+    })
+}
+
+/// The first Vulkan/Metal/DX12 adapter, else GL, with a device of WebGL2-level limits.
+async fn gpu() -> Result<(wgpu::Adapter, wgpu::Device, wgpu::Queue), RenderError> {
     // Vulkan (lavapipe on CI) or Metal first; GL only when neither exists, since EGL probing is
     // noisy on headless machines.
     let mut last_error = String::new();
@@ -76,30 +108,43 @@ async fn render_async(
         })
         .await
         .map_err(|e| RenderError::Device(e.to_string()))?;
-    let mut renderer = MeshRenderer::new(&device, wgpu::TextureFormat::Rgba8UnormSrgb);
-    renderer.set_mesh(&device, &queue, mesh, None)?;
-    if let Some(l) = lines {
-        renderer.set_lines(&device, &queue, l, [0.05, 0.05, 0.06]);
-    }
-    let (tx, rx) = std::sync::mpsc::channel();
-    renderer
-        .begin_snapshot(&device, &queue, width, height, camera)
-        .read(move |r| {
-            let _ = tx.send(r);
-        });
-    device
-        .poll(wgpu::PollType::Wait {
-            submission_index: None,
-            timeout: None,
+    Ok((adapter, device, queue))
+}
+
+/// Renders a presentation scene (glass `panels`, metal `frames`, ground and sun shadows; see
+/// [`PresentationRenderer`]) seen by `camera` into a `width` x `height` image, with or without
+/// the sun's `shadows`. Blocks.
+pub fn render_presentation_offscreen(
+    panels: &TriangleBuffers,
+    frames: &TriangleBuffers,
+    camera: &OrbitCamera,
+    (width, height): (u32, u32),
+    shadows: bool,
+) -> Result<OffscreenImage, RenderError> {
+    pollster::block_on(async {
+        let (adapter, device, queue) = gpu().await?;
+        let mut r = PresentationRenderer::new(&device, wgpu::TextureFormat::Rgba8UnormSrgb);
+        r.set_scene(&device, &queue, panels, None, frames)?;
+        r.set_shadows(shadows);
+        let (tx, rx) = std::sync::mpsc::channel();
+        r.begin_snapshot(&device, &queue, width.max(1), height.max(1), camera)
+            .read(move |r| {
+                let _ = tx.send(r);
+            });
+        device
+            .poll(wgpu::PollType::Wait {
+                submission_index: None,
+                timeout: None,
+            })
+            .map_err(|e| RenderError::Readback(e.to_string()))?;
+        let rgba = rx
+            .recv()
+            .map_err(|e| RenderError::Readback(e.to_string()))??;
+        Ok(OffscreenImage {
+            width: width.max(1),
+            height: height.max(1),
+            rgba,
+            adapter: adapter.get_info().name,
         })
-        .map_err(|e| RenderError::Readback(e.to_string()))?;
-    let rgba = rx
-        .recv()
-        .map_err(|e| RenderError::Readback(e.to_string()))??;
-    Ok(OffscreenImage {
-        width,
-        height,
-        rgba,
-        adapter: adapter.get_info().name,
     })
 }

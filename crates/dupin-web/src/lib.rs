@@ -5,14 +5,22 @@
 //! them with `dupin-render` into a canvas (WebGPU, or WebGL2 where WebGPU is missing).
 //! Errors cross the boundary as JS `Error`s carrying the Rust message.
 
+mod hexd2d;
 mod mesh_data;
+mod present;
 mod session;
+mod teach;
 // The canvas viewer needs wgpu's browser backends, which exist only on wasm32.
 #[cfg(target_arch = "wasm32")]
 mod viewer;
 
+pub use hexd2d::HexDelaunayLab;
 pub use mesh_data::{MeshData, torus_mesh};
+#[cfg(target_arch = "wasm32")]
+pub use present::Presenter;
+pub use present::torus_panels_js;
 pub use session::{Session, color_legend, free_defaults, scene_names, surface_catalog_js};
+pub use teach::DupinLesson;
 #[cfg(target_arch = "wasm32")]
 pub use viewer::Viewer;
 

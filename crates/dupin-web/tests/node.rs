@@ -141,3 +141,6 @@ fn surface_catalog_lists_every_library_surface_with_ranges() {
         }
     }
 }
+
+#[path = "web_api/teach.rs"]
+mod teach_node;

@@ -1,0 +1,382 @@
+//! Presentation mode: the current panel mesh as glass with metal frames (beams along edges,
+//! nodes at vertices), optionally with its offset layer (conical-meshes paper, section on
+//! offsets: `dupin_core::offset_mesh`) joined by support beams, drawn by
+//! `dupin_render::PresentationRenderer` (sun shadow map, hemisphere light) with a damped orbit.
+
+// Scene building is used by the wasm-only `Presenter` (and the native tests).
+#![cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
+
+use crate::mesh_data::MeshData;
+use dupin_core::{PolyMesh, TriangleBuffers, Vec3, offset_mesh, polymesh_buffers};
+use wasm_bindgen::prelude::*;
+
+/// Glass and frame buffers of a presentation scene, with counts for the page.
+pub(crate) struct Scene {
+    pub(crate) glass: TriangleBuffers,
+    pub(crate) frames: TriangleBuffers,
+    pub(crate) panels: usize,
+    pub(crate) beams: usize,
+    /// Why the offset layer is missing, when it was asked for and the core refused it.
+    pub(crate) offset_error: Option<String>,
+}
+
+/// Builds the scene for `mesh`; with `offset`, adds the face-offset layer at a quarter of the
+/// mean edge length and a support beam from each vertex to its offset.
+pub(crate) fn build_scene(mesh: &PolyMesh, offset: bool) -> Scene {
+    let edges = dupin_core::polymesh_edges(mesh);
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for s in edges.chunks_exact(6) {
+        let d = ((s[3] - s[0]).powi(2) + (s[4] - s[1]).powi(2) + (s[5] - s[2]).powi(2)).sqrt();
+        if d.is_finite() {
+            sum += d as f64;
+            n += 1;
+        }
+    }
+    let mean = if n > 0 { sum / n as f64 } else { 1.0 };
+    let (beam, node) = ((0.06 * mean) as f32, (0.11 * mean) as f32);
+    let (mut glass, _) = polymesh_buffers(mesh, None);
+    let mut frame_edges = edges;
+    let mut offset_error = None;
+    let mut panels = mesh.num_faces();
+    if offset {
+        match offset_mesh(mesh, 0.25 * mean) {
+            Ok(off) => {
+                let (g, _) = polymesh_buffers(&off, None);
+                append(&mut glass, &g);
+                frame_edges.extend(dupin_core::polymesh_edges(&off));
+                // Support beams: vertex i of the mesh to vertex i of its offset.
+                for i in 0..mesh.num_vertices().min(off.num_vertices()) {
+                    let (a, b): (Vec3, Vec3) = (mesh.positions[i], off.positions[i]);
+                    frame_edges.extend([a.x, a.y, a.z, b.x, b.y, b.z].map(|x| x as f32));
+                }
+                panels += off.num_faces();
+            }
+            Err(e) => offset_error = Some(format!("no offset layer: {e}")),
+        }
+    }
+    let beams = frame_edges.len() / 6;
+    Scene {
+        glass,
+        frames: dupin_render::frame_buffers(&frame_edges, beam, node),
+        panels,
+        beams,
+        offset_error,
+    }
+}
+
+fn append(a: &mut TriangleBuffers, b: &TriangleBuffers) {
+    let base = a.vertex_count() as u32;
+    a.positions.extend(&b.positions);
+    a.normals.extend(&b.normals);
+    a.indices.extend(b.indices.iter().map(|i| i + base));
+}
+
+/// A torus of about `panels` quad panels (R = 2, r = 0.7), for the presentation benchmark.
+pub(crate) fn torus_panels(panels: u32) -> Result<PolyMesh, String> {
+    if !(16..=200_000).contains(&panels) {
+        return Err(format!("panel count must be in 16..=200000, got {panels}"));
+    }
+    let nu = ((panels as f64 * 2.5).sqrt().round() as usize).max(4);
+    let nv = (panels as usize).div_ceil(nu).max(4);
+    let (big, small) = (2.0f64, 0.7f64);
+    let mut pos = Vec::with_capacity(nu * nv);
+    for i in 0..nu {
+        for j in 0..nv {
+            let (u, v) = (
+                std::f64::consts::TAU * i as f64 / nu as f64,
+                std::f64::consts::TAU * j as f64 / nv as f64,
+            );
+            let r = big + small * v.cos();
+            pos.push(Vec3::new(r * u.cos(), r * u.sin(), small * v.sin()));
+        }
+    }
+    let faces: Vec<[u32; 4]> = (0..nu)
+        .flat_map(|i| {
+            (0..nv).map(move |j| {
+                let (i1, j1) = ((i + 1) % nu, (j + 1) % nv);
+                [i * nv + j, i1 * nv + j, i1 * nv + j1, i * nv + j1].map(|k| k as u32)
+            })
+        })
+        .collect();
+    PolyMesh::new(pos, &faces).map_err(|e| e.to_string())
+}
+
+/// A torus panel mesh of about `panels` quads, for trying presentation mode at scale.
+#[wasm_bindgen(js_name = torusPanels)]
+pub fn torus_panels_js(panels: u32) -> Result<MeshData, JsError> {
+    let m = torus_panels(panels).map_err(|e| JsError::new(&e))?;
+    let colors = vec![[0.9f32, 0.9, 0.9]; m.num_faces()];
+    Ok(MeshData::panels(m, &colors))
+}
+
+#[cfg(target_arch = "wasm32")]
+pub use canvas::Presenter;
+
+#[cfg(target_arch = "wasm32")]
+mod canvas {
+    use super::*;
+    use dupin_render::{OrbitCamera, PresentationRenderer, wgpu};
+
+    /// Presentation view on its own canvas (WebGPU, or WebGL2), with a damped orbit.
+    #[wasm_bindgen]
+    pub struct Presenter {
+        surface: wgpu::Surface<'static>,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+        config: wgpu::SurfaceConfiguration,
+        renderer: PresentationRenderer,
+        camera: OrbitCamera,
+        /// Angular velocity (yaw, pitch), radians per second, decaying with `DAMPING`.
+        velocity: (f32, f32),
+        backend: &'static str,
+    }
+
+    /// Velocity half-life of the orbit after a drag, seconds.
+    const HALF_LIFE: f32 = 0.25;
+
+    #[wasm_bindgen]
+    impl Presenter {
+        /// Creates the presentation view on `canvas` (`force_webgl2`: skip WebGPU).
+        pub async fn create(
+            canvas: web_sys::HtmlCanvasElement,
+            force_webgl2: bool,
+        ) -> Result<Presenter, JsError> {
+            let (width, height) = (canvas.width().max(1), canvas.height().max(1));
+            let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+            desc.backends = if force_webgl2 {
+                wgpu::Backends::GL
+            } else {
+                wgpu::Backends::BROWSER_WEBGPU | wgpu::Backends::GL
+            };
+            let instance = wgpu::util::new_instance_with_webgpu_detection(desc).await;
+            let surface = instance
+                .create_surface(wgpu::SurfaceTarget::Canvas(canvas))
+                .map_err(|e| JsError::new(&format!("cannot draw into the canvas: {e}")))?;
+            let adapter = instance
+                .request_adapter(&wgpu::RequestAdapterOptions {
+                    compatible_surface: Some(&surface),
+                    ..Default::default()
+                })
+                .await
+                .map_err(|e| JsError::new(&format!("no WebGPU or WebGL2 adapter: {e}")))?;
+            let backend = match adapter.get_info().backend {
+                wgpu::Backend::BrowserWebGpu => "WebGPU",
+                wgpu::Backend::Gl => "WebGL2",
+                _ => "other",
+            };
+            let (device, queue) = adapter
+                .request_device(&wgpu::DeviceDescriptor {
+                    label: Some("dupin presentation"),
+                    required_limits: wgpu::Limits::downlevel_webgl2_defaults()
+                        .using_resolution(adapter.limits()),
+                    ..Default::default()
+                })
+                .await
+                .map_err(|e| JsError::new(&format!("cannot open the graphics device: {e}")))?;
+            let config = surface
+                .get_default_config(&adapter, width, height)
+                .ok_or_else(|| JsError::new("the canvas is not supported by this adapter"))?;
+            surface.configure(&device, &config);
+            let renderer = PresentationRenderer::new(&device, config.format);
+            Ok(Presenter {
+                surface,
+                device,
+                queue,
+                config,
+                renderer,
+                camera: OrbitCamera::framing(glam::Vec3::ZERO, 1.0),
+                velocity: (0.0, 0.0),
+                backend,
+            })
+        }
+
+        /// `"WebGPU"` or `"WebGL2"`.
+        #[wasm_bindgen(getter)]
+        pub fn backend(&self) -> String {
+            self.backend.to_string()
+        }
+
+        /// Shows `mesh` as glass and frames (with `offset`, also its offset layer); returns
+        /// `{ panels, beams, offsetError }` and frames the camera on it.
+        #[wasm_bindgen(js_name = setMesh)]
+        pub fn set_mesh(&mut self, mesh: &MeshData, offset: bool) -> Result<JsValue, JsError> {
+            let poly = match &mesh.panels {
+                Some(p) => p.clone(),
+                None => {
+                    let pos = mesh
+                        .buffers
+                        .positions
+                        .chunks_exact(3)
+                        .map(|p| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
+                        .collect();
+                    PolyMesh::new(pos, mesh.buffers.indices.chunks_exact(3))
+                        .map_err(|e| JsError::new(&e.to_string()))?
+                }
+            };
+            let scene = build_scene(&poly, offset);
+            self.renderer
+                .set_scene(&self.device, &self.queue, &scene.glass, None, &scene.frames)
+                .map_err(|e| JsError::new(&e.to_string()))?;
+            let (c, r) = self.renderer.bounds();
+            self.camera = OrbitCamera::framing(c, r);
+            let info = js_sys::Object::new();
+            let set = |k: &str, v: JsValue| js_sys::Reflect::set(&info, &k.into(), &v);
+            let _ = set("panels", (scene.panels as f64).into());
+            let _ = set("beams", (scene.beams as f64).into());
+            let _ = set(
+                "offsetError",
+                scene.offset_error.map_or(JsValue::NULL, |e| e.into()),
+            );
+            Ok(info.into())
+        }
+
+        /// A drag of (`dx`, `dy`) radians: turns the view and leaves it coasting, damped.
+        pub fn orbit(&mut self, dx: f32, dy: f32, dt_ms: f32) {
+            if !(dx.is_finite() && dy.is_finite()) {
+                return;
+            }
+            self.camera.orbit(dx, dy);
+            let dt = (dt_ms / 1000.0).max(1.0 / 240.0);
+            self.velocity = (dx / dt, dy / dt);
+        }
+
+        /// Advances the coasting orbit by `dt_ms`; true while it still moves (redraw needed).
+        pub fn tick(&mut self, dt_ms: f32) -> bool {
+            let dt = (dt_ms / 1000.0).clamp(0.0, 0.1);
+            let (vx, vy) = self.velocity;
+            if vx.hypot(vy) < 1e-3 {
+                self.velocity = (0.0, 0.0);
+                return false;
+            }
+            self.camera.orbit(vx * dt, vy * dt);
+            let decay = 0.5f32.powf(dt / HALF_LIFE);
+            self.velocity = (vx * decay, vy * decay);
+            true
+        }
+
+        /// Stops any coasting.
+        pub fn stop(&mut self) {
+            self.velocity = (0.0, 0.0);
+        }
+
+        /// Moves the camera closer (`factor` < 1) or farther.
+        pub fn zoom(&mut self, factor: f32) {
+            self.camera.zoom(factor);
+        }
+
+        /// Adapts to a new canvas size in device pixels.
+        pub fn resize(&mut self, width: u32, height: u32) {
+            let (width, height) = (width.clamp(1, 8192), height.clamp(1, 8192));
+            if (width, height) != (self.config.width, self.config.height) {
+                self.config.width = width;
+                self.config.height = height;
+                self.surface.configure(&self.device, &self.config);
+            }
+        }
+
+        /// Lets wgpu deliver finished work (snapshots on WebGL2); call every frame.
+        pub fn poll(&self) {
+            let _ = self.device.poll(wgpu::PollType::Poll);
+        }
+
+        /// Draws one frame.
+        pub fn render(&mut self) -> Result<(), JsError> {
+            let frame = match self.surface.get_current_texture() {
+                wgpu::CurrentSurfaceTexture::Success(t)
+                | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+                wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                    self.surface.configure(&self.device, &self.config);
+                    return Ok(());
+                }
+                wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
+                    return Ok(());
+                }
+                wgpu::CurrentSurfaceTexture::Validation => {
+                    return Err(JsError::new(
+                        "the canvas surface reported a validation error",
+                    ));
+                }
+            };
+            let view = frame.texture.create_view(&Default::default());
+            self.renderer.render(
+                &self.device,
+                &self.queue,
+                &view,
+                self.config.width,
+                self.config.height,
+                &self.camera,
+            );
+            self.queue.present(frame);
+            Ok(())
+        }
+
+        /// Renders at `scale` x the canvas size (2 for the 2x PNG); resolves to an `ImageData`.
+        pub fn snapshot(&mut self, scale: f32) -> Result<js_sys::Promise, JsError> {
+            if !(scale.is_finite() && scale > 0.0 && scale <= 8.0) {
+                return Err(JsError::new(&format!(
+                    "snapshot scale must be in (0, 8], got {scale}"
+                )));
+            }
+            let w = (self.config.width as f32 * scale).round() as u32;
+            let h = (self.config.height as f32 * scale).round() as u32;
+            let pending =
+                self.renderer
+                    .begin_snapshot(&self.device, &self.queue, w, h, &self.camera);
+            let (w, h) = (pending.width(), pending.height());
+            let mut pending = Some(pending);
+            let promise = js_sys::Promise::new(&mut |resolve, reject| {
+                let Some(pending) = pending.take() else {
+                    return;
+                };
+                pending.read(move |result| {
+                    let value = result
+                        .map_err(|e| JsValue::from(js_sys::Error::new(&e.to_string())))
+                        .and_then(|rgba| {
+                            web_sys::ImageData::new_with_u8_clamped_array_and_sh(
+                                wasm_bindgen::Clamped(&rgba),
+                                w,
+                                h,
+                            )
+                            .map(JsValue::from)
+                        });
+                    let _ = match value {
+                        Ok(v) => resolve.call1(&JsValue::NULL, &v),
+                        Err(e) => reject.call1(&JsValue::NULL, &e),
+                    };
+                });
+            });
+            self.poll();
+            Ok(promise)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scene_counts_and_offset_layer() {
+        let m = torus_panels(400).unwrap();
+        assert!((400..=440).contains(&m.num_faces()));
+        let s = build_scene(&m, false);
+        assert_eq!(s.panels, m.num_faces());
+        // A closed quad torus: 2 edges per face.
+        assert_eq!(s.beams, 2 * m.num_faces());
+        assert_eq!(s.glass.triangle_count(), 2 * m.num_faces());
+        // 4 sides per beam and 6 per node, 2 triangles a side.
+        assert_eq!(
+            s.frames.triangle_count(),
+            2 * (4 * s.beams + 6 * m.num_vertices())
+        );
+        let o = build_scene(&m, true);
+        match &o.offset_error {
+            None => {
+                assert_eq!(o.panels, 2 * m.num_faces());
+                assert_eq!(o.beams, 2 * s.beams + m.num_vertices());
+            }
+            Some(e) => assert!(e.starts_with("no offset layer"), "{e}"),
+        }
+        assert!(torus_panels(3).is_err());
+    }
+}

@@ -1,0 +1,80 @@
+// The 2D hexagonal Delaunay tab: points added by clicks, stepped to completion, angles within the
+// simple refinement's bounds [30, 120] degrees (Sußner & Greiner, section 4); refusals inline.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { SHOTS, byId, openPage, pixelStats } from './harness.mjs';
+
+test('2D tab: click points, step to completion, angles within [30, 120]', async () => {
+  const { browser, page, errors } = await openPage();
+  try {
+    await byId(page, 'hexd').click();
+    const canvas = byId(page, 'hexd-canvas');
+    await canvas.waitFor();
+    const box = await canvas.boundingBox();
+    // A fixed scatter around the centre (deterministic).
+    const pts = [[0.5, 0.5], [0.58, 0.43], [0.41, 0.62], [0.66, 0.6], [0.45, 0.38], [0.52, 0.55], [0.37, 0.47]];
+    for (const [fx, fy] of pts) await page.mouse.click(box.x + fx * box.width, box.y + fy * box.height);
+    const status = byId(page, 'hexd-status');
+    assert.match(await status.textContent(), /7 points/);
+    assert.equal(await status.getAttribute('data-done'), 'false');
+    const hist = byId(page, 'hexd-histogram');
+    const h0 = await hist.screenshot();
+    let steps = 0;
+    while (!(await byId(page, 'hexd-step').isDisabled())) {
+      await byId(page, 'hexd-step').click();
+      steps++;
+      assert.ok(steps < 500, 'refinement never finishes');
+    }
+    assert.ok(steps >= 2, `only ${steps} steps`);
+    assert.equal(await status.getAttribute('data-done'), 'true');
+    // The last click may only discover that nothing is left to split.
+    const taken = Number(await status.getAttribute('data-steps'));
+    assert.ok(taken >= steps - 1 && taken <= steps, `${taken} steps after ${steps} clicks`);
+    const min = Number(await status.getAttribute('data-min-angle'));
+    const max = Number(await status.getAttribute('data-max-angle'));
+    assert.ok(min >= 30 - 1e-6 && max <= 120 + 1e-6, `angles ${min}..${max}`);
+    assert.ok(Number(await status.getAttribute('data-triangles')) > 7);
+    const shot = await canvas.screenshot({ path: `${SHOTS}/hexd-simple.png` });
+    assert.ok((await pixelStats(page, shot)).covered > 0.05);
+    const h1 = await hist.screenshot({ path: `${SHOTS}/hexd-histogram.png` });
+    assert.ok((await pixelStats(page, h1, h0)).differing > 0.005, 'the histogram fills in');
+    // Dragging a point restarts the refinement from the bounding hexagon.
+    const [fx, fy] = pts[0];
+    await page.mouse.move(box.x + fx * box.width, box.y + fy * box.height);
+    await page.mouse.down();
+    await page.mouse.move(box.x + fx * box.width + 20, box.y + fy * box.height + 10, { steps: 4 });
+    await page.mouse.up();
+    assert.equal(await status.getAttribute('data-steps'), '0');
+    assert.match(await status.textContent(), /7 points/);
+    assert.deepEqual(errors, [], 'console errors');
+  } finally {
+    await browser.close();
+  }
+});
+
+test('2D tab: segments and the extended mode surface the core message inline', async () => {
+  const { browser, page } = await openPage();
+  try {
+    await byId(page, 'hexd').click();
+    const box = await byId(page, 'hexd-canvas').boundingBox();
+    const status = byId(page, 'hexd-status');
+    await page.mouse.click(box.x + 0.5 * box.width, box.y + 0.5 * box.height);
+    await page.mouse.click(box.x + 0.6 * box.width, box.y + 0.45 * box.height);
+    await byId(page, 'hexd-mode').selectOption('extended');
+    const ext = await status.textContent();
+    if (await status.evaluate((e) => e.classList.contains('error'))) assert.match(ext, /not implemented/);
+    await byId(page, 'hexd-mode').selectOption('simple');
+    assert.ok(!(await status.evaluate((e) => e.classList.contains('error'))));
+    await byId(page, 'hexd-tool').selectOption('segments');
+    await page.mouse.click(box.x + 0.5 * box.width, box.y + 0.5 * box.height);
+    await page.mouse.click(box.x + 0.6 * box.width, box.y + 0.45 * box.height);
+    const text = await status.textContent();
+    assert.ok(await status.evaluate((e) => e.classList.contains('error')), text);
+    assert.match(text, /not implemented|segment/);
+    assert.ok(await byId(page, 'hexd-step').isDisabled());
+    await byId(page, 'hexd-clear').click();
+    assert.ok(!(await status.evaluate((e) => e.classList.contains('error'))));
+  } finally {
+    await browser.close();
+  }
+});

@@ -1,0 +1,215 @@
+// 2D tab: hexagonal Delaunay triangulation (Sußner & Greiner) step by step. The refinement, the
+// cells, the dual triangulation and its angle histogram all come from wasm (`HexDelaunayLab`);
+// this file handles clicks and drags and draws into 2D canvases.
+import { HexDelaunayLab } from './pkg/dupin_web.js';
+
+const VIEW = 3.2; // half-height of the shown world square
+
+let lab = null;
+let points = [];     // [x, y] world coordinates
+let segments = [];   // [i, j]
+let pendingSeg = null;
+let cells = null;
+let dual = null;
+let inputError = null;
+let panel, canvas, hist, statusEl, modeSel, toolSel, stepBtn, runBtn;
+
+const el = (tag, attrs = {}, text) => {
+  const e = document.createElement(tag);
+  for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, v);
+  if (text !== undefined) e.textContent = text;
+  return e;
+};
+
+function scale() { return Math.min(canvas.width, canvas.height) / (2 * VIEW); }
+function toScreen([x, y]) { const s = scale(); return [canvas.width / 2 + x * s, canvas.height / 2 - y * s]; }
+function toWorld(px, py) { const s = scale(); return [(px - canvas.width / 2) / s, (canvas.height / 2 - py) / s]; }
+
+/** Restarts the refinement on the current input; the core's refusal is shown inline. */
+function restart() {
+  try {
+    lab?.free();
+    lab = new HexDelaunayLab(modeSel.value);
+    if (points.length > 0) lab.setInput(new Float64Array(points.flat()), new Uint32Array(segments.flat()));
+    inputError = null;
+  } catch (e) {
+    inputError = String(e.message ?? e);
+  }
+  refresh();
+}
+
+function refresh() {
+  try {
+    cells = lab ? lab.cells() : null;
+    dual = lab ? lab.dual() : null;
+  } catch (e) { inputError = String(e.message ?? e); }
+  draw();
+  drawHistogram();
+  const done = !lab || lab.done();
+  stepBtn.disabled = done || !!inputError;
+  runBtn.disabled = done || !!inputError;
+  const tri = dual ? dual.triangles.length / 3 : 0;
+  statusEl.dataset.done = String(done && !inputError && points.length > 0);
+  statusEl.dataset.steps = String(lab ? lab.steps() : 0);
+  statusEl.dataset.triangles = String(tri);
+  statusEl.dataset.minAngle = tri ? dual.minAngle.toFixed(4) : '';
+  statusEl.dataset.maxAngle = tri ? dual.maxAngle.toFixed(4) : '';
+  statusEl.classList.toggle('error', !!inputError);
+  if (inputError) statusEl.textContent = inputError;
+  else if (points.length === 0) statusEl.textContent = 'Click to add points, drag to move them.';
+  else statusEl.textContent = `${points.length} points · ${segments.length} segments · step ${lab.steps()}${done ? ' (done)' : ''} · ${tri} triangles · angles ${dual.minAngle.toFixed(1)}°–${dual.maxAngle.toFixed(1)}°`;
+}
+
+function draw() {
+  const g = canvas.getContext('2d');
+  g.fillStyle = '#101218';
+  g.fillRect(0, 0, canvas.width, canvas.height);
+  if (cells && cells.domain.length) {
+    let k = 0;
+    g.lineWidth = 1;
+    cells.sizes.forEach((n, i) => {
+      g.beginPath();
+      for (let j = 0; j < n; j++) {
+        const [x, y] = toScreen([cells.corners[2 * (k + j)], cells.corners[2 * (k + j) + 1]]);
+        if (j === 0) g.moveTo(x, y); else g.lineTo(x, y);
+      }
+      g.closePath();
+      g.fillStyle = cells.occupied[i] ? 'rgba(127,178,229,0.18)' : 'rgba(127,178,229,0.05)';
+      g.fill();
+      g.strokeStyle = 'rgba(127,178,229,0.45)';
+      g.stroke();
+      k += n;
+    });
+  }
+  if (dual && dual.triangles.length) {
+    g.strokeStyle = '#e6e8ee';
+    g.lineWidth = 0.8;
+    g.beginPath();
+    const v = dual.vertices;
+    for (let t = 0; t < dual.triangles.length; t += 3) {
+      const [a, b, c] = [0, 1, 2].map((k) => toScreen([v[2 * dual.triangles[t + k]], v[2 * dual.triangles[t + k] + 1]]));
+      g.moveTo(...a); g.lineTo(...b); g.lineTo(...c); g.closePath();
+    }
+    g.stroke();
+  }
+  g.strokeStyle = '#ff9e64';
+  g.lineWidth = 2;
+  for (const [i, j] of segments) {
+    g.beginPath(); g.moveTo(...toScreen(points[i])); g.lineTo(...toScreen(points[j])); g.stroke();
+  }
+  points.forEach((p, i) => {
+    const [x, y] = toScreen(p);
+    g.fillStyle = i === pendingSeg ? '#ff9e64' : '#f2c14e';
+    g.beginPath(); g.arc(x, y, 4, 0, Math.PI * 2); g.fill();
+  });
+}
+
+function drawHistogram() {
+  const g = hist.getContext('2d');
+  const [w, h] = [hist.width, hist.height];
+  g.fillStyle = '#101218';
+  g.fillRect(0, 0, w, h);
+  const x = (deg) => 20 + (deg / 180) * (w - 30);
+  if (dual && dual.histogram.length) {
+    const max = Math.max(1, ...dual.histogram);
+    g.fillStyle = '#7fb2e5';
+    dual.histogram.forEach((n, i) => {
+      const bh = (n / max) * (h - 28);
+      g.fillRect(x(i * dual.binDeg), h - 16 - bh, Math.max(1, x(dual.binDeg) - x(0) - 1), bh);
+    });
+  }
+  const marks = [[43.9, '#5fd39a'], [90, '#5fd39a']];
+  if (modeSel.value === 'simple') marks.push([30, '#ff9e64'], [120, '#ff9e64']);
+  g.font = '10px system-ui';
+  for (const [deg, col] of marks) {
+    g.strokeStyle = col; g.fillStyle = col;
+    g.beginPath(); g.moveTo(x(deg), 4); g.lineTo(x(deg), h - 16); g.stroke();
+    g.fillText(`${deg}°`, x(deg) + 2, 12);
+  }
+  g.fillStyle = '#8d93a3';
+  for (const deg of [0, 60, 180]) g.fillText(`${deg}`, x(deg) - 4, h - 3);
+}
+
+function nearest(px, py) {
+  let best = -1, bd = 10;
+  points.forEach((p, i) => {
+    const [x, y] = toScreen(p);
+    const d = Math.hypot(x - px, y - py);
+    if (d < bd) { bd = d; best = i; }
+  });
+  return best;
+}
+
+function wire() {
+  let dragging = -1;
+  canvas.addEventListener('pointerdown', (e) => {
+    const r = canvas.getBoundingClientRect();
+    const px = (e.clientX - r.left) * (canvas.width / r.width), py = (e.clientY - r.top) * (canvas.height / r.height);
+    let i = nearest(px, py);
+    if (toolSel.value === 'segments') {
+      if (i < 0) { points.push(toWorld(px, py)); i = points.length - 1; }
+      if (pendingSeg === null) pendingSeg = i;
+      else { if (i !== pendingSeg) segments.push([pendingSeg, i]); pendingSeg = null; }
+      restart();
+      return;
+    }
+    if (i < 0) { points.push(toWorld(px, py)); restart(); return; }
+    dragging = i;
+    canvas.setPointerCapture(e.pointerId);
+  });
+  canvas.addEventListener('pointermove', (e) => {
+    if (dragging < 0) return;
+    const r = canvas.getBoundingClientRect();
+    points[dragging] = toWorld((e.clientX - r.left) * (canvas.width / r.width), (e.clientY - r.top) * (canvas.height / r.height));
+    restart();
+  });
+  const up = () => { dragging = -1; };
+  canvas.addEventListener('pointerup', up);
+  canvas.addEventListener('pointercancel', up);
+  stepBtn.addEventListener('click', () => {
+    try { lab.step(); } catch (e) { inputError = String(e.message ?? e); }
+    refresh();
+  });
+  runBtn.addEventListener('click', () => {
+    // Steps with a redraw between them, so the subdivision is watched rather than jumped over.
+    const tick = () => {
+      if (!lab || lab.done() || inputError || panel.hidden) return;
+      try { lab.step(); } catch (e) { inputError = String(e.message ?? e); }
+      refresh();
+      setTimeout(tick, 40);
+    };
+    tick();
+  });
+  modeSel.addEventListener('change', restart);
+}
+
+/** Adds the 2D tab button and panel to the page. */
+export function initHexd2d() {
+  panel = el('section', { class: 'hexd', 'data-testid': 'hexd-panel', hidden: '' });
+  canvas = el('canvas', { 'data-testid': 'hexd-canvas', width: '560', height: '480', 'aria-label': 'Click to add points; drag to move' });
+  hist = el('canvas', { 'data-testid': 'hexd-histogram', width: '300', height: '120', 'aria-label': 'Angle histogram' });
+  statusEl = el('p', { 'data-testid': 'hexd-status', role: 'status', class: 'hexd-status' });
+  modeSel = el('select', { 'data-testid': 'hexd-mode', 'aria-label': 'Refinement mode' });
+  modeSel.append(new Option('simple (30°–120°)', 'simple'), new Option('extended (43.9°–90°)', 'extended'));
+  toolSel = el('select', { 'data-testid': 'hexd-tool', 'aria-label': 'Tool' });
+  toolSel.append(new Option('points', 'points'), new Option('segments', 'segments'));
+  stepBtn = el('button', { type: 'button', 'data-testid': 'hexd-step' }, 'Step');
+  runBtn = el('button', { type: 'button', 'data-testid': 'hexd-run' }, 'Run');
+  const clear = el('button', { type: 'button', 'data-testid': 'hexd-clear' }, 'Clear');
+  clear.addEventListener('click', () => { points = []; segments = []; pendingSeg = null; restart(); });
+  const bar = el('div', { class: 'hexd-controls' });
+  bar.append(modeSel, toolSel, stepBtn, runBtn, clear);
+  const side = el('div', { class: 'hexd-side' });
+  const note = el('p', { class: 'hint' }, 'Hexagon cells (blue) are split one refinement step at a time; white: the dual triangulation. The histogram counts its angles; the simple refinement keeps them in [30°, 120°] (section 4), the extended one in [43.9°, 90°] (section 5).');
+  side.append(bar, statusEl, hist, note);
+  panel.append(canvas, side);
+  document.querySelector('main').append(panel);
+  const toggle = el('button', { type: 'button', 'data-testid': 'hexd', 'aria-pressed': 'false' }, '2D Delaunay');
+  toggle.addEventListener('click', () => {
+    panel.hidden = !panel.hidden;
+    toggle.setAttribute('aria-pressed', String(!panel.hidden));
+  });
+  document.querySelector('header .buttons')?.append(toggle);
+  wire();
+  restart();
+}

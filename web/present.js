@@ -1,0 +1,170 @@
+// Presentation mode: the current panels as glass in metal frames, with sun shadows, a damped
+// orbit, full screen and a 2x PNG. Rendering and geometry are wasm's (`Presenter`); this file
+// wires events and the frame loop.
+import { Presenter, torusPanels } from './pkg/dupin_web.js';
+
+let presenter = null;
+let panel, canvas, statusEl, offsetBox;
+let open = false;
+let dirty = true;
+let getMesh = () => null;
+let demo = null;         // MeshData of the 10k-panel demo, when shown
+
+const el = (tag, attrs = {}, text) => {
+  const e = document.createElement(tag);
+  for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, v);
+  if (text !== undefined) e.textContent = text;
+  return e;
+};
+
+function status(text, isError = false) {
+  statusEl.textContent = text;
+  statusEl.classList.toggle('error', isError);
+}
+
+function show(mesh) {
+  if (!presenter || !mesh) return;
+  try {
+    const info = presenter.setMesh(mesh, offsetBox.checked);
+    statusEl.dataset.panels = String(info.panels);
+    status(`${presenter.backend} · ${info.panels} panels · ${info.beams} beams${info.offsetError ? ` · ${info.offsetError}` : ''}`, !!info.offsetError);
+    dirty = true;
+  } catch (e) { status(String(e.message ?? e), true); }
+}
+
+function resize() {
+  const dpr = window.devicePixelRatio || 1;
+  const w = Math.max(1, Math.round(canvas.clientWidth * dpr));
+  const h = Math.max(1, Math.round(canvas.clientHeight * dpr));
+  if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; presenter.resize(w, h); dirty = true; }
+}
+
+let last = 0;
+function frame(t) {
+  if (!open) return;
+  const dt = last ? t - last : 16;
+  last = t;
+  resize();
+  presenter.poll();
+  if (presenter.tick(dt)) dirty = true;
+  if (dirty) {
+    dirty = false;
+    try { presenter.render(); } catch (e) { status(String(e.message ?? e), true); }
+    statusEl.dataset.rendered = 'true';
+  }
+  requestAnimationFrame(frame);
+}
+
+async function openPresentation() {
+  panel.hidden = false;
+  open = true;
+  if (!presenter) {
+    try {
+      canvas.width = Math.max(1, canvas.clientWidth);
+      canvas.height = Math.max(1, canvas.clientHeight);
+      const webgl2 = new URLSearchParams(location.hash.slice(1)).get('backend') === 'webgl2';
+      presenter = await Presenter.create(canvas, webgl2);
+    } catch (e) { status(`Cannot start presentation: ${e.message ?? e}`, true); return; }
+  }
+  show(demo ?? getMesh());
+  last = 0;
+  requestAnimationFrame(frame);
+}
+
+function closePresentation() {
+  open = false;
+  panel.hidden = true;
+  if (document.fullscreenElement) document.exitFullscreen().catch(() => {});
+}
+
+function wireOrbit() {
+  const pointers = new Map();
+  let lastMove = 0;
+  canvas.addEventListener('pointerdown', (e) => { canvas.setPointerCapture(e.pointerId); pointers.set(e.pointerId, e); presenter?.stop(); lastMove = performance.now(); });
+  canvas.addEventListener('pointermove', (e) => {
+    const prev = pointers.get(e.pointerId);
+    if (!prev || !presenter) return;
+    pointers.set(e.pointerId, e);
+    const now = performance.now();
+    presenter.orbit((e.clientX - prev.clientX) * 0.008, (e.clientY - prev.clientY) * 0.008, now - lastMove);
+    lastMove = now;
+    dirty = true;
+  });
+  const up = (e) => pointers.delete(e.pointerId);
+  canvas.addEventListener('pointerup', up);
+  canvas.addEventListener('pointercancel', up);
+  canvas.addEventListener('wheel', (e) => { e.preventDefault(); presenter?.zoom(Math.exp(e.deltaY * 0.001)); dirty = true; }, { passive: false });
+}
+
+async function snapshotPng(scale) {
+  const image = await presenter.snapshot(scale);
+  const c = new OffscreenCanvas(image.width, image.height);
+  c.getContext('2d').putImageData(image, 0, 0);
+  return c.convertToBlob({ type: 'image/png' });
+}
+
+/** Adds the Present button and the presentation overlay; `currentMesh()` gives the MeshData. */
+export function initPresent(currentMesh) {
+  getMesh = currentMesh;
+  panel = el('section', { class: 'present', 'data-testid': 'present-panel', hidden: '' });
+  canvas = el('canvas', { 'data-testid': 'present-canvas', 'aria-label': 'Presentation view: drag to orbit' });
+  offsetBox = el('input', { type: 'checkbox', 'data-testid': 'present-offset' });
+  const offsetLabel = el('label', {}, ' offset layer');
+  offsetLabel.prepend(offsetBox);
+  const demoBtn = el('button', { type: 'button', 'data-testid': 'present-demo', title: 'A torus of 10 000 panels' }, '10k panels');
+  const pngBtn = el('button', { type: 'button', 'data-testid': 'present-png' }, 'PNG ×2');
+  const fsBtn = el('button', { type: 'button', 'data-testid': 'present-fullscreen' }, 'Full screen');
+  const closeBtn = el('button', { type: 'button', 'data-testid': 'present-close' }, 'Close');
+  statusEl = el('p', { 'data-testid': 'present-status', role: 'status', class: 'present-status' });
+  const bar = el('div', { class: 'present-bar' });
+  bar.append(offsetLabel, demoBtn, pngBtn, fsBtn, closeBtn, statusEl);
+  panel.append(canvas, bar);
+  document.body.append(panel);
+  const toggle = el('button', { type: 'button', 'data-testid': 'present' }, 'Present');
+  toggle.addEventListener('click', openPresentation);
+  document.querySelector('header .buttons')?.append(toggle);
+  closeBtn.addEventListener('click', closePresentation);
+  offsetBox.addEventListener('change', () => show(demo ?? getMesh()));
+  demoBtn.addEventListener('click', () => {
+    demo?.free();
+    demo = torusPanels(10000);
+    show(demo);
+  });
+  fsBtn.addEventListener('click', () => {
+    (document.fullscreenElement ? document.exitFullscreen() : panel.requestFullscreen())
+      .catch((e) => status(`full screen refused: ${e.message ?? e}`, true));
+  });
+  pngBtn.addEventListener('click', async () => {
+    try {
+      const blob = await snapshotPng(2);
+      const url = URL.createObjectURL(blob);
+      Object.assign(el('a'), { href: url, download: 'dupin-presentation@2x.png' }).click();
+      setTimeout(() => URL.revokeObjectURL(url), 1000);
+    } catch (e) { status(String(e.message ?? e), true); }
+  });
+  document.addEventListener('keydown', (e) => { if (open && e.key === 'Escape' && !document.fullscreenElement) closePresentation(); });
+  wireOrbit();
+  // For tests and benchmarks: pixels, and the mean frame interval over `frames` orbiting frames.
+  window.dupinPresent = {
+    snapshotDataUrl: async (scale = 1) => {
+      const blob = await snapshotPng(scale);
+      return new Promise((resolve) => { const r = new FileReader(); r.onload = () => resolve(r.result); r.readAsDataURL(blob); });
+    },
+    size: () => [canvas.width, canvas.height],
+    orbitFrames: (frames) => new Promise((resolve) => {
+      const stamps = [];
+      let cpu = 0;
+      const step = (t) => {
+        stamps.push(t);
+        const t0 = performance.now();
+        presenter.orbit(0.01, 0, 16);
+        presenter.stop();
+        presenter.render();
+        cpu += performance.now() - t0;
+        if (stamps.length < frames) requestAnimationFrame(step);
+        else resolve({ frames, meanIntervalMs: (stamps.at(-1) - stamps[0]) / (frames - 1), meanRenderCallMs: cpu / frames });
+      };
+      requestAnimationFrame(step);
+    }),
+  };
+}

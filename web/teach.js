@@ -1,0 +1,188 @@
+// Teaching inset: Dupin duality at one surface point (P-Hex paper, sections 3-5.1). All geometry
+// comes from wasm (`DupinLesson`); this file draws its primitives as SVG and forwards drags.
+import { DupinLesson, surfaceCatalog } from './pkg/dupin_web.js';
+
+const SVGNS = 'http://www.w3.org/2000/svg';
+const el = (tag, attrs = {}, text) => {
+  const e = tag.startsWith('svg:') ? document.createElementNS(SVGNS, tag.slice(4)) : document.createElement(tag);
+  for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, v);
+  if (text !== undefined) e.textContent = text;
+  return e;
+};
+
+const COLORS = { indicatrix: '#7fb2e5', star: '#e6e8ee', conic: '#8d93a3', center: '#f2c14e', hexagon: '#5fd39a',
+  invalid: '#ff7b72', dragged: '#c58af9', conjugate: '#f2c14e', construct: '#ff9e64' };
+
+let lesson = null;
+let state = null;
+let steps = null;
+let stepIndex = -1;
+let panel, svg, layer, verdictEl, reasonEl, condEl, captionEl, errorEl, surfaceSel, uIn, vIn;
+
+function polyline(flat, stroke, extra = {}) {
+  const pts = [];
+  for (let i = 0; i + 1 < flat.length; i += 2) pts.push(`${flat[i]},${flat[i + 1]}`);
+  return el('svg:polyline', { points: pts.join(' '), fill: 'none', stroke, 'vector-effect': 'non-scaling-stroke', ...extra });
+}
+
+function dot(x, y, r, fill, extra = {}) {
+  return el('svg:circle', { cx: x, cy: y, r, fill, ...extra });
+}
+
+function label(x, y, text, size) {
+  // Text is drawn un-flipped inside the y-flipped layer.
+  const t = el('svg:text', { x, y: -y, 'font-size': size, fill: COLORS.construct, transform: 'scale(1,-1)' }, text);
+  return t;
+}
+
+function draw() {
+  if (!state) return;
+  const E = state.extent;
+  svg.setAttribute('viewBox', `${-E} ${-E} ${2 * E} ${2 * E}`);
+  const r = E * 0.03;
+  const g = [];
+  for (const c of state.indicatrix) g.push(polyline(c, COLORS.indicatrix, { 'stroke-width': 2 }));
+  for (const d of state.asymptotes) {
+    g.push(polyline([-4 * E * d[0], -4 * E * d[1], 4 * E * d[0], 4 * E * d[1]], COLORS.indicatrix, { 'stroke-dasharray': '3 4', 'stroke-width': 1 }));
+  }
+  for (const t of state.triangleConics) for (const c of t.curves) g.push(polyline(c, COLORS.conic, { 'stroke-width': 0.7, opacity: 0.7 }));
+  for (const c of state.hexagonConic) g.push(polyline(c, COLORS.hexagon, { 'stroke-width': 1, 'stroke-dasharray': '2 3' }));
+  const ring = state.ring;
+  if (ring.length === 6) {
+    for (let i = 0; i < 6; i++) {
+      const [p, q] = [ring[i], ring[(i + 1) % 6]];
+      g.push(polyline([0, 0, p[0], p[1]], COLORS.star, { 'stroke-width': 1.2 }));
+      g.push(polyline([p[0], p[1], q[0], q[1]], COLORS.star, { 'stroke-width': 1.2 }));
+    }
+  }
+  if (state.hexagon.length === 6) {
+    const h = state.hexagon.flat();
+    g.push(polyline([...h, h[0], h[1]], state.verdict === 'invalid' ? COLORS.invalid : COLORS.hexagon, { 'stroke-width': 2.5 }));
+  }
+  for (const t of state.triangleConics) g.push(dot(t.center[0], t.center[1], r * 0.6, COLORS.center));
+  if (state.dragged && state.conjugate) {
+    const [d, c] = [state.dragged, state.conjugate];
+    const n = Math.hypot(d[0], d[1]) || 1;
+    const L = E * 0.8;
+    g.push(polyline([-L * d[0] / n, -L * d[1] / n, L * d[0] / n, L * d[1] / n], COLORS.dragged, { 'stroke-width': 1.2, 'stroke-dasharray': '6 3' }));
+    g.push(polyline([-L * c[0], -L * c[1], L * c[0], L * c[1]], COLORS.conjugate, { 'stroke-width': 1.2, 'stroke-dasharray': '6 3' }));
+  }
+  if (steps && stepIndex >= 0) {
+    for (const s of steps.slice(0, stepIndex + 1)) {
+      for (const c of s.curves) g.push(polyline(c, COLORS.construct, { 'stroke-width': 1, opacity: 0.8 }));
+      for (const [x1, y1, x2, y2] of s.segments) g.push(polyline([x1, y1, x2, y2], COLORS.construct, { 'stroke-width': 1.6 }));
+      for (const [name, x, y] of s.points) { g.push(dot(x, y, r * 0.7, COLORS.construct)); g.push(label(x + r, y + r, name, E * 0.08)); }
+    }
+  }
+  g.push(dot(0, 0, r, COLORS.star));
+  ring.forEach(([x, y], i) => {
+    const h = dot(x, y, r * 1.3, i < 2 ? '#ffffff' : COLORS.star, { 'data-vertex': String(i), class: 'teach-handle' });
+    h.addEventListener('pointerdown', (e) => startDrag(e, i));
+    g.push(h);
+  });
+  layer.replaceChildren(...g);
+  verdictEl.textContent = state.verdict === 'undecided' ? `${state.kind} point: no verdict` : `${state.kind} point: star ${state.verdict}`;
+  verdictEl.dataset.verdict = state.verdict;
+  verdictEl.dataset.kind = state.kind;
+  verdictEl.className = `teach-verdict ${state.verdict}`;
+  reasonEl.textContent = state.reason;
+  condEl.replaceChildren(...state.conditions.map((c) => el('li', { class: c.holds ? 'holds' : 'fails' }, `${c.holds ? '✓' : '✗'} ${c.text}`)));
+  captionEl.textContent = steps && stepIndex >= 0
+    ? `Step ${stepIndex + 1}/${steps.length}. ${steps[stepIndex].caption}`
+    : 'Tangent plane in the principal frame (x: k1, y: k2). Blue: the Dupin indicatrix (section 3); white: the projected triangle star; grey: each triangle\'s Dupin conic, yellow dots its Dupin center; green: the Dupin hexagon (section 4.1, Prop. 3). Drag a vertex: Props. 4 and 5 (section 4.2) decide validity; purple/yellow dashes: the dragged direction and its conjugate.';
+}
+
+function showError(e) {
+  errorEl.textContent = e ? String(e.message ?? e) : '';
+}
+
+// Redrawing replaces the handles, so the drag is tracked on the <svg> itself.
+let dragIndex = -1;
+
+function startDrag(e, i) {
+  e.preventDefault();
+  e.stopPropagation();
+  dragIndex = i;
+  svg.setPointerCapture(e.pointerId);
+}
+
+function moveDrag(ev) {
+  if (dragIndex < 0) return;
+  const m = layer.getScreenCTM().inverse();
+  const pt = new DOMPoint(ev.clientX, ev.clientY).matrixTransform(m);
+  try {
+    state = lesson.dragVertex(dragIndex, pt.x, pt.y);
+    steps = null; stepIndex = -1;
+    showError(null);
+  } catch (err) { showError(err); }
+  draw();
+}
+
+function load() {
+  const spec = CATALOG.find((s) => s.name === surfaceSel.value);
+  const params = {};
+  try {
+    const u = Number(uIn.value), v = Number(vIn.value);
+    if (uIn.value.trim() === '' || vIn.value.trim() === '' || !Number.isFinite(u) || !Number.isFinite(v)) throw new Error('u and v must be numbers');
+    const next = new DupinLesson(spec.name, params, u, v);
+    lesson?.free();
+    lesson = next;
+    state = lesson.state();
+    steps = null; stepIndex = -1;
+    showError(null);
+  } catch (e) { showError(e); }
+  draw();
+}
+
+let CATALOG = [];
+
+/** Adds the Teach button and the inset panel to the page. */
+export function initTeach() {
+  CATALOG = surfaceCatalog();
+  panel = el('section', { class: 'teach', 'data-testid': 'teach-panel', hidden: '' });
+  surfaceSel = el('select', { 'data-testid': 'teach-surface', 'aria-label': 'Surface' });
+  for (const s of CATALOG) if (s.name !== 'bspline') surfaceSel.append(new Option(s.name, s.name));
+  surfaceSel.value = 'torus';
+  uIn = el('input', { type: 'number', step: '0.1', value: '0.3', 'data-testid': 'teach-u', 'aria-label': 'u' });
+  vIn = el('input', { type: 'number', step: '0.1', value: '0.4', 'data-testid': 'teach-v', 'aria-label': 'v' });
+  const stepBtn = el('button', { type: 'button', 'data-testid': 'teach-step', title: 'Section 5.1 construction, one step at a time' }, 'Ideal △ step');
+  const idealBtn = el('button', { type: 'button', 'data-testid': 'teach-ideal' }, 'Reset star');
+  const controls = el('div', { class: 'teach-controls' });
+  const lab = (t, c) => { const l = el('label', {}, t); l.append(c); return l; };
+  controls.append(lab('Surface ', surfaceSel), lab('u ', uIn), lab('v ', vIn), stepBtn, idealBtn);
+  svg = el('svg:svg', { 'data-testid': 'teach-inset', class: 'teach-inset', width: '300', height: '300', role: 'img', 'aria-label': 'Dupin indicatrix, triangle star and Dupin hexagon' });
+  svg.append(el('svg:rect', { x: '-1e6', y: '-1e6', width: '2e6', height: '2e6', fill: '#101218' }));
+  layer = el('svg:g', { transform: 'scale(1,-1)' });
+  svg.append(layer);
+  verdictEl = el('p', { 'data-testid': 'teach-verdict', class: 'teach-verdict' });
+  reasonEl = el('p', { class: 'teach-reason', 'data-testid': 'teach-reason' });
+  condEl = el('ul', { class: 'teach-conditions' });
+  captionEl = el('p', { class: 'teach-caption', 'data-testid': 'teach-caption' });
+  errorEl = el('p', { class: 'field-error', 'data-testid': 'teach-error', role: 'alert' });
+  panel.append(controls, svg, verdictEl, reasonEl, condEl, captionEl, errorEl);
+  document.querySelector('main').append(panel);
+  const toggle = el('button', { type: 'button', 'data-testid': 'teach', 'aria-pressed': 'false' }, 'Teach');
+  toggle.addEventListener('click', () => {
+    panel.hidden = !panel.hidden;
+    toggle.setAttribute('aria-pressed', String(!panel.hidden));
+    if (!panel.hidden && !lesson) load();
+  });
+  document.querySelector('header .buttons')?.append(toggle);
+  for (const c of [surfaceSel, uIn, vIn]) c.addEventListener('change', load);
+  svg.addEventListener('pointermove', moveDrag);
+  const endDrag = () => { dragIndex = -1; };
+  svg.addEventListener('pointerup', endDrag);
+  svg.addEventListener('pointercancel', endDrag);
+  stepBtn.addEventListener('click', () => {
+    try {
+      steps ??= lesson.idealTriangleSteps();
+      stepIndex = stepIndex + 1 >= steps.length ? -1 : stepIndex + 1;
+      showError(null);
+    } catch (e) { showError(e); }
+    draw();
+  });
+  idealBtn.addEventListener('click', () => {
+    try { state = lesson.makeIdeal(); showError(null); } catch (e) { showError(e); }
+    draw();
+  });
+}
