@@ -10,7 +10,7 @@
 
 use dupin_core::{
     DupinConic, DupinIndicatrix, PointType, TriangleStar, Vec2, dupin_conic_through,
-    ideal_triangle, surface_by_name, surface_catalog,
+    ideal_triangle, surface_by_name,
 };
 use serde::Serialize;
 use std::collections::BTreeMap;
