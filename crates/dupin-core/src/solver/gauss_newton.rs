@@ -340,9 +340,9 @@ impl LevenbergMarquardt {
                 // model is nearly exact, barely on a fair one (ρ ≈ 0.7), grow on a poor one.
                 // A fixed shrink on every ρ > 0.5 made the next try fail (a wasted
                 // factorisation) about every second step on strongly curved constraints.
-                // Near-exact model (ρ > 0.9): the full shrink, so Newton steps (and their
+                // Good model (ρ > 0.75): the full shrink, so Newton steps (and their
                 // quadratic convergence) are reached without delay.
-                let factor = if rho > 0.9 {
+                let factor = if rho > 0.75 {
                     1.0 / self.options.decrease
                 } else {
                     (1.0 - (2.0 * rho - 1.0).powi(3)).clamp(1.0 / self.options.decrease, 2.0)
