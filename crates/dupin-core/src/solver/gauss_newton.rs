@@ -37,7 +37,8 @@ pub struct LmOptions {
     /// Step halvings tried on a rejected step before the damping is raised (each costs one
     /// evaluation instead of a factorisation).
     pub step_halvings: usize,
-    /// Factor by which the damping shrinks after an accepted step (> 1).
+    /// Factor by which the damping shrinks after an accepted step with a good model (gain
+    /// ratio ρ > 0.75; less, by Nielsen's rule, for 0.5 < ρ ≤ 0.75; > 1).
     pub decrease: f64,
 }
 
