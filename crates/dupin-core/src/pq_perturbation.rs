@@ -924,8 +924,10 @@ impl PqPerturbation {
     fn enter_refinement(&mut self) {
         self.phase = PqPhase::Sqp;
         self.lm.invalidate();
-        // Near-Gauss-Newton steps on the constraints: quadratic convergence once close.
-        self.lm.set_damping(1e-9);
+        // Near-Gauss-Newton steps on the constraints: quadratic convergence once close. If the
+        // first one is rejected (far from feasible), retry at the penalty phase's damping.
+        let last = self.lm.damping();
+        self.lm.set_damping_with_fallback(1e-9, last);
     }
 
     /// Runs to the end and returns the result.
