@@ -141,42 +141,13 @@ mod canvas {
             canvas: web_sys::HtmlCanvasElement,
             force_webgl2: bool,
         ) -> Result<Presenter, JsError> {
-            let (width, height) = (canvas.width().max(1), canvas.height().max(1));
-            let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
-            desc.backends = if force_webgl2 {
-                wgpu::Backends::GL
-            } else {
-                wgpu::Backends::BROWSER_WEBGPU | wgpu::Backends::GL
-            };
-            let instance = wgpu::util::new_instance_with_webgpu_detection(desc).await;
-            let surface = instance
-                .create_surface(wgpu::SurfaceTarget::Canvas(canvas))
-                .map_err(|e| JsError::new(&format!("cannot draw into the canvas: {e}")))?;
-            let adapter = instance
-                .request_adapter(&wgpu::RequestAdapterOptions {
-                    compatible_surface: Some(&surface),
-                    ..Default::default()
-                })
-                .await
-                .map_err(|e| JsError::new(&format!("no WebGPU or WebGL2 adapter: {e}")))?;
-            let backend = match adapter.get_info().backend {
-                wgpu::Backend::BrowserWebGpu => "WebGPU",
-                wgpu::Backend::Gl => "WebGL2",
-                _ => "other",
-            };
-            let (device, queue) = adapter
-                .request_device(&wgpu::DeviceDescriptor {
-                    label: Some("dupin presentation"),
-                    required_limits: wgpu::Limits::downlevel_webgl2_defaults()
-                        .using_resolution(adapter.limits()),
-                    ..Default::default()
-                })
-                .await
-                .map_err(|e| JsError::new(&format!("cannot open the graphics device: {e}")))?;
-            let config = surface
-                .get_default_config(&adapter, width, height)
-                .ok_or_else(|| JsError::new("the canvas is not supported by this adapter"))?;
-            surface.configure(&device, &config);
+            let crate::viewer::CanvasGpu {
+                surface,
+                device,
+                queue,
+                config,
+                backend,
+            } = crate::viewer::CanvasGpu::open(canvas, force_webgl2, "dupin presentation").await?;
             let renderer = PresentationRenderer::new(&device, config.format);
             Ok(Presenter {
                 surface,
@@ -281,21 +252,9 @@ mod canvas {
 
         /// Draws one frame.
         pub fn render(&mut self) -> Result<(), JsError> {
-            let frame = match self.surface.get_current_texture() {
-                wgpu::CurrentSurfaceTexture::Success(t)
-                | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
-                wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
-                    self.surface.configure(&self.device, &self.config);
-                    return Ok(());
-                }
-                wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
-                    return Ok(());
-                }
-                wgpu::CurrentSurfaceTexture::Validation => {
-                    return Err(JsError::new(
-                        "the canvas surface reported a validation error",
-                    ));
-                }
+            let Some(frame) = crate::viewer::next_frame(&self.surface, &self.device, &self.config)?
+            else {
+                return Ok(());
             };
             let view = frame.texture.create_view(&Default::default());
             self.renderer.render(

@@ -24,44 +24,13 @@ impl Viewer {
         canvas: web_sys::HtmlCanvasElement,
         force_webgl2: bool,
     ) -> Result<Viewer, JsError> {
-        let (width, height) = (canvas.width().max(1), canvas.height().max(1));
-        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
-        desc.backends = if force_webgl2 {
-            wgpu::Backends::GL
-        } else {
-            wgpu::Backends::BROWSER_WEBGPU | wgpu::Backends::GL
-        };
-        let instance = wgpu::util::new_instance_with_webgpu_detection(desc).await;
-        let surface = instance
-            .create_surface(wgpu::SurfaceTarget::Canvas(canvas))
-            .map_err(|e| JsError::new(&format!("cannot draw into the canvas: {e}")))?;
-        let adapter = instance
-            .request_adapter(&wgpu::RequestAdapterOptions {
-                compatible_surface: Some(&surface),
-                ..Default::default()
-            })
-            .await
-            .map_err(|e| {
-                JsError::new(&format!("no WebGPU or WebGL2 adapter in this browser: {e}"))
-            })?;
-        let backend = match adapter.get_info().backend {
-            wgpu::Backend::BrowserWebGpu => "WebGPU",
-            wgpu::Backend::Gl => "WebGL2",
-            _ => "other",
-        };
-        let (device, queue) = adapter
-            .request_device(&wgpu::DeviceDescriptor {
-                label: Some("dupin"),
-                required_limits: wgpu::Limits::downlevel_webgl2_defaults()
-                    .using_resolution(adapter.limits()),
-                ..Default::default()
-            })
-            .await
-            .map_err(|e| JsError::new(&format!("cannot open the graphics device: {e}")))?;
-        let config = surface
-            .get_default_config(&adapter, width, height)
-            .ok_or_else(|| JsError::new("the canvas is not supported by this adapter"))?;
-        surface.configure(&device, &config);
+        let CanvasGpu {
+            surface,
+            device,
+            queue,
+            config,
+            backend,
+        } = CanvasGpu::open(canvas, force_webgl2, "dupin").await?;
         let renderer = MeshRenderer::new(&device, config.format);
         Ok(Viewer {
             surface,
@@ -194,21 +163,8 @@ impl Viewer {
 
     /// Draws one frame.
     pub fn render(&mut self) -> Result<(), JsError> {
-        let frame = match self.surface.get_current_texture() {
-            wgpu::CurrentSurfaceTexture::Success(t)
-            | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
-            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
-                self.surface.configure(&self.device, &self.config);
-                return Ok(());
-            }
-            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
-                return Ok(());
-            }
-            wgpu::CurrentSurfaceTexture::Validation => {
-                return Err(JsError::new(
-                    "the canvas surface reported a validation error",
-                ));
-            }
+        let Some(frame) = next_frame(&self.surface, &self.device, &self.config)? else {
+            return Ok(());
         };
         let view = frame.texture.create_view(&Default::default());
         self.renderer.render(
@@ -221,5 +177,93 @@ impl Viewer {
         );
         self.queue.present(frame);
         Ok(())
+    }
+}
+
+/// The canvas's next frame, or `None` when there is nothing to draw into this time (an outdated
+/// or lost surface is reconfigured; a timeout or an occluded canvas skips the frame).
+pub(crate) fn next_frame(
+    surface: &wgpu::Surface<'static>,
+    device: &wgpu::Device,
+    config: &wgpu::SurfaceConfiguration,
+) -> Result<Option<wgpu::SurfaceTexture>, JsError> {
+    match surface.get_current_texture() {
+        wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => {
+            Ok(Some(t))
+        }
+        wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+            surface.configure(device, config);
+            Ok(None)
+        }
+        wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => Ok(None),
+        wgpu::CurrentSurfaceTexture::Validation => Err(JsError::new(
+            "the canvas surface reported a validation error",
+        )),
+    }
+}
+
+/// A canvas with its wgpu surface, device and queue (shared by [`Viewer`] and the presenter).
+pub(crate) struct CanvasGpu {
+    pub(crate) surface: wgpu::Surface<'static>,
+    pub(crate) device: wgpu::Device,
+    pub(crate) queue: wgpu::Queue,
+    pub(crate) config: wgpu::SurfaceConfiguration,
+    /// `"WebGPU"` or `"WebGL2"`.
+    pub(crate) backend: &'static str,
+}
+
+impl CanvasGpu {
+    /// Opens `canvas` with WebGPU, or WebGL2 where WebGPU is missing (`force_webgl2`: WebGL2
+    /// only), under WebGL2's limits so both backends behave alike.
+    pub(crate) async fn open(
+        canvas: web_sys::HtmlCanvasElement,
+        force_webgl2: bool,
+        label: &str,
+    ) -> Result<CanvasGpu, JsError> {
+        let (width, height) = (canvas.width().max(1), canvas.height().max(1));
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        desc.backends = if force_webgl2 {
+            wgpu::Backends::GL
+        } else {
+            wgpu::Backends::BROWSER_WEBGPU | wgpu::Backends::GL
+        };
+        let instance = wgpu::util::new_instance_with_webgpu_detection(desc).await;
+        let surface = instance
+            .create_surface(wgpu::SurfaceTarget::Canvas(canvas))
+            .map_err(|e| JsError::new(&format!("cannot draw into the canvas: {e}")))?;
+        let adapter = instance
+            .request_adapter(&wgpu::RequestAdapterOptions {
+                compatible_surface: Some(&surface),
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| {
+                JsError::new(&format!("no WebGPU or WebGL2 adapter in this browser: {e}"))
+            })?;
+        let backend = match adapter.get_info().backend {
+            wgpu::Backend::BrowserWebGpu => "WebGPU",
+            wgpu::Backend::Gl => "WebGL2",
+            _ => "other",
+        };
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some(label),
+                required_limits: wgpu::Limits::downlevel_webgl2_defaults()
+                    .using_resolution(adapter.limits()),
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| JsError::new(&format!("cannot open the graphics device: {e}")))?;
+        let config = surface
+            .get_default_config(&adapter, width, height)
+            .ok_or_else(|| JsError::new("the canvas is not supported by this adapter"))?;
+        surface.configure(&device, &config);
+        Ok(CanvasGpu {
+            surface,
+            device,
+            queue,
+            config,
+            backend,
+        })
     }
 }
