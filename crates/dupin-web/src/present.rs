@@ -271,39 +271,11 @@ mod canvas {
 
         /// Renders at `scale` x the canvas size (2 for the 2x PNG); resolves to an `ImageData`.
         pub fn snapshot(&mut self, scale: f32) -> Result<js_sys::Promise, JsError> {
-            if !(scale.is_finite() && scale > 0.0 && scale <= 8.0) {
-                return Err(JsError::new(&format!(
-                    "snapshot scale must be in (0, 8], got {scale}"
-                )));
-            }
-            let w = (self.config.width as f32 * scale).round() as u32;
-            let h = (self.config.height as f32 * scale).round() as u32;
+            let (w, h) = crate::viewer::snapshot_size(&self.config, scale)?;
             let pending =
                 self.renderer
                     .begin_snapshot(&self.device, &self.queue, w, h, &self.camera);
-            let (w, h) = (pending.width(), pending.height());
-            let mut pending = Some(pending);
-            let promise = js_sys::Promise::new(&mut |resolve, reject| {
-                let Some(pending) = pending.take() else {
-                    return;
-                };
-                pending.read(move |result| {
-                    let value = result
-                        .map_err(|e| JsValue::from(js_sys::Error::new(&e.to_string())))
-                        .and_then(|rgba| {
-                            web_sys::ImageData::new_with_u8_clamped_array_and_sh(
-                                wasm_bindgen::Clamped(&rgba),
-                                w,
-                                h,
-                            )
-                            .map(JsValue::from)
-                        });
-                    let _ = match value {
-                        Ok(v) => resolve.call1(&JsValue::NULL, &v),
-                        Err(e) => reject.call1(&JsValue::NULL, &e),
-                    };
-                });
-            });
+            let promise = crate::viewer::image_data_promise(pending);
             self.poll();
             Ok(promise)
         }

@@ -117,40 +117,11 @@ impl Viewer {
     /// resolves to an `ImageData` of it. Pixels come back from the GPU, so this works where a
     /// browser screenshot does not show WebGPU canvases (headless Chromium).
     pub fn snapshot(&mut self, scale: f32) -> Result<js_sys::Promise, JsError> {
-        if !(scale.is_finite() && scale > 0.0 && scale <= 8.0) {
-            return Err(JsError::new(&format!(
-                "snapshot scale must be in (0, 8], got {scale}"
-            )));
-        }
-        let w = (self.config.width as f32 * scale).round() as u32;
-        let h = (self.config.height as f32 * scale).round() as u32;
+        let (w, h) = snapshot_size(&self.config, scale)?;
         let pending = self
             .renderer
             .begin_snapshot(&self.device, &self.queue, w, h, &self.camera);
-        let (w, h) = (pending.width(), pending.height());
-        // Promise::new takes an FnMut it calls exactly once.
-        let mut pending = Some(pending);
-        let promise = js_sys::Promise::new(&mut |resolve, reject| {
-            let Some(pending) = pending.take() else {
-                return;
-            };
-            pending.read(move |result| {
-                let value = result
-                    .map_err(|e| JsValue::from(js_sys::Error::new(&e.to_string())))
-                    .and_then(|rgba| {
-                        web_sys::ImageData::new_with_u8_clamped_array_and_sh(
-                            wasm_bindgen::Clamped(&rgba),
-                            w,
-                            h,
-                        )
-                        .map(JsValue::from)
-                    });
-                let _ = match value {
-                    Ok(v) => resolve.call1(&JsValue::NULL, &v),
-                    Err(e) => reject.call1(&JsValue::NULL, &e),
-                };
-            });
-        });
+        let promise = image_data_promise(pending);
         self.poll();
         Ok(promise)
     }
@@ -266,4 +237,48 @@ impl CanvasGpu {
             backend,
         })
     }
+}
+
+/// The pixel size of a snapshot at `scale` times the canvas (`scale` in (0, 8]).
+pub(crate) fn snapshot_size(
+    config: &wgpu::SurfaceConfiguration,
+    scale: f32,
+) -> Result<(u32, u32), JsError> {
+    if !(scale.is_finite() && scale > 0.0 && scale <= 8.0) {
+        return Err(JsError::new(&format!(
+            "snapshot scale must be in (0, 8], got {scale}"
+        )));
+    }
+    Ok((
+        (config.width as f32 * scale).round() as u32,
+        (config.height as f32 * scale).round() as u32,
+    ))
+}
+
+/// A promise of the `ImageData` a GPU readback delivers (the caller polls the device).
+pub(crate) fn image_data_promise(pending: dupin_render::PendingSnapshot) -> js_sys::Promise {
+    let (w, h) = (pending.width(), pending.height());
+    // Promise::new takes an FnMut it calls exactly once.
+    let mut pending = Some(pending);
+    js_sys::Promise::new(&mut |resolve, reject| {
+        let Some(pending) = pending.take() else {
+            return;
+        };
+        pending.read(move |result| {
+            let value = result
+                .map_err(|e| JsValue::from(js_sys::Error::new(&e.to_string())))
+                .and_then(|rgba| {
+                    web_sys::ImageData::new_with_u8_clamped_array_and_sh(
+                        wasm_bindgen::Clamped(&rgba),
+                        w,
+                        h,
+                    )
+                    .map(JsValue::from)
+                });
+            let _ = match value {
+                Ok(v) => resolve.call1(&JsValue::NULL, &v),
+                Err(e) => reject.call1(&JsValue::NULL, &e),
+            };
+        });
+    })
 }
