@@ -9,6 +9,10 @@ use std::time::Instant;
 
 /// Runs all checks; stops at the first failure.
 pub fn run() -> Result<()> {
+    // A full run gains nothing from incremental caches, and on a small CI disk they cost
+    // gigabytes (the wasm-pack children inherit this too).
+    // SAFETY: set before any thread is spawned.
+    unsafe { std::env::set_var("CARGO_INCREMENTAL", "0") };
     let web = WebBuild::load()?;
     let mut times = Vec::new();
     let mut step = |name: &str, f: &mut dyn FnMut() -> Result<()>| -> Result<()> {
@@ -16,6 +20,9 @@ pub fn run() -> Result<()> {
         let t = Instant::now();
         let r = f();
         times.push((name.to_string(), t.elapsed().as_secs_f64()));
+        if let Some(gb) = util::free_disk_gb(&root()) {
+            println!("    ({gb:.1} GB free on the target disk)");
+        }
         r.map_err(|e| format!("{name}: {e}"))
     };
     step("setup", &mut || {
@@ -58,6 +65,10 @@ pub fn run() -> Result<()> {
                 .env("RUSTDOCFLAGS", "-D warnings"),
         )
     })?;
+    step(
+        "free the native test build if the disk is short",
+        &mut || free_native_tests_if_short(),
+    )?;
     step("core tests on wasm32 (Node)", &mut || {
         // The core's wasm32 test files run under wasm-bindgen-test-runner in Node.
         util::run(
@@ -96,4 +107,26 @@ pub fn run() -> Result<()> {
         println!("  {secs:8.1} s  {name}");
     }
     Ok(())
+}
+
+/// Below this much free disk the wasm and web builds (about 1.5 GB) may not fit.
+const SHORT_DISK_GB: f64 = 4.0;
+
+/// Removes the native debug build (tests have run, docs are built) when the disk is short, so a
+/// CI machine with a few GB free still fits the wasm builds; a roomy machine keeps it for reruns.
+fn free_native_tests_if_short() -> Result<()> {
+    let target = root().join("target");
+    match util::free_disk_gb(&target) {
+        Some(gb) if gb < SHORT_DISK_GB => {
+            let debug = target.join("debug");
+            println!("only {gb:.1} GB free: removing {}", debug.display());
+            std::fs::remove_dir_all(&debug)
+                .map_err(|e| format!("could not remove {}: {e}", debug.display()))
+        }
+        Some(gb) => {
+            println!("{gb:.1} GB free: keeping the native build");
+            Ok(())
+        }
+        None => Ok(()),
+    }
 }

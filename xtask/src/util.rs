@@ -47,3 +47,17 @@ pub fn output(cmd: &mut Command) -> Option<String> {
 pub fn is_root() -> bool {
     output(Command::new("id").arg("-u")).is_some_and(|s| s.trim() == "0")
 }
+
+/// Free space in GB on the file system holding `path` (from POSIX `df -Pk`), or None if unknown.
+pub fn free_disk_gb(path: &std::path::Path) -> Option<f64> {
+    let dir = path.ancestors().find(|p| p.exists())?;
+    let out = output(Command::new("df").arg("-Pk").arg(dir))?;
+    let kb: f64 = out
+        .lines()
+        .nth(1)?
+        .split_whitespace()
+        .nth(3)?
+        .parse()
+        .ok()?;
+    Some(kb / 1024.0 / 1024.0)
+}
