@@ -6,14 +6,17 @@
 //! for tests. The core never knows about this crate.
 
 mod camera;
+mod gpu_mesh;
 mod mesh_renderer;
 #[cfg(not(target_arch = "wasm32"))]
 mod offscreen;
 mod presentation;
+mod readback;
 
 pub use camera::OrbitCamera;
-pub use mesh_renderer::{BACKGROUND, MeshRenderer, PendingSnapshot, RenderError};
+pub use mesh_renderer::{BACKGROUND, MeshRenderer, RenderError};
 #[cfg(not(target_arch = "wasm32"))]
 pub use offscreen::{OffscreenImage, render_offscreen, render_presentation_offscreen};
 pub use presentation::{GLASS_TINT, METAL_COLOR, PresentationRenderer, frame_buffers};
+pub use readback::PendingSnapshot;
 pub use wgpu;

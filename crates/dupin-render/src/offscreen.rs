@@ -3,6 +3,7 @@
 use crate::camera::OrbitCamera;
 use crate::mesh_renderer::{MeshRenderer, RenderError};
 use crate::presentation::PresentationRenderer;
+use crate::readback::PendingSnapshot;
 use dupin_core::TriangleBuffers;
 
 /// An 8-bit sRGB RGBA image, rows top to bottom.
@@ -51,12 +52,21 @@ async fn render_async(
     if let Some(l) = lines {
         renderer.set_lines(&device, &queue, l, [0.05, 0.05, 0.06]);
     }
+    let pending = renderer.begin_snapshot(&device, &queue, width, height, camera);
+    finish(&adapter, &device, pending)
+}
+
+/// Waits for `pending` to come back from the GPU.
+fn finish(
+    adapter: &wgpu::Adapter,
+    device: &wgpu::Device,
+    pending: PendingSnapshot,
+) -> Result<OffscreenImage, RenderError> {
+    let (width, height) = (pending.width(), pending.height());
     let (tx, rx) = std::sync::mpsc::channel();
-    renderer
-        .begin_snapshot(&device, &queue, width, height, camera)
-        .read(move |r| {
-            let _ = tx.send(r);
-        });
+    pending.read(move |r| {
+        let _ = tx.send(r);
+    });
     device
         .poll(wgpu::PollType::Wait {
             submission_index: None,
@@ -126,25 +136,7 @@ pub fn render_presentation_offscreen(
         let mut r = PresentationRenderer::new(&device, wgpu::TextureFormat::Rgba8UnormSrgb);
         r.set_scene(&device, &queue, panels, None, frames)?;
         r.set_shadows(shadows);
-        let (tx, rx) = std::sync::mpsc::channel();
-        r.begin_snapshot(&device, &queue, width.max(1), height.max(1), camera)
-            .read(move |r| {
-                let _ = tx.send(r);
-            });
-        device
-            .poll(wgpu::PollType::Wait {
-                submission_index: None,
-                timeout: None,
-            })
-            .map_err(|e| RenderError::Readback(e.to_string()))?;
-        let rgba = rx
-            .recv()
-            .map_err(|e| RenderError::Readback(e.to_string()))??;
-        Ok(OffscreenImage {
-            width: width.max(1),
-            height: height.max(1),
-            rgba,
-            adapter: adapter.get_info().name,
-        })
+        let pending = r.begin_snapshot(&device, &queue, width.max(1), height.max(1), camera);
+        finish(&adapter, &device, pending)
     })
 }

@@ -1,4 +1,4 @@
-// Presentation mode: metal frames and a ground that receive a shadow map of the frames, and glass
+// Presentation mode (after vertex_io.wgsl): metal frames and a ground that receive a shadow map of the frames, and glass
 // panels blended over them with a Fresnel-like rim. Soft light: a sky/ground hemisphere ambient
 // plus one sun whose shadow is filtered with a 3x3 percentage-closer kernel.
 
@@ -17,19 +17,6 @@ struct Uniforms {
 @group(0) @binding(1) var shadow_map: texture_depth_2d;
 @group(0) @binding(2) var shadow_sampler: sampler_comparison;
 
-struct VsIn {
-    @location(0) pos: vec3<f32>,
-    @location(1) normal: vec3<f32>,
-    @location(2) color: vec3<f32>,
-};
-
-struct VsOut {
-    @builtin(position) clip: vec4<f32>,
-    @location(0) world: vec3<f32>,
-    @location(1) normal: vec3<f32>,
-    @location(2) color: vec3<f32>,
-};
-
 @vertex
 fn vs_main(v: VsIn) -> VsOut {
     var o: VsOut;
@@ -46,8 +33,7 @@ fn vs_shadow(v: VsIn) -> @builtin(position) vec4<f32> {
 }
 
 fn encode(c: vec3<f32>, a: f32) -> vec4<f32> {
-    let g = pow(clamp(c, vec3<f32>(0.0), vec3<f32>(1.0)), vec3<f32>(1.0 / 2.2));
-    return vec4<f32>(mix(c, g, u.flags.x), a);
+    return encode_rgba(c, a, u.flags.x);
 }
 
 // Fraction of the sun reaching `world` (1 lit, 0 shadowed), 3x3 PCF.
@@ -76,10 +62,7 @@ fn hemisphere(n: vec3<f32>) -> vec3<f32> {
 @fragment
 fn fs_metal(i: VsOut) -> @location(0) vec4<f32> {
     let view = normalize(u.eye.xyz - i.world);
-    var n = normalize(i.normal);
-    if (dot(n, view) < 0.0) {
-        n = -n;
-    }
+    let n = facing_normal(i, u.eye.xyz);
     let sun = normalize(u.sun.xyz);
     let lit = sunlight(i.world, n);
     let h = normalize(sun + view);
@@ -92,10 +75,7 @@ fn fs_metal(i: VsOut) -> @location(0) vec4<f32> {
 @fragment
 fn fs_glass(i: VsOut) -> @location(0) vec4<f32> {
     let view = normalize(u.eye.xyz - i.world);
-    var n = normalize(i.normal);
-    if (dot(n, view) < 0.0) {
-        n = -n;
-    }
+    let n = facing_normal(i, u.eye.xyz);
     let sun = normalize(u.sun.xyz);
     let lit = sunlight(i.world, n);
     let cos_v = clamp(dot(n, view), 0.0, 1.0);

@@ -1,4 +1,4 @@
-// Lit mesh and flat lines. Two-sided Blinn-Phong with a camera-attached key light and a fill, so
+// Lit mesh and flat lines (after vertex_io.wgsl). Two-sided Blinn-Phong with a camera-attached key light and a fill, so
 // panels read clearly from any orbit angle.
 
 struct Uniforms {
@@ -12,19 +12,6 @@ struct Uniforms {
 
 @group(0) @binding(0) var<uniform> u: Uniforms;
 
-struct VsIn {
-    @location(0) pos: vec3<f32>,
-    @location(1) normal: vec3<f32>,
-    @location(2) color: vec3<f32>,
-};
-
-struct VsOut {
-    @builtin(position) clip: vec4<f32>,
-    @location(0) world: vec3<f32>,
-    @location(1) normal: vec3<f32>,
-    @location(2) color: vec3<f32>,
-};
-
 @vertex
 fn vs_main(v: VsIn) -> VsOut {
     var o: VsOut;
@@ -36,18 +23,14 @@ fn vs_main(v: VsIn) -> VsOut {
 }
 
 fn encode(c: vec3<f32>) -> vec4<f32> {
-    let g = pow(clamp(c, vec3<f32>(0.0), vec3<f32>(1.0)), vec3<f32>(1.0 / 2.2));
-    return vec4<f32>(mix(c, g, u.flags.x), 1.0);
+    return encode_rgba(c, 1.0, u.flags.x);
 }
 
 @fragment
 fn fs_main(i: VsOut) -> @location(0) vec4<f32> {
     let view = normalize(u.eye.xyz - i.world);
-    var n = normalize(i.normal);
-    // Two-sided: light the side the viewer sees, whatever the winding.
-    if (dot(n, view) < 0.0) {
-        n = -n;
-    }
+    // Two-sided: light the side the viewer sees.
+    let n = facing_normal(i, u.eye.xyz);
     let key = normalize(u.key_dir.xyz);
     let fill = normalize(vec3<f32>(-key.x, 0.5, -key.z));
     let diffuse = max(dot(n, key), 0.0) * 0.75 + max(dot(n, fill), 0.0) * 0.25;

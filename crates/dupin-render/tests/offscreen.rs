@@ -7,10 +7,9 @@
 
 use dupin_core::{Torus, sample_surface};
 use dupin_render::{BACKGROUND, OffscreenImage, OrbitCamera, render_offscreen};
-use std::path::PathBuf;
 
-const W: u32 = 320;
-const H: u32 = 240;
+mod common;
+use common::{H, W, expect_image, reference_image, save};
 
 fn torus_image(camera: impl FnOnce(&mut OrbitCamera)) -> OffscreenImage {
     let mesh = sample_surface(
@@ -23,28 +22,7 @@ fn torus_image(camera: impl FnOnce(&mut OrbitCamera)) -> OffscreenImage {
     );
     let mut cam = OrbitCamera::framing_points(&mesh.positions);
     camera(&mut cam);
-    render_offscreen(&mesh, None, &cam, W, H).unwrap_or_else(|e| {
-        panic!("offscreen rendering failed: {e}. Install a Vulkan driver (apt-get install mesa-vulkan-drivers) or run `cargo xtask test`, which does.")
-    })
-}
-
-fn out_dir() -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target/render-tests");
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn save(img: &OffscreenImage, name: &str) -> PathBuf {
-    let path = out_dir().join(name);
-    image::save_buffer(
-        &path,
-        &img.rgba,
-        img.width,
-        img.height,
-        image::ColorType::Rgba8,
-    )
-    .unwrap();
-    path
+    expect_image(render_offscreen(&mesh, None, &cam, W, H))
 }
 
 fn srgb8(c: f64) -> u8 {
@@ -101,20 +79,8 @@ fn torus_matches_reference_image() {
         covered * 100.0
     );
 
-    let reference = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/reference/torus.png");
-    if std::env::var_os("DUPIN_BLESS").is_some() {
-        std::fs::copy(&actual, &reference).unwrap();
-    }
-    let want = image::open(&reference)
-        .unwrap_or_else(|e| {
-            panic!(
-                "{}: {e}; run with DUPIN_BLESS=1 to create it",
-                reference.display()
-            )
-        })
-        .to_rgba8();
-    assert_eq!((want.width(), want.height()), (W, H));
-    let (differing, mean) = difference(&img.rgba, want.as_raw());
+    let (want, reference) = reference_image("torus.png", &actual);
+    let (differing, mean) = difference(&img.rgba, &want);
     assert!(
         differing < 0.005 && mean < 1.5,
         "render differs from reference ({}): {:.2}% pixels off, mean |d| {mean:.2}; adapter {}; see {}",

@@ -8,10 +8,9 @@
 
 use dupin_core::{PolyMesh, TriangleBuffers, Vec3, polymesh_buffers, polymesh_edges};
 use dupin_render::{OffscreenImage, OrbitCamera, frame_buffers, render_presentation_offscreen};
-use std::path::PathBuf;
 
-const W: u32 = 320;
-const H: u32 = 240;
+mod common;
+use common::{H, W, expect_image, reference_image, save};
 
 /// An 8 x 6 grid of quads on a gentle saddle, lifted above the ground it casts shadows on.
 fn panels() -> PolyMesh {
@@ -63,28 +62,13 @@ fn render(with_frames: bool, with_glass: bool, shadows: bool) -> OffscreenImage 
             .collect::<Vec<_>>(),
     );
     cam.distance *= 1.15;
-    render_presentation_offscreen(&glass, &frames, &cam, (W, H), shadows).unwrap_or_else(|e| {
-        panic!("offscreen rendering failed: {e}. Install a Vulkan driver (apt-get install mesa-vulkan-drivers) or run `cargo xtask test`, which does.")
-    })
-}
-
-fn out_dir() -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target/render-tests");
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn save(img: &OffscreenImage, name: &str) -> PathBuf {
-    let path = out_dir().join(name);
-    image::save_buffer(
-        &path,
-        &img.rgba,
-        img.width,
-        img.height,
-        image::ColorType::Rgba8,
-    )
-    .unwrap();
-    path
+    expect_image(render_presentation_offscreen(
+        &glass,
+        &frames,
+        &cam,
+        (W, H),
+        shadows,
+    ))
 }
 
 /// Fraction of pixels differing by more than `t` levels in some channel.
@@ -148,22 +132,9 @@ fn presentation_matches_reference_and_shows_frames_glass_and_shadows() {
         "{brighter} pixels brighter in shadow"
     );
 
-    let reference =
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/reference/presentation.png");
-    if std::env::var_os("DUPIN_BLESS").is_some() {
-        std::fs::copy(&actual, &reference).unwrap();
-    }
-    let want = image::open(&reference)
-        .unwrap_or_else(|e| {
-            panic!(
-                "{}: {e}; run with DUPIN_BLESS=1 to create it",
-                reference.display()
-            )
-        })
-        .to_rgba8();
-    assert_eq!((want.width(), want.height()), (W, H));
-    let off = differing(&full.rgba, want.as_raw(), 24);
-    let mean = mean_abs(&full.rgba, want.as_raw());
+    let (want, _) = reference_image("presentation.png", &actual);
+    let off = differing(&full.rgba, &want, 24);
+    let mean = mean_abs(&full.rgba, &want);
     assert!(
         off < 0.005 && mean < 1.5,
         "render differs from reference: {:.2}% pixels off, mean |d| {mean:.2}; adapter {}; see {}",
