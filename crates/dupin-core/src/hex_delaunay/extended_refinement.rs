@@ -565,9 +565,10 @@ impl OccupiedIndex {
 ///
 /// Leaves: only a leaf with fins can be marked, so a split of `(k, x)` matters to the leaves
 /// of level `k` within two steps (their fins, or a neighbour's fins for the opposite-strip
-/// rule), the new leaves of level `k + 1` and their neighbours (two steps from `2x`; three
-/// when a point moved into them: the rings), and the leaves of level `k - 1` whose fin-side
-/// hexagons include `x` or its neighbours (two steps from `x / 2`).
+/// rule), the new leaves of level `k + 1` and those near them (three steps from `2x`: their
+/// neighbours' presence and the rings of points that moved in; with two, the final full pass
+/// still found splits), and the leaves of level `k - 1` whose fin-side hexagons include `x` or
+/// its neighbours (two steps from `x / 2`).
 ///
 /// Occupied hexagons: their rules read the occupancy within three steps, the 2-ring and, for
 /// a waived ring conflict, the relocations of the 2-ring (fins one step further, fin-side
@@ -587,8 +588,7 @@ fn affected(
     for &(k, x) in changes {
         let c = (2 * x.0, 2 * x.1);
         leaves.extend(disc(x, 2).map(|z| (k, z)));
-        let moved_in = disc(c, 1).any(|z| r.point_in(k + 1, z).is_some());
-        leaves.extend(disc(c, if moved_in { 3 } else { 2 }).map(|z| (k + 1, z)));
+        leaves.extend(disc(c, 3).map(|z| (k + 1, z)));
         if k >= 1 {
             let half = (x.0.div_euclid(2), x.1.div_euclid(2));
             leaves.extend(disc(half, 2).map(|z| (k - 1, z)));
