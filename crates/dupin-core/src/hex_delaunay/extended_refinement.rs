@@ -19,7 +19,7 @@
 //! same-level neighbour has fins none of which is at or next to its own fin directions (two
 //! such centres move apart and leave a 35° triangle between them, a case Fig. 10 lacks);
 //! (b) ring conflicts between occupied hexagons of one level, resolved by splitting or by a
-//! local check of the triangles around the rings (see `classify`); (c) the 2-ring of an
+//! local check of the triangles around the rings (see `Pass::verify`); (c) the 2-ring of an
 //! occupied hexagon is made of unsplit full hexagons of its level; (d) on Ω's boundary a centre
 //! may only slide along the boundary, Ω's corners and an OCCUPIED_2's moved ring stay off it.
 //!
@@ -154,6 +154,12 @@ enum Leaf {
     Fixed,
     Moved(Vec2),
 }
+
+/// Hexagons as (level, centre).
+type Hexes = Vec<(u32, Axial)>;
+
+/// The hexagons a pass marks for splitting and those it makes present, sorted.
+type Marks = (Hexes, Hexes);
 
 /// One classification pass: the rules as pure functions of the current hierarchy, evaluated
 /// only where asked, with the occupied hexagons' verdicts memoised for the pass. A rule fires
@@ -473,7 +479,7 @@ impl<'a> Pass<'a> {
     }
 
     /// The marks, sorted (deterministic order of the splits).
-    fn marks(self) -> (Vec<(u32, Axial)>, Vec<(u32, Axial)>) {
+    fn marks(self) -> Marks {
         let mut split: Vec<_> = self.split.into_iter().collect();
         split.sort_unstable();
         let mut present: Vec<_> = self.present.into_iter().collect();
@@ -484,7 +490,7 @@ impl<'a> Pass<'a> {
 
 /// A full pass: every occupied hexagon and every leaf. Returns the marks and the relocated
 /// centres.
-fn full_pass(r: &Refinement) -> (Vec<(u32, Axial)>, Vec<(u32, Axial)>, FxHashMap<Key, Vec2>) {
+fn full_pass(r: &Refinement) -> (Marks, FxHashMap<Key, Vec2>) {
     let mut pass = Pass::new(r);
     for c in &r.cell_of {
         if let Cell::Full(k, x) = *c {
@@ -498,8 +504,7 @@ fn full_pass(r: &Refinement) -> (Vec<(u32, Axial)>, Vec<(u32, Axial)>, FxHashMap
             moved.insert(pack(k, v), p);
         }
     });
-    let (split, present) = pass.marks();
-    (split, present, moved)
+    (pass.marks(), moved)
 }
 
 /// Side of the square blocks of lattice coordinates (as a shift) that index the occupied
@@ -574,11 +579,7 @@ impl OccupiedIndex {
 /// a waived ring conflict, the relocations of the 2-ring (fins one step further, fin-side
 /// hexagons one level finer); the leaves read their rings. Those within eight steps at levels
 /// `k` and `k + 1` (from `2x`) and six at level `k - 1` are re-run and give the ring roles.
-fn affected(
-    r: &Refinement,
-    index: &mut OccupiedIndex,
-    changes: &[(u32, Axial)],
-) -> (Vec<(u32, Axial)>, Vec<(u32, Axial)>) {
+fn affected(r: &Refinement, index: &mut OccupiedIndex, changes: &[(u32, Axial)]) -> (Hexes, Hexes) {
     let mut leaves: FxHashSet<(u32, Axial)> = FxHashSet::default();
     leaves.reserve(changes.len() * 24);
     let mut occupied: FxHashSet<(u32, Axial)> = FxHashSet::default();
@@ -608,11 +609,7 @@ fn affected(
 }
 
 /// An incremental pass over the given leaves and occupied hexagons.
-fn region_pass(
-    r: &Refinement,
-    leaves: &[(u32, Axial)],
-    occupied: &[(u32, Axial)],
-) -> (Vec<(u32, Axial)>, Vec<(u32, Axial)>) {
+fn region_pass(r: &Refinement, leaves: &[(u32, Axial)], occupied: &[(u32, Axial)]) -> Marks {
     let h = &r.hierarchy;
     let mut pass = Pass::new(r);
     for &(k, x) in occupied {
@@ -674,8 +671,7 @@ pub fn extended_pass(
             }
             None => {
                 state.index.rebuild(r);
-                let (s, p, _) = full_pass(r);
-                (s, p)
+                full_pass(r).0
             }
         };
         let mut made = Vec::new();
@@ -700,5 +696,5 @@ pub const ANGLE_MIN: f64 = 43.897_886_248_013_99;
 
 /// The relocated centres (section 5.4) of the finished extended refinement.
 pub fn relocated_centres(r: &Refinement) -> FxHashMap<Key, Vec2> {
-    full_pass(r).2
+    full_pass(r).1
 }
