@@ -33,16 +33,13 @@ fn bench(c: &mut Criterion) {
             .expect("valid input")
             .triangles
             .len();
-        // The extended mode only at 2k points: at 16k one run takes minutes (BENCHMARKS.md).
-        let extended = (n <= 2000).then(|| {
-            hex_delaunay(&pts, &[], HexDelaunayMode::Extended)
-                .expect("valid input")
-                .triangles
-                .len()
-        });
+        let extended = hex_delaunay(&pts, &[], HexDelaunayMode::Extended)
+            .expect("valid input")
+            .triangles
+            .len();
         let theirs = spade_refine(&pts);
         eprintln!(
-            "{n} points: hex_delaunay simple {ours}, extended {extended:?} triangles, spade \
+            "{n} points: hex_delaunay simple {ours}, extended {extended} triangles, spade \
              30deg {theirs} triangles"
         );
         g.bench_with_input(BenchmarkId::new("simple", n), &pts, |b, p| {
@@ -50,14 +47,12 @@ fn bench(c: &mut Criterion) {
                 hex_delaunay(black_box(p), &[], HexDelaunayMode::Simple).map(|t| t.triangles.len())
             })
         });
-        if extended.is_some() {
-            g.bench_with_input(BenchmarkId::new("extended", n), &pts, |b, p| {
-                b.iter(|| {
-                    hex_delaunay(black_box(p), &[], HexDelaunayMode::Extended)
-                        .map(|t| t.triangles.len())
-                })
-            });
-        }
+        g.bench_with_input(BenchmarkId::new("extended", n), &pts, |b, p| {
+            b.iter(|| {
+                hex_delaunay(black_box(p), &[], HexDelaunayMode::Extended)
+                    .map(|t| t.triangles.len())
+            })
+        });
         g.bench_with_input(BenchmarkId::new("spade_refine_30deg", n), &pts, |b, p| {
             b.iter(|| spade_refine(black_box(p)))
         });

@@ -19,17 +19,21 @@
 //! same-level neighbour has fins none of which is at or next to its own fin directions (two
 //! such centres move apart and leave a 35° triangle between them, a case Fig. 10 lacks);
 //! (b) ring conflicts between occupied hexagons of one level, resolved by splitting or by a
-//! local check of the triangles around the rings (see `classify`); (c) the 2-ring of an
+//! local check of the triangles around the rings (see `Pass::verify`); (c) the 2-ring of an
 //! occupied hexagon is made of unsplit full hexagons of its level; (d) on Ω's boundary a centre
 //! may only slide along the boundary, Ω's corners and an OCCUPIED_2's moved ring stay off it.
 //!
-//! Each pass classifies every leaf full hexagon in O(1) expected hash look-ups, so a pass costs
-//! O(T) for T current triangles; passes repeat until no rule fires.
+//! Cost: the rules are pure functions of the hierarchy, evaluated per hexagon in O(1) expected
+//! hash look-ups. After a wave of splits the next pass evaluates only the hexagons the splits
+//! can affect (found from the splits, and an index of occupied hexagons by lattice block), so
+//! the passes together cost O(S) for S splits; a full pass over all leaves, O(T) for T
+//! triangles, starts and ends the run (a few in all: one more each time it finds something
+//! the incremental passes left).
 
 use super::dual::{Key, pack};
 use super::error::HexDelaunayError;
 use super::hierarchy::{Cell, Hierarchy};
-use super::lattice::{Axial, DIRS, add, in_domain, on_boundary, parents_of_midpoint};
+use super::lattice::{Axial, DIRS, add, hex_norm, in_domain, on_boundary, parents_of_midpoint};
 use super::simple_refinement::Refinement;
 use crate::math::Vec2;
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -84,6 +88,21 @@ fn consecutive(mask: u8) -> Option<(usize, usize)> {
     }
 }
 
+/// Position of the offset `dz` (hexagonal norm 2) in the order of `ring(_, 2)`.
+fn ring2_index(dz: Axial) -> usize {
+    // ring(v, 2) walks side j from 2·DIRS[j] along DIRS[j + 2], two steps per side.
+    for j in 0..6 {
+        let d = DIRS[j];
+        let e = DIRS[(j + 2) % 6];
+        for t in 0..2 {
+            if (2 * d.0 + t * e.0, 2 * d.1 + t * e.1) == dz {
+                return 2 * j + t as usize;
+            }
+        }
+    }
+    unreachable!("offset of hexagonal norm 2")
+}
+
 /// Lattice points at hexagonal distance exactly `r` from `v`.
 fn ring(v: Axial, r: i64) -> impl Iterator<Item = Axial> {
     (0..6).flat_map(move |j| {
@@ -93,41 +112,95 @@ fn ring(v: Axial, r: i64) -> impl Iterator<Item = Axial> {
     })
 }
 
+/// Outward normals of the half-sized hexagon's edges (at 30° + 60° i).
+const EDGE_NORMALS: [(f64, f64); 6] = [
+    (0.866_025_403_784_438_6, 0.5),
+    (0.0, 1.0),
+    (-0.866_025_403_784_438_6, 0.5),
+    (-0.866_025_403_784_438_6, -0.5),
+    (0.0, -1.0),
+    (0.866_025_403_784_438_6, -0.5),
+];
+
 /// Whether `p` lies in the half-sized hexagon of the hexagon with centre `c`, circumradius `r`.
 fn in_half_hexagon(p: Vec2, c: Vec2, r: f64) -> bool {
     let q = p - c;
-    (0..6).all(|i| {
-        let t = std::f64::consts::FRAC_PI_6 + std::f64::consts::FRAC_PI_3 * i as f64;
-        q.x * t.cos() + q.y * t.sin() <= 0.25 * SQRT3 * r
-    })
+    EDGE_NORMALS
+        .iter()
+        .all(|&(nx, ny)| q.x * nx + q.y * ny <= 0.25 * SQRT3 * r)
 }
 
-/// The result of one classification pass.
-struct Pass {
-    split: Vec<(u32, Axial)>,
-    present: Vec<(u32, Axial)>,
-    moved: FxHashMap<Key, Vec2>,
+/// What section 5.1 (and our ring rules) make of an occupied hexagon.
+#[derive(Debug, Clone, Copy)]
+enum Occupied {
+    /// Split (ring conflict, boundary ring or a finer 2-ring hexagon).
+    Split,
+    /// Its 2-ring has coarser cells, made present this pass (they are marked already).
+    Rough,
+    /// OCCUPIED_1 or OCCUPIED_2 with its rings: `shift` moves its 1-ring (zero for an
+    /// OCCUPIED_1); `verify` is the largest distance to a point whose ring conflict was waived
+    /// (0 if none), whose triangles around the 1-ring must be checked.
+    Rings {
+        occ2: bool,
+        shift: Vec2,
+        verify: f64,
+    },
 }
 
-/// Classifies the leaves (all of them, or those in `region`) and the occupied hexagons.
-fn classify(r: &Refinement, region: Option<&FxHashSet<(u32, Axial)>>) -> Pass {
-    let h = &r.hierarchy;
-    let f = &h.frame;
-    let mut occupied: FxHashMap<(u32, Axial), Vec2> = FxHashMap::default();
-    for (i, c) in r.cell_of.iter().enumerate() {
-        if let Cell::Full(k, x) = *c {
-            occupied.insert((k, x), r.points[i]);
+/// How a leaf full hexagon's centre ends up (section 5.4), or that a rule splits it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Leaf {
+    Split,
+    Fixed,
+    Moved(Vec2),
+}
+
+/// Hexagons as (level, centre).
+type Hexes = Vec<(u32, Axial)>;
+
+/// The hexagons a pass marks for splitting and those it makes present, sorted.
+type Marks = (Hexes, Hexes);
+
+/// One classification pass: the rules as pure functions of the current hierarchy, evaluated
+/// only where asked, with the occupied hexagons' verdicts memoised for the pass. A rule fires
+/// the same way whichever subset of hexagons a pass visits, so an incremental pass marks only
+/// what a full pass would mark too.
+struct Pass<'a> {
+    r: &'a Refinement,
+    occupied: FxHashMap<(u32, Axial), Occupied>,
+    /// In a full pass, once every occupied hexagon is analysed: the ring hexagons, with the
+    /// shift of a moved 1-ring (so a leaf asks one map instead of its 18 neighbours).
+    rings: Option<FxHashMap<(u32, Axial), Option<Vec2>>>,
+    split: FxHashSet<(u32, Axial)>,
+    present: FxHashSet<(u32, Axial)>,
+}
+
+impl<'a> Pass<'a> {
+    fn new(r: &'a Refinement) -> Self {
+        Pass {
+            r,
+            occupied: FxHashMap::default(),
+            rings: None,
+            split: FxHashSet::default(),
+            present: FxHashSet::default(),
         }
     }
-    let mut split: FxHashSet<(u32, Axial)> = FxHashSet::default();
-    let mut present: FxHashSet<(u32, Axial)> = FxHashSet::default();
-    // Ring memberships: 1-ring of an OCCUPIED_1 / OCCUPIED_2 (with its shift), 2-ring of an
-    // OCCUPIED_2.
-    let mut ring1_fixed: FxHashSet<(u32, Axial)> = FxHashSet::default();
-    let mut ring1_moved: FxHashMap<(u32, Axial), Vec2> = FxHashMap::default();
-    let mut ring2: FxHashSet<(u32, Axial)> = FxHashSet::default();
-    let mut verify: Vec<(u32, Axial, f64)> = Vec::new();
-    for (&(k, x), &p) in &occupied {
+
+    /// The verdict on the occupied hexagon `x` at level `k` (None if unoccupied); marks its
+    /// splits and presences the first time it is asked.
+    fn occupied(&mut self, k: u32, x: Axial) -> Option<Occupied> {
+        if let Some(&o) = self.occupied.get(&(k, x)) {
+            return Some(o);
+        }
+        let p = self.r.point_in(k, x)?;
+        let o = self.analyse(k, x, p);
+        self.occupied.insert((k, x), o);
+        Some(o)
+    }
+
+    fn analyse(&mut self, k: u32, x: Axial, p: Vec2) -> Occupied {
+        let h = &self.r.hierarchy;
+        let f = &h.frame;
         let c = f.position(k, x);
         let rad = f.radius(k);
         let occ2 = !in_half_hexagon(p, c, rad);
@@ -136,178 +209,230 @@ fn classify(r: &Refinement, region: Option<&FxHashSet<(u32, Axial)>>) -> Pass {
         // ring hexagon twice: split. Two steps apart with one OCCUPIED_2 (a fixed ring hexagon
         // of the other is moved), or three steps apart with both OCCUPIED_2 (a moved 1-ring
         // hexagon lies in the other's fixed 2-ring): ours, kept when the triangles around the
-        // 1-ring still meet the bounds (checked below), else split. Splitting every such pair
-        // would put the points in cells too small for section 6.3's edge bound. Four steps
-        // apart the rings only share fixed 2-ring hexagons (the paper's Fig. 7).
-        let mut must_split = false;
+        // 1-ring still meet the bounds (checked in `verify`), else split. Splitting every such
+        // pair would put the points in cells too small for section 6.3's edge bound. Four
+        // steps apart the rings only share fixed 2-ring hexagons (the paper's Fig. 7).
+        let mut verify: f64 = 0.0;
         for dist in 2..=3 {
             for z in ring(x, dist) {
-                if let Some(&q) = occupied.get(&(k, z)) {
+                if let Some(q) = self.r.point_in(k, z) {
                     let other = !in_half_hexagon(q, f.position(k, z), rad);
                     match (dist, occ2, other) {
-                        (2, true, true) => must_split = true,
+                        (2, true, true) => {
+                            self.split.insert((k, x));
+                            return Occupied::Split;
+                        }
                         (2, true, false) | (2, false, true) | (3, true, true) => {
-                            verify.push((k, x, (p - q).norm()));
+                            verify = verify.max((p - q).norm());
                         }
                         _ => {}
                     }
                 }
             }
         }
-        if must_split {
-            split.insert((k, x));
-            continue;
-        }
         // Ours: an OCCUPIED_2's moved 1-ring must not touch Ω's boundary (tiling).
         if occ2 && ring(x, 1).any(|z| on_boundary(k, z)) {
-            split.insert((k, x));
-            continue;
+            self.split.insert((k, x));
+            return Occupied::Split;
         }
         // Ours: the 2-ring must be unsplit full hexagons of this level (rules 4 and 5 one ring
         // further out): a finer one splits the occupied hexagon, a coarser one is made present.
-        let mut rough = false;
+        let mut rough = None;
         for z in ring(x, 2) {
             if !in_domain(k, z) {
                 continue;
             }
             if !h.is_present(k, z) {
-                present.insert((k, z));
-                rough = true;
+                self.present.insert((k, z));
+                rough.get_or_insert(Occupied::Rough);
             } else if h.is_split(k, z) {
-                split.insert((k, x));
-                rough = true;
+                self.split.insert((k, x));
+                rough = Some(Occupied::Split);
             }
         }
-        if rough {
-            continue;
+        if let Some(o) = rough {
+            return o;
         }
-        if occ2 {
+        let shift = if occ2 {
             // Corner nearest to p: corners at 60° i.
             let q = p - c;
             let a = q.y.atan2(q.x);
             let i = (a / std::f64::consts::FRAC_PI_3).round() as i64;
             let t = std::f64::consts::FRAC_PI_3 * i as f64;
-            let shift = Vec2::new(t.cos(), t.sin()) * (0.5 * rad);
-            for z in ring(x, 1) {
-                ring1_moved.insert((k, z), shift);
-            }
-            for z in ring(x, 2) {
-                ring2.insert((k, z));
-            }
+            Vec2::new(t.cos(), t.sin()) * (0.5 * rad)
         } else {
-            for z in ring(x, 1) {
-                ring1_fixed.insert((k, z));
-            }
+            Vec2::zeros()
+        };
+        Occupied::Rings {
+            occ2,
+            shift,
+            verify,
         }
     }
-    // Fixed means: no fins, not occupied, not moved in a ring.
-    let fixed = |k: u32, v: Axial| -> bool {
+
+    /// The shift of `v` at level `k` if it lies in the moved 1-ring of an OCCUPIED_2.
+    fn ring1_moved(&mut self, k: u32, v: Axial) -> Option<Vec2> {
+        if let Some(rings) = &self.rings {
+            return rings.get(&(k, v)).copied().flatten();
+        }
+        for z in ring(v, 1) {
+            if let Some(Occupied::Rings {
+                occ2: true, shift, ..
+            }) = self.occupied(k, z)
+            {
+                return Some(shift);
+            }
+        }
+        None
+    }
+
+    /// Whether `v` at level `k` is occupied or in the 1-ring of an occupied hexagon or the
+    /// 2-ring of an OCCUPIED_2.
+    fn in_some_ring(&mut self, k: u32, v: Axial) -> bool {
+        if self.r.point_in(k, v).is_some() {
+            return true;
+        }
+        if let Some(rings) = &self.rings {
+            return rings.contains_key(&(k, v));
+        }
+        for dist in 1..=2 {
+            for z in ring(v, dist) {
+                if let Some(Occupied::Rings { occ2, .. }) = self.occupied(k, z)
+                    && (dist == 1 || occ2)
+                {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+
+    /// FIXED_CENTER_x: no fins, not occupied, not moved in a ring.
+    fn fixed(&mut self, k: u32, v: Axial) -> bool {
+        let h = &self.r.hierarchy;
         h.is_present(k, v)
             && !h.is_split(k, v)
             && fin_mask(h, k, v) == 0
-            && !occupied.contains_key(&(k, v))
-            && !ring1_moved.contains_key(&(k, v))
-    };
-    let mut moved: FxHashMap<Key, Vec2> = FxHashMap::default();
-    let mut visit = |k: u32, v: Axial| {
+            && self.r.point_in(k, v).is_none()
+            && self.ring1_moved(k, v).is_none()
+    }
+
+    /// Classifies the leaf full hexagon `v` at level `k` (5.1, 5.2, 5.4).
+    fn leaf(&mut self, k: u32, v: Axial) -> Leaf {
+        let h = &self.r.hierarchy;
+        let f = &h.frame;
         let mask = fin_mask(h, k, v);
         if mask == 0 {
-            if let Some(s) = ring1_moved.get(&(k, v)) {
-                moved.insert(pack(k, v), f.position(k, v) + s);
-            }
-            return;
+            return match self.ring1_moved(k, v) {
+                Some(s) => Leaf::Moved(f.position(k, v) + s),
+                None => Leaf::Fixed,
+            };
         }
         let Some((j, n)) = consecutive(mask) else {
-            split.insert((k, v)); // SUBDIVIDE (and, here, MOVED_CENTER_3).
-            return;
+            return Leaf::Split; // SUBDIVIDE (and, here, MOVED_CENTER_3).
         };
-        if ring1_fixed.contains(&(k, v))
-            || ring1_moved.contains_key(&(k, v))
-            || ring2.contains(&(k, v))
-            || occupied.contains_key(&(k, v))
-        {
-            split.insert((k, v));
-            return;
+        // A boundary centre may only slide along Ω's edge: one fin, towards a boundary
+        // neighbour. Ω's corners stay put (the triangles must tile Ω).
+        let corner = v.0 == 0 || v.1 == 0 || v.0 + v.1 == 0;
+        if on_boundary(k, v) && (corner || !(n == 1 && on_boundary(k, add(v, DIRS[j])))) {
+            return Leaf::Split;
         }
-        for d in DIRS {
-            let y = add(v, d);
-            if h.is_present(k, y) && !h.is_split(k, y) {
-                let my = fin_mask(h, k, y);
-                let adjacent_fins =
-                    mask | (mask << 1) | (mask >> 1) | ((mask & 1) << 5) | ((mask >> 5) & 1);
-                if my != 0 && my & adjacent_fins == 0 {
-                    split.insert((k, v));
-                    return;
-                }
-            }
+        // The checks below are independent; the cheapest run first.
+        if self.in_some_ring(k, v) {
+            return Leaf::Split;
         }
         let c2 = (2 * v.0, 2 * v.1);
         let a = add(c2, add(DIRS[j], DIRS[j])); // centre of the fin's far full hexagon
         let (target, w) = if n == 1 {
-            if !fixed(k + 1, a) {
-                split.insert((k, v));
-                return;
+            if !self.fixed(k + 1, a) {
+                return Leaf::Split;
             }
             (f.position(k + 1, a), 1.0 / 6.0)
         } else {
             let j1 = (j + 1) % 6;
             let b = add(c2, add(DIRS[j1], DIRS[j1]));
             let ab = add(c2, add(DIRS[j], DIRS[j1]));
-            if !fixed(k + 1, a) || !fixed(k + 1, b) || !fixed(k + 1, ab) {
-                split.insert((k, v));
-                return;
+            if !self.fixed(k + 1, a) || !self.fixed(k + 1, b) || !self.fixed(k + 1, ab) {
+                return Leaf::Split;
             }
             (f.position(k + 1, ab), 0.4)
         };
-        let c = f.position(k, v);
-        // A boundary centre may only slide along Ω's edge: one fin, towards a boundary
-        // neighbour.
-        // Ω's corners stay put (the triangles must tile Ω).
-        let corner = v.0 == 0 || v.1 == 0 || v.0 + v.1 == 0;
-        if on_boundary(k, v) && (corner || !(n == 1 && on_boundary(k, add(v, DIRS[j])))) {
-            split.insert((k, v));
-            return;
-        }
-        moved.insert(pack(k, v), c + (target - c) * w);
-    };
-    match region {
-        None => for_each_leaf(h, &mut visit),
-        Some(set) => {
-            // The fans checked below need the relocations of the occupied hexagons' 2-rings.
-            let extra = verify
-                .iter()
-                .flat_map(|&(k, x, _)| disc(x, 2).map(move |z| (k, z)));
-            let mut seen: FxHashSet<(u32, Axial)> = FxHashSet::default();
-            for (k, v) in set.iter().copied().chain(extra) {
-                if h.is_present(k, v) && !h.is_split(k, v) && seen.insert((k, v)) {
-                    visit(k, v);
+        // Ours: opposite-facing fin strips. The neighbours' fins come from the split states of
+        // the 2-ring, each asked once (the ring's hexagons are shared by two neighbours).
+        let adjacent_fins =
+            mask | (mask << 1) | (mask >> 1) | ((mask & 1) << 5) | ((mask >> 5) & 1);
+        let ring2: [bool; 12] = {
+            let mut it = ring(v, 2);
+            std::array::from_fn(|_| h.is_split(k, it.next().expect("12 hexagons")))
+        };
+        for (i, d) in DIRS.iter().enumerate() {
+            let y = add(v, *d);
+            if mask & (1 << i) != 0 || !h.is_present(k, y) {
+                continue;
+            }
+            // Neighbours of y: v (unsplit), y + d_i = ring-2 corner 2i, its two ring-1 sides
+            // v + d_{i±1}, and the ring-2 hexagons 2i ± 1 between them.
+            let split_at = |j: usize| -> bool {
+                let e = DIRS[j];
+                let z = add(y, e);
+                let dz = (z.0 - v.0, z.1 - v.1);
+                if dz == (0, 0) {
+                    return false;
                 }
+                if let Some(m) = DIRS.iter().position(|&q| q == dz) {
+                    return mask & (1 << m) != 0;
+                }
+                ring2[ring2_index(dz)]
+            };
+            let my = (0..6).fold(0u8, |m, j| m | (u8::from(split_at(j)) << j));
+            if my != 0 && my & adjacent_fins == 0 {
+                return Leaf::Split;
             }
         }
+        let c = f.position(k, v);
+        Leaf::Moved(c + (target - c) * w)
     }
-    // The waived ring conflicts: every triangle around the 1-ring of such an occupied hexagon
-    // (all lattice triangles of its level, by the 2-ring rule) must keep its angles in
-    // [α, 90°] and its edges at least section 6.3's d·√7/(12√3) for the pair's distance d.
-    let at = |k: u32, v: Axial| -> Vec2 {
-        if let Some(&p) = occupied.get(&(k, v)) {
-            p
-        } else {
-            moved
-                .get(&pack(k, v))
-                .copied()
-                .unwrap_or_else(|| f.position(k, v))
+
+    /// Visits the leaf `v` at level `k`: marks it when a rule splits it. Without `position`,
+    /// a leaf without fins (which no rule splits) is not looked at further.
+    fn visit(&mut self, k: u32, v: Axial, position: bool) -> Leaf {
+        if !position && fin_mask(&self.r.hierarchy, k, v) == 0 {
+            return Leaf::Fixed;
         }
-    };
-    let cos_lo = (ANGLE_MIN - 1e-9).to_radians().cos();
-    for &(k, x, dist) in &verify {
-        if split.contains(&(k, x)) {
-            continue;
+        let l = self.leaf(k, v);
+        if l == Leaf::Split {
+            self.split.insert((k, v));
         }
-        // Section 6.3's bound for the pair.
+        l
+    }
+
+    /// Our waived ring conflicts: every triangle around the 1-ring of the occupied hexagon `x`
+    /// (all lattice triangles of its level, by the 2-ring rule) must keep its angles in
+    /// [α, 90°] and its edges at least section 6.3's d·√7/(12√3) for the pair's distance d,
+    /// else `x` is split.
+    fn verify(&mut self, k: u32, x: Axial, dist: f64) {
+        if self.split.contains(&(k, x)) {
+            return;
+        }
+        // Exact relocations: the ring roles asked one by one, not from a partial ring map.
+        let rings = self.rings.take();
+        let mut pos: FxHashMap<Axial, Vec2> = FxHashMap::default();
+        for z in disc(x, 2) {
+            let p = match self.r.point_in(k, z) {
+                Some(p) => p,
+                None => match self.leaf(k, z) {
+                    Leaf::Moved(p) => p,
+                    _ => self.r.hierarchy.frame.position(k, z),
+                },
+            };
+            pos.insert(z, p);
+        }
+        self.rings = rings;
+        let cos_lo = (ANGLE_MIN - 1e-9).to_radians().cos();
         let min_edge = dist * 7f64.sqrt() / (12.0 * SQRT3) * (1.0 + 1e-9);
         let ok = ring(x, 1).all(|y| {
             (0..6).all(|i| {
-                let p = [y, add(y, DIRS[i]), add(y, DIRS[(i + 1) % 6])].map(|v| at(k, v));
+                let p = [y, add(y, DIRS[i]), add(y, DIRS[(i + 1) % 6])].map(|v| pos[&v]);
                 (0..3).all(|j| {
                     let (u, w) = (p[(j + 1) % 3] - p[j], p[(j + 2) % 3] - p[j]);
                     let c = u.dot(&w) / (u.norm() * w.norm());
@@ -316,27 +441,199 @@ fn classify(r: &Refinement, region: Option<&FxHashSet<(u32, Axial)>>) -> Pass {
             })
         });
         if !ok {
-            split.insert((k, x));
+            self.split.insert((k, x));
         }
     }
-    let mut split: Vec<_> = split.into_iter().collect();
-    split.sort_unstable();
-    let mut present: Vec<_> = present.into_iter().collect();
-    present.sort_unstable();
-    Pass {
-        split,
-        present,
-        moved,
+
+    /// Runs the occupied hexagon's own rules (marks, and the check of a waived conflict).
+    fn visit_occupied(&mut self, k: u32, x: Axial) {
+        if let Some(Occupied::Rings { verify, .. }) = self.occupied(k, x)
+            && verify > 0.0
+        {
+            self.verify(k, x, verify);
+        }
+    }
+
+    /// From now on, ring roles come from the occupied hexagons analysed so far (all of them in
+    /// a full pass; in an incremental pass those near the changes, so a role may be missed:
+    /// that only keeps a leaf from being marked, which a later pass catches).
+    fn freeze_rings(&mut self) {
+        let mut rings: FxHashMap<(u32, Axial), Option<Vec2>> = FxHashMap::default();
+        for (&(k, x), o) in &self.occupied {
+            if let Occupied::Rings { occ2, shift, .. } = *o {
+                for z in ring(x, 1) {
+                    // A moved 1-ring's shift wins over a fixed ring membership.
+                    let e = rings.entry((k, z)).or_insert(None);
+                    if occ2 {
+                        *e = Some(shift);
+                    }
+                }
+                if occ2 {
+                    for z in ring(x, 2) {
+                        rings.entry((k, z)).or_insert(None);
+                    }
+                }
+            }
+        }
+        self.rings = Some(rings);
+    }
+
+    /// The marks, sorted (deterministic order of the splits).
+    fn marks(self) -> Marks {
+        let mut split: Vec<_> = self.split.into_iter().collect();
+        split.sort_unstable();
+        let mut present: Vec<_> = self.present.into_iter().collect();
+        present.sort_unstable();
+        (split, present)
     }
 }
 
-/// Which leaves the next extended pass must classify: after splits, only those near them
-/// (the work-queue design of the simple refinement, one pass per wave of splits); otherwise
-/// all of them. A run ends only after a full pass finds nothing, so the result is the same
-/// fixed point a sequence of full passes reaches, at O(changes) cost per incremental pass.
+/// A full pass: every occupied hexagon and every leaf. Returns the marks and the relocated
+/// centres.
+fn full_pass(r: &Refinement) -> (Marks, FxHashMap<Key, Vec2>) {
+    let mut pass = Pass::new(r);
+    for c in &r.cell_of {
+        if let Cell::Full(k, x) = *c {
+            pass.visit_occupied(k, x);
+        }
+    }
+    pass.freeze_rings();
+    let mut moved: FxHashMap<Key, Vec2> = FxHashMap::default();
+    for_each_leaf(&r.hierarchy, |k, v| {
+        if let Leaf::Moved(p) = pass.visit(k, v, true) {
+            moved.insert(pack(k, v), p);
+        }
+    });
+    (pass.marks(), moved)
+}
+
+/// Side of the square blocks of lattice coordinates (as a shift) that index the occupied
+/// hexagons of a level, to find those near a change without scanning all points.
+const BLOCK: u32 = 3;
+
+/// The occupied hexagons per level and block of lattice coordinates. Entries go stale when a
+/// point leaves its cell (dropped on use); new ones are added for the children of every split.
+#[derive(Debug, Clone, Default)]
+struct OccupiedIndex {
+    blocks: FxHashMap<(u32, Axial), Vec<Axial>>,
+}
+
+impl OccupiedIndex {
+    fn rebuild(&mut self, r: &Refinement) {
+        self.blocks.clear();
+        for c in &r.cell_of {
+            if let Cell::Full(k, x) = *c {
+                self.add(k, x);
+            }
+        }
+    }
+
+    fn add(&mut self, k: u32, x: Axial) {
+        let b = self
+            .blocks
+            .entry((k, (x.0 >> BLOCK, x.1 >> BLOCK)))
+            .or_default();
+        if !b.contains(&x) {
+            b.push(x);
+        }
+    }
+
+    /// Records the occupied children of the split hexagon `x` at level `k`.
+    fn after_split(&mut self, r: &Refinement, k: u32, x: Axial) {
+        for z in disc((2 * x.0, 2 * x.1), 1) {
+            if r.point_in(k + 1, z).is_some() {
+                self.add(k + 1, z);
+            }
+        }
+    }
+
+    /// Calls `f` for every occupied hexagon of level `k` within hexagonal distance `rad` of
+    /// `c` (dropping stale entries on the way).
+    fn near(&mut self, r: &Refinement, k: u32, c: Axial, rad: i64, mut f: impl FnMut(Axial)) {
+        for bx in (c.0 - rad) >> BLOCK..=(c.0 + rad) >> BLOCK {
+            for by in (c.1 - rad) >> BLOCK..=(c.1 + rad) >> BLOCK {
+                let Some(b) = self.blocks.get_mut(&(k, (bx, by))) else {
+                    continue;
+                };
+                b.retain(|&x| r.point_in(k, x).is_some());
+                for &x in b.iter() {
+                    if hex_norm((x.0 - c.0, x.1 - c.1)) <= rad {
+                        f(x);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// What an incremental pass visits after the splits `changes`.
+///
+/// Leaves: only a leaf with fins can be marked, so a split of `(k, x)` matters to the leaves
+/// of level `k` within two steps (their fins, or a neighbour's fins for the opposite-strip
+/// rule), the new leaves of level `k + 1` and those near them (three steps from `2x`: their
+/// neighbours' presence and the rings of points that moved in; with two, the final full pass
+/// still found splits), and the leaves of level `k - 1` whose fin-side hexagons include `x` or
+/// its neighbours (two steps from `x / 2`).
+///
+/// Occupied hexagons: their rules read the occupancy within three steps, the 2-ring and, for
+/// a waived ring conflict, the relocations of the 2-ring (fins one step further, fin-side
+/// hexagons one level finer); the leaves read their rings. Those within eight steps at levels
+/// `k` and `k + 1` (from `2x`) and six at level `k - 1` are re-run and give the ring roles.
+fn affected(r: &Refinement, index: &mut OccupiedIndex, changes: &[(u32, Axial)]) -> (Hexes, Hexes) {
+    let mut leaves: FxHashSet<(u32, Axial)> = FxHashSet::default();
+    leaves.reserve(changes.len() * 24);
+    let mut occupied: FxHashSet<(u32, Axial)> = FxHashSet::default();
+    for &(k, x) in changes {
+        index.after_split(r, k, x);
+    }
+    for &(k, x) in changes {
+        let c = (2 * x.0, 2 * x.1);
+        leaves.extend(disc(x, 2).map(|z| (k, z)));
+        leaves.extend(disc(c, 3).map(|z| (k + 1, z)));
+        if k >= 1 {
+            let half = (x.0.div_euclid(2), x.1.div_euclid(2));
+            leaves.extend(disc(half, 2).map(|z| (k - 1, z)));
+            index.near(r, k - 1, half, 6, |o| {
+                occupied.insert((k - 1, o));
+            });
+        }
+        index.near(r, k, x, 8, |o| {
+            occupied.insert((k, o));
+        });
+        index.near(r, k + 1, c, 8, |o| {
+            occupied.insert((k + 1, o));
+        });
+    }
+    // The order of the visits does not matter (the rules read the state, not the marks).
+    (leaves.into_iter().collect(), occupied.into_iter().collect())
+}
+
+/// An incremental pass over the given leaves and occupied hexagons.
+fn region_pass(r: &Refinement, leaves: &[(u32, Axial)], occupied: &[(u32, Axial)]) -> Marks {
+    let h = &r.hierarchy;
+    let mut pass = Pass::new(r);
+    for &(k, x) in occupied {
+        pass.visit_occupied(k, x);
+    }
+    pass.freeze_rings();
+    for &(k, v) in leaves {
+        // Only a leaf with fins can be marked; the fins are the cheapest test.
+        if !h.is_split(k, v) && fin_mask(h, k, v) != 0 && h.is_present(k, v) {
+            pass.visit(k, v, true);
+        }
+    }
+    pass.marks()
+}
+
+/// The state between extended passes: the splits since the last pass (`None`: the next pass
+/// is a full one) and the index of occupied hexagons. After splits a pass classifies only the
+/// hexagons near them (a work queue of affected hexagons, one pass per wave of splits). A run
+/// ends only after a full pass finds nothing, so the result is a fixed point of the full
+/// rules, at O(changes) cost per incremental pass.
 #[derive(Debug, Clone, Default)]
 pub struct ExtendedState {
     changes: Option<Vec<(u32, Axial)>>,
+    index: OccupiedIndex,
 }
 
 impl ExtendedState {
@@ -358,21 +655,6 @@ fn disc(v: Axial, r: i64) -> impl Iterator<Item = Axial> {
     (-r..=r).flat_map(move |a| ((-r).max(-a - r)..=r.min(-a + r)).map(move |b| (v.0 + a, v.1 + b)))
 }
 
-/// Leaves whose classification a split of `(k, x)` may change: its level within two steps
-/// (fins, neighbours' fins, rings), the coarser level within three, the finer within four
-/// (new leaves and the fin-adjacent hexagons of 5.2's fourth rule).
-fn candidates(changes: &[(u32, Axial)]) -> FxHashSet<(u32, Axial)> {
-    let mut out = FxHashSet::default();
-    for &(k, x) in changes {
-        out.extend(disc(x, 2).map(|z| (k, z)));
-        if k >= 1 {
-            out.extend(disc((x.0.div_euclid(2), x.1.div_euclid(2)), 3).map(|z| (k - 1, z)));
-        }
-        out.extend(disc((2 * x.0, 2 * x.1), 4).map(|z| (k + 1, z)));
-    }
-    out
-}
-
 /// One extended step on a refinement whose simple rules are exhausted: classifies (near the
 /// last changes, or everywhere) and splits every hexagon an extended rule marks. Returns the
 /// splits made; empty once a full pass finds nothing.
@@ -381,14 +663,22 @@ pub fn extended_pass(
     state: &mut ExtendedState,
 ) -> Result<Vec<(u32, Axial)>, HexDelaunayError> {
     loop {
-        let region = state.changes.take().map(|c| candidates(&c));
-        let full = region.is_none();
-        let pass = classify(r, region.as_ref());
+        let full = state.changes.is_none();
+        let (split, present) = match state.changes.take() {
+            Some(changes) => {
+                let (leaves, occupied) = affected(r, &mut state.index, &changes);
+                region_pass(r, &leaves, &occupied)
+            }
+            None => {
+                state.index.rebuild(r);
+                full_pass(r).0
+            }
+        };
         let mut made = Vec::new();
-        for (k, x) in pass.split {
+        for (k, x) in split {
             made.extend(r.split_now(k, x)?);
         }
-        for (k, x) in pass.present {
+        for (k, x) in present {
             made.extend(r.make_present(k, x)?);
         }
         if !made.is_empty() {
@@ -406,5 +696,5 @@ pub const ANGLE_MIN: f64 = 43.897_886_248_013_99;
 
 /// The relocated centres (section 5.4) of the finished extended refinement.
 pub fn relocated_centres(r: &Refinement) -> FxHashMap<Key, Vec2> {
-    classify(r, None).moved
+    full_pass(r).1
 }

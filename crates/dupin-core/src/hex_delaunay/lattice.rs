@@ -55,14 +55,15 @@ pub fn is_even(v: Axial) -> bool {
 /// For a point `v` that is not even: the two level-`k-1` centres whose midpoint it is.
 #[inline]
 pub fn parents_of_midpoint(v: Axial) -> (Axial, Axial) {
-    for d in DIRS {
-        let w = (v.0 - d.0, v.1 - d.1);
-        if is_even(w) {
-            let a = (w.0 >> 1, w.1 >> 1);
-            return (a, (a.0 + d.0, a.1 + d.1));
-        }
-    }
-    unreachable!("every non-even axial point is a midpoint of two lattice neighbours")
+    // The first direction `d` of DIRS with `v - d` even, by the parities of `v`: (1, 0),
+    // (0, 1) or (-1, 1).
+    let d = match (v.0 & 1, v.1 & 1) {
+        (1, 0) => DIRS[0],
+        (0, 1) => DIRS[1],
+        _ => DIRS[2],
+    };
+    let a = ((v.0 - d.0) >> 1, (v.1 - d.1) >> 1);
+    (a, (a.0 + d.0, a.1 + d.1))
 }
 
 /// Adds two axial vectors.
@@ -155,6 +156,13 @@ mod tests {
                     let (p, q) = parents_of_midpoint(v);
                     assert_eq!(add(p, q), v);
                     assert!(DIRS.contains(&(q.0 - p.0, q.1 - p.1)));
+                    // The first parent is the one reached through the first direction of
+                    // DIRS (leaf enumeration counts a joined hexagon from that parent).
+                    let d = DIRS
+                        .into_iter()
+                        .find(|d| is_even((v.0 - d.0, v.1 - d.1)))
+                        .unwrap();
+                    assert_eq!(p, ((v.0 - d.0) / 2, (v.1 - d.1) / 2));
                 }
             }
         }

@@ -104,6 +104,14 @@ impl Refinement {
         self.occupants.get(c).map_or(0, Vec::len)
     }
 
+    /// The last point located in the full hexagon `x` at level `k`, if any (one hash look-up;
+    /// once the simple rules are done every occupied cell holds exactly one point).
+    #[inline]
+    pub fn point_in(&self, k: u32, x: Axial) -> Option<Vec2> {
+        let i = *self.occupants.get(&Cell::Full(k, x))?.last()?;
+        Some(self.points[i as usize])
+    }
+
     fn check(&self, i: u32) -> Option<Action> {
         let h = &self.hierarchy;
         match self.cell_of[i as usize] {
