@@ -52,6 +52,7 @@ mod support_structure;
 mod surface;
 mod tangent_duality;
 mod triangle_star;
+mod vertex_pick;
 
 pub use circular::{circular_residual, quad_circularity};
 pub use conical::{
@@ -111,6 +112,7 @@ pub use solver::{
 };
 pub use subdivision::{catmull_clark, chaikin, doo_sabin, lane_riesenfeld_cubic};
 pub use support_structure::support_structure;
+pub use vertex_pick::{VertexPick, VertexStarError, pick_vertex, vertex_ring};
 pub use surface::{
     BSplinePatch, BSplinePatchError, Catenoid, ClosestPoint, ClosestPointError, Cylinder, Domain,
     DupinCyclide, Ellipsoid, Enneper, FundamentalForms, HyperbolicParaboloid, Hyperboloid,

@@ -287,6 +287,13 @@ impl Session {
     /// Advances one observable step (a triangulation layer, the dual mesh, one Gauss-Newton
     /// iteration; a whole PQ scene) and returns the metrics.
     pub fn step(&mut self) -> Result<JsValue, JsError> {
+        self.advance()?;
+        self.metrics()
+    }
+
+    /// [`Session::step`] without building the metrics (the worker times the solver and the
+    /// metrics separately, then calls `metrics()`).
+    pub fn advance(&mut self) -> Result<(), JsError> {
         match &mut self.run {
             Run::Phex(p) => {
                 if !p.done() {
@@ -305,7 +312,7 @@ impl Session {
                 }
             }
         }
-        self.metrics()
+        Ok(())
     }
 
     /// True once the run has finished.
@@ -411,6 +418,29 @@ impl Session {
             1.0
         };
         Ok(panel_schedule_svg(&sched, scale))
+    }
+
+    /// The P-Hex triangulation vertex under a click: `origin` and `direction` (3 numbers each)
+    /// are the view ray (`Viewer.pickRay`). Returns `null` when the ray misses the triangles on
+    /// screen, else `{ vertex, uv, point, normal, k1, k2, dir1, dir2, neighbours, ring,
+    /// message }`: the surface point, its principal frame and the six ring neighbours (indices
+    /// and positions, counter-clockwise), or `message` saying why there is no complete star.
+    /// Throws for a PQ scene (no triangulation) or a malformed ray.
+    #[wasm_bindgen(js_name = pickVertex)]
+    pub fn pick_vertex(&self, origin: Vec<f64>, direction: Vec<f64>) -> Result<JsValue, JsError> {
+        let Run::Phex(p) = &self.run else {
+            return Err(JsError::new(
+                "vertex picking needs a P-Hex run: PQ scenes have no triangulation",
+            ));
+        };
+        if origin.len() != 3 || direction.len() != 3 {
+            return Err(JsError::new("a ray needs 3 origin and 3 direction numbers"));
+        }
+        let v = |a: &[f64]| dupin_core::Vec3::new(a[0], a[1], a[2]);
+        match crate::pick::pick_star(p, v(&origin), v(&direction)) {
+            Some(pick) => to_js(&pick),
+            None => Ok(JsValue::NULL),
+        }
     }
 
     /// The current mesh for the viewer: flat panels coloured by `mode` (`planarity`: blue
