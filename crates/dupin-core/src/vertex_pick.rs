@@ -186,7 +186,8 @@ pub fn vertex_ring(
         if q == start {
             break;
         }
-        if ring.len() >= n {
+        // An open fan of n triangles has n + 1 ring vertices, a closed one n.
+        if ring.len() > n {
             return Err(VertexStarError::NonManifold { vertex });
         }
         ring.push(q);
@@ -264,6 +265,12 @@ mod tests {
         assert!(matches!(
             vertex_ring(pos.len(), &fewer, 12),
             Err(VertexStarError::Boundary { triangles: 5, .. })
+        ));
+        // An open fan listed from its middle (a base-curve vertex after one layer).
+        let open = [[0, 1, 34], [33, 0, 67], [67, 0, 34]];
+        assert!(matches!(
+            vertex_ring(68, &open, 0),
+            Err(VertexStarError::Boundary { triangles: 3, .. })
         ));
         // A closed fan of four triangles (an octahedron's apex).
         let oct = [[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]];
