@@ -112,7 +112,6 @@ pub use solver::{
 };
 pub use subdivision::{catmull_clark, chaikin, doo_sabin, lane_riesenfeld_cubic};
 pub use support_structure::support_structure;
-pub use vertex_pick::{VertexPick, VertexStarError, pick_vertex, vertex_ring};
 pub use surface::{
     BSplinePatch, BSplinePatchError, Catenoid, ClosestPoint, ClosestPointError, Cylinder, Domain,
     DupinCyclide, Ellipsoid, Enneper, FundamentalForms, HyperbolicParaboloid, Hyperboloid,
@@ -122,3 +121,4 @@ pub use surface::{
 };
 pub use tangent_duality::{TangentDualPoint, TangentDualityError, tangent_dual_point};
 pub use triangle_star::{DupinHexagon, TriangleStar, TriangleStarError};
+pub use vertex_pick::{VertexPick, VertexStarError, pick_vertex, vertex_ring};

@@ -94,7 +94,9 @@ pub fn pick_vertex(
             .min_by(|&i, &j| {
                 let pi = positions[tri[i] as usize];
                 let pj = positions[tri[j] as usize];
-                (pi - hit).norm_squared().total_cmp(&(pj - hit).norm_squared())
+                (pi - hit)
+                    .norm_squared()
+                    .total_cmp(&(pj - hit).norm_squared())
             })
             .unwrap_or(0);
         best = Some(VertexPick {
@@ -196,10 +198,11 @@ pub fn vertex_ring(
     if ring.len() != n {
         return Err(VertexStarError::NonManifold { vertex });
     }
-    ring.try_into().map_err(|r: Vec<u32>| VertexStarError::Valence {
-        vertex,
-        valence: r.len(),
-    })
+    ring.try_into()
+        .map_err(|r: Vec<u32>| VertexStarError::Valence {
+            vertex,
+            valence: r.len(),
+        })
 }
 
 #[cfg(test)]
@@ -214,7 +217,11 @@ mod tests {
         let mut pos = Vec::new();
         for j in 0..n {
             for i in 0..n {
-                pos.push(Vec3::new(i as f64 + 0.5 * j as f64, j as f64 * 0.75f64.sqrt(), 0.0));
+                pos.push(Vec3::new(
+                    i as f64 + 0.5 * j as f64,
+                    j as f64 * 0.75f64.sqrt(),
+                    0.0,
+                ));
             }
         }
         let id = |i: u32, j: u32| j * n + i;
@@ -240,7 +247,10 @@ mod tests {
         for k in 0..6 {
             let a = pos[ring[k] as usize] - pos[v];
             let b = pos[ring[(k + 1) % 6] as usize] - pos[v];
-            assert!(a.cross(&b).z > 0.0, "ring {ring:?} not counter-clockwise at {k}");
+            assert!(
+                a.cross(&b).z > 0.0,
+                "ring {ring:?} not counter-clockwise at {k}"
+            );
         }
     }
 
@@ -328,9 +338,21 @@ mod tests {
         let mut t2 = tris.clone();
         t2.extend(tris.iter().map(|t| t.map(|i| i + n)));
         let target = pos[5];
-        let up = pick_vertex(&all, &t2, target + Vec3::new(0.0, 0.0, 5.0), Vec3::new(0.0, 0.0, -1.0)).unwrap();
+        let up = pick_vertex(
+            &all,
+            &t2,
+            target + Vec3::new(0.0, 0.0, 5.0),
+            Vec3::new(0.0, 0.0, -1.0),
+        )
+        .unwrap();
         assert_eq!(up.vertex, 5 + n as usize);
-        let down = pick_vertex(&all, &t2, target - Vec3::new(0.0, 0.0, 5.0), Vec3::new(0.0, 0.0, 1.0)).unwrap();
+        let down = pick_vertex(
+            &all,
+            &t2,
+            target - Vec3::new(0.0, 0.0, 5.0),
+            Vec3::new(0.0, 0.0, 1.0),
+        )
+        .unwrap();
         assert_eq!(down.vertex, 5);
     }
 }

@@ -140,7 +140,10 @@ pub(crate) fn star_of(p: &PhexPipeline, triangles: &[[u32; 3]], v: usize) -> Sta
     match vertex_ring(tri.positions.len(), triangles, v) {
         Ok(ring) => {
             out.neighbours = ring.to_vec();
-            out.ring = ring.iter().map(|&i| a3(tri.positions[i as usize])).collect();
+            out.ring = ring
+                .iter()
+                .map(|&i| a3(tri.positions[i as usize]))
+                .collect();
         }
         Err(e) => out.message = Some(format!("{e}; click an interior vertex")),
     }
@@ -172,12 +175,7 @@ mod tests {
     /// inline message instead of a star.
     #[test]
     fn a_click_on_a_projected_vertex_picks_it_and_its_star() {
-        let cfg = PhexConfig::for_surface(
-            "torus",
-            &[],
-            TriangulationMethod::Prescribed,
-            Some(0.5),
-        );
+        let cfg = PhexConfig::for_surface("torus", &[], TriangulationMethod::Prescribed, Some(0.5));
         let mut p = PhexPipeline::new(cfg).unwrap();
         while !p.done() {
             p.step().unwrap();
@@ -221,12 +219,7 @@ mod tests {
 
     #[test]
     fn boundary_vertices_get_a_message() {
-        let cfg = PhexConfig::for_surface(
-            "torus",
-            &[],
-            TriangulationMethod::Prescribed,
-            Some(0.5),
-        );
+        let cfg = PhexConfig::for_surface("torus", &[], TriangulationMethod::Prescribed, Some(0.5));
         let mut p = PhexPipeline::new(cfg).unwrap();
         p.step().unwrap();
         p.step().unwrap();

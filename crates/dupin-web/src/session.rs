@@ -640,12 +640,8 @@ mod tests {
                 .unwrap_or(0.0)
                 * 1e-9
         };
-        let mut cfg = PhexConfig::for_surface(
-            "torus",
-            &[],
-            TriangulationMethod::Prescribed,
-            Some(0.155),
-        );
+        let mut cfg =
+            PhexConfig::for_surface("torus", &[], TriangulationMethod::Prescribed, Some(0.155));
         cfg.initialisation = Initialisation::DupinDuality;
         let p = PhexPipeline::new(cfg.clone()).unwrap();
         let mut d = dual_mesh_options(
@@ -700,12 +696,8 @@ mod tests {
     /// the planarity colours always match a fresh computation on the current mesh.
     #[test]
     fn cached_face_planarity_follows_every_step() {
-        let mut cfg = PhexConfig::for_surface(
-            "torus",
-            &[],
-            TriangulationMethod::Prescribed,
-            Some(0.6),
-        );
+        let mut cfg =
+            PhexConfig::for_surface("torus", &[], TriangulationMethod::Prescribed, Some(0.6));
         cfg.initialisation = Initialisation::DupinDuality;
         let mut session = Session {
             run: Run::Phex(Box::new(PhexPipeline::new(cfg).unwrap())),

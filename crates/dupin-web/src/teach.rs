@@ -323,7 +323,11 @@ impl DupinLesson {
             .unwrap_or_default();
         let mut st = LessonState {
             kind: kind.name(),
-            star: if self.ring.is_some() { "mesh" } else { "lattice" },
+            star: if self.ring.is_some() {
+                "mesh"
+            } else {
+                "lattice"
+            },
             k1: ind.k1(),
             k2: ind.k2(),
             extent: self.extent,
@@ -393,7 +397,8 @@ impl DupinLesson {
                     holds: inside,
                 },
                 Condition {
-                    text: "3) no conjugate pair of directions encloses the three edge directions".into(),
+                    text: "3) no conjugate pair of directions encloses the three edge directions"
+                        .into(),
                     holds: open,
                 },
             ];
@@ -488,7 +493,11 @@ impl DupinLesson {
         }
         st.reason = format!(
             "The projected star of a mesh vertex: six different triangles, so its validity is the definition: the Dupin hexagon joining their Dupin centers is {} (section 4.1). {lattice_valid} of 6 triangles would give a valid lattice star by Proposition {} (section 4.2).",
-            if simple { "simple" } else { "self-intersecting" },
+            if simple {
+                "simple"
+            } else {
+                "self-intersecting"
+            },
             if elliptic { 4 } else { 5 }
         );
     }
@@ -729,8 +738,7 @@ mod mesh_star_tests {
     /// A lattice star (a, b) lifted onto the osculating paraboloid z = Q(x)/2 at a torus point.
     fn lifted(c: &Curvature, ind: &DupinIndicatrix, a: Vec2, b: Vec2) -> [Vec3; 6] {
         let f = c.frame();
-        [a, b, b - a, -a, -b, a - b]
-            .map(|q| f.to_world(&q) + c.normal * (0.5 * ind.quadratic(&q)))
+        [a, b, b - a, -a, -b, a - b].map(|q| f.to_world(&q) + c.normal * (0.5 * ind.quadratic(&q)))
     }
 
     /// The projected star of a lifted lattice star is that lattice star, and its verdict (the
@@ -765,7 +773,11 @@ mod mesh_star_tests {
                 let verdict = if valid { "valid" } else { "invalid" };
                 assert_eq!(s.verdict, verdict, "a = {a:?}, b = {b:?}");
                 assert_eq!(s.conditions.len(), 7);
-                assert!(s.conditions.iter().all(|k| k.holds == valid), "{:?}", s.conditions);
+                assert!(
+                    s.conditions.iter().all(|k| k.holds == valid),
+                    "{:?}",
+                    s.conditions
+                );
                 seen.insert((s.kind, s.verdict));
             }
         }
@@ -791,7 +803,11 @@ mod mesh_star_tests {
         assert_eq!(after[2], [-0.09, 0.11]);
         // Onto the line through the centre and a neighbour: triangle 1 (or 2) is flat.
         assert!(l.drag(2, 2.0 * after[1][0], 2.0 * after[1][1]).is_err());
-        assert_eq!(l.lesson_state().ring, after, "a refused drag changes nothing");
+        assert_eq!(
+            l.lesson_state().ring,
+            after,
+            "a refused drag changes nothing"
+        );
         // A collapsed ring vertex is refused at construction.
         let mut flat = ring;
         flat[3] = c.point;

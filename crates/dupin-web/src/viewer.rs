@@ -104,7 +104,8 @@ impl Viewer {
     /// Normalised device coordinates and depth `[x, y, z]` of the 3D point (x, y, z) in the
     /// current view (to mark a picked vertex); `undefined` behind the eye.
     pub fn project(&self, x: f32, y: f32, z: f32) -> Option<Vec<f32>> {
-        crate::pick::project(&self.camera, self.aspect(), glam::Vec3::new(x, y, z)).map(|p| p.to_vec())
+        crate::pick::project(&self.camera, self.aspect(), glam::Vec3::new(x, y, z))
+            .map(|p| p.to_vec())
     }
 
     fn aspect(&self) -> f32 {
