@@ -12,7 +12,9 @@
 //! - [`Curvature`], [`PointType`], [`CurvatureTolerance`] (section 3);
 //! - [`DupinIndicatrix`], [`DupinConic`], conjugate and asymptotic directions (sections 3, 4.2);
 //! - [`dupin_center`], [`tangent_dual_point`], [`TriangleStar`] (section 4, Propositions 3-5);
-//! - [`ideal_triangle`] (section 5.1); [`is_simple_polygon`] (exact predicates).
+//! - [`ideal_triangle`] (section 5.1); [`is_simple_polygon`] (exact predicates);
+//! - [`pick_vertex`] and [`vertex_ring`]: the mesh vertex under a view ray and its triangle star
+//!   (section 4.1), for the page's teaching inset.
 //! ## P-Hex meshes (P-Hex paper, sections 5 to 7)
 //! - [`triangulate`] (methods 1 and 2 of section 5.2, parabolic rules of 5.3, [`bounded_ratio`]);
 //! - [`dual_mesh`] (section 6 initialisation, tangent duality), [`PlanarityOptimiser`]
