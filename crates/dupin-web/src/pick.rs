@@ -10,6 +10,8 @@ use serde::{Deserialize, Serialize};
 /// The ray through normalised device coordinates (`x`, `y` in [-1, 1], y up) of a viewport of
 /// aspect `aspect`: a point on the near plane and a unit direction into the scene. `None` for
 /// a singular camera or non-finite input.
+// Used by the wasm-only `Viewer` (and the tests).
+#[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
 pub(crate) fn view_ray(cam: &OrbitCamera, aspect: f32, x: f32, y: f32) -> Option<(G3, G3)> {
     let inv = cam.view_proj(aspect).inverse();
     let near = inv * Vec4::new(x, y, 0.0, 1.0);
@@ -23,12 +25,16 @@ pub(crate) fn view_ray(cam: &OrbitCamera, aspect: f32, x: f32, y: f32) -> Option
 }
 
 /// Normalised device coordinates and depth (0 near .. 1 far) of `p`; `None` behind the eye.
+// Used by the wasm-only `Viewer` (and the tests).
+#[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
 pub(crate) fn project(cam: &OrbitCamera, aspect: f32, p: G3) -> Option<[f32; 3]> {
     let c = cam.view_proj(aspect) * p.extend(1.0);
     (c.w > 0.0).then(|| [c.x / c.w, c.y / c.w, c.z / c.w])
 }
 
 /// The orbit camera of `Viewer::camera`'s six numbers (target, distance, yaw, pitch).
+// Used by the wasm-only `Viewer` (and the tests).
+#[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
 pub(crate) fn camera_from(v: &[f32]) -> Result<OrbitCamera, String> {
     if v.len() != 6 || !v.iter().all(|x| x.is_finite()) || v[3] <= 0.0 {
         return Err(
