@@ -1,8 +1,9 @@
 // The teaching inset (P-Hex paper sections 3-5.1): it opens, draws, and reacts to a drag of a star
-// vertex (its pixels and its Proposition 4 verdict change); the section 5.1 steps and bad input.
+// vertex (its pixels and its Proposition 4 verdict change); the section 5.1 steps and bad input;
+// a click on a mesh vertex in the 3D view opens it at that vertex's real star.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { SHOTS, byId, openPage, pixelStats } from './harness.mjs';
+import { SHOTS, byId, drag, exportText, openPage, pixelStats, waitSteps } from './harness.mjs';
 
 /** Screen position of a star handle (or the star centre for index -1). */
 async function handle(page, i) {
@@ -115,7 +116,6 @@ const picked = (page) => byId(page, 'teach-inset').getAttribute('data-picked-ver
 test('teach inset from a clicked 3D vertex: its real star, a boundary message, dragging still works', async () => {
   const { browser, page, errors } = await openPage({ hash: '#scene=free&surface=torus&method=prescribed&size=0.5' });
   try {
-    const { waitSteps, exportText } = await import('./harness.mjs');
     await waitSteps(page, 1);
     await byId(page, 'step').click();
     await waitSteps(page, 2);
@@ -187,7 +187,6 @@ test('teach inset from a clicked 3D vertex: its real star, a boundary message, d
     ring2.forEach((q, k) => assert.equal(q[0] === ring[k][0] && q[1] === ring[k][1], k !== 2, `vertex ${k} after dragging vertex 2`));
     // Orbiting the 3D view by a drag still works and does not pick.
     const cam0 = await page.evaluate(() => Array.from(window.dupin.viewer.camera()));
-    const { drag } = await import('./harness.mjs');
     await drag(page, 60, 0);
     const cam1 = await page.evaluate(() => Array.from(window.dupin.viewer.camera()));
     assert.notDeepEqual(cam1, cam0, 'the drag orbits');
