@@ -1,7 +1,7 @@
 // The page's side of web/worker.js: starts the worker and turns its messages into callbacks.
 // Every load gets a new generation number; replies for older loads are ignored.
 export class Solver {
-  constructor({ onState, onError, onExport }) {
+  constructor({ onState, onError, onExport, onPick }) {
     this.gen = 0;
     this.worker = new Worker(new URL('./worker.js', import.meta.url), { type: 'module' });
     this.ready = new Promise((resolve, reject) => {
@@ -19,6 +19,7 @@ export class Solver {
       if (m.type === 'state') onState(m);
       else if (m.type === 'error') onError(m);
       else if (m.type === 'export') onExport(m);
+      else if (m.type === 'pick') onPick?.(m);
     });
   }
 

@@ -1,5 +1,7 @@
 // Teaching inset: Dupin duality at one surface point (P-Hex paper, sections 3-5.1). All geometry
-// comes from wasm (`DupinLesson`); this file draws its primitives as SVG and forwards drags.
+// comes from wasm (`DupinLesson`); this file draws its primitives as SVG and forwards drags. The
+// lesson is either at a surface point (u, v) picked in the inset, or at a mesh vertex clicked in
+// the 3D view (`showPick`, fed by `Session.pickVertex` in the worker).
 import { DupinLesson, surfaceCatalog } from './pkg/dupin_web.js';
 
 const SVGNS = 'http://www.w3.org/2000/svg';
@@ -17,7 +19,8 @@ let lesson = null;
 let state = null;
 let steps = null;
 let stepIndex = -1;
-let panel, svg, layer, verdictEl, reasonEl, condEl, captionEl, errorEl, surfaceSel, uIn, vIn;
+let panel, svg, layer, verdictEl, reasonEl, condEl, captionEl, errorEl, surfaceSel, uIn, vIn, sourceEl, toggleBtn;
+let picked = null; // the mesh vertex the lesson is at (Session.pickVertex's answer), if any
 
 function polyline(flat, stroke, extra = {}) {
   const pts = [];
@@ -84,16 +87,20 @@ function draw() {
   verdictEl.textContent = state.verdict === 'undecided' ? `${state.kind} point: no verdict` : `${state.kind} point: star ${state.verdict}`;
   verdictEl.dataset.verdict = state.verdict;
   verdictEl.dataset.kind = state.kind;
+  svg.dataset.star = state.star;
+  svg.dataset.ring = JSON.stringify(state.ring);
   verdictEl.className = `teach-verdict ${state.verdict}`;
   reasonEl.textContent = state.reason;
   condEl.replaceChildren(...state.conditions.map((c) => el('li', { class: c.holds ? 'holds' : 'fails' }, `${c.holds ? '✓' : '✗'} ${c.text}`)));
   captionEl.textContent = steps && stepIndex >= 0
     ? `Step ${stepIndex + 1}/${steps.length}. ${steps[stepIndex].caption}`
-    : 'Tangent plane in the principal frame (x: k1, y: k2). Blue: the Dupin indicatrix (section 3); white: the projected triangle star; grey: each triangle\'s Dupin conic, yellow dots its Dupin center; green: the Dupin hexagon (section 4.1, Prop. 3). Drag a vertex: Props. 4 and 5 (section 4.2) decide validity; purple/yellow dashes: the dragged direction and its conjugate.';
+    : (picked ? `Mesh vertex ${picked.vertex}: its six neighbours projected onto the tangent plane (section 6). The Dupin indicatrix is drawn scaled to the star. ` : '')
+    + 'Tangent plane in the principal frame (x: k1, y: k2). Blue: the Dupin indicatrix (section 3); white: the projected triangle star; grey: each triangle\'s Dupin conic, yellow dots its Dupin center; green: the Dupin hexagon (section 4.1, Prop. 3). Drag a vertex: Props. 4 and 5 (section 4.2) decide validity; purple/yellow dashes: the dragged direction and its conjugate.';
 }
 
 function showError(e) {
   errorEl.textContent = e ? String(e.message ?? e) : '';
+  delete errorEl.dataset.pickedVertex;
 }
 
 // Redrawing replaces the handles, so the drag is tracked on the <svg> itself.
@@ -127,11 +134,59 @@ function load() {
     const next = new DupinLesson(spec.name, params, u, v);
     lesson?.free();
     lesson = next;
+    setPicked(null);
     state = lesson.state();
     steps = null; stepIndex = -1;
     showError(null);
   } catch (e) { showError(e); }
   draw();
+}
+
+function setPicked(pick) {
+  picked = pick;
+  if (pick) {
+    svg.dataset.pickedVertex = String(pick.vertex);
+    svg.dataset.pickedNeighbours = pick.neighbours.join(',');
+    sourceEl.textContent = `Mesh vertex ${pick.vertex} at (u, v) = (${pick.uv.map((x) => x.toFixed(3)).join(', ')}), k1 = ${pick.k1.toPrecision(3)}, k2 = ${pick.k2.toPrecision(3)}`;
+  } else {
+    delete svg.dataset.pickedVertex;
+    delete svg.dataset.pickedNeighbours;
+    sourceEl.textContent = 'Surface point (u, v) above, or click a vertex of the mesh.';
+  }
+}
+
+function open() {
+  panel.hidden = false;
+  toggleBtn.setAttribute('aria-pressed', 'true');
+}
+
+/**
+ * Opens the inset at a clicked mesh vertex: `pick` is `Session.pickVertex`'s answer (null when
+ * the click missed the mesh), `error` the worker's message. Returns the picked vertex (for the
+ * 3D marker) or null. A vertex without a complete star keeps the last lesson and shows why.
+ */
+export function showPick(pick, error) {
+  open();
+  if (error || !pick) {
+    showError(error ?? 'No mesh under the click: click a vertex of the P-Hex mesh.');
+    return null;
+  }
+  if (pick.message) {
+    showError(`Vertex ${pick.vertex}: ${pick.message}`);
+    errorEl.dataset.pickedVertex = String(pick.vertex);
+    return pick;
+  }
+  try {
+    const next = DupinLesson.fromStar(pick);
+    lesson?.free();
+    lesson = next;
+    state = lesson.state();
+    steps = null; stepIndex = -1;
+    setPicked(pick);
+    showError(null);
+  } catch (e) { showError(e); }
+  draw();
+  return pick;
 }
 
 let CATALOG = [];
@@ -159,15 +214,18 @@ export function initTeach() {
   condEl = el('ul', { class: 'teach-conditions' });
   captionEl = el('p', { class: 'teach-caption', 'data-testid': 'teach-caption' });
   errorEl = el('p', { class: 'field-error', 'data-testid': 'teach-error', role: 'alert' });
-  panel.append(controls, svg, verdictEl, reasonEl, condEl, captionEl, errorEl);
+  sourceEl = el('p', { class: 'teach-caption', 'data-testid': 'teach-source' });
+  panel.append(controls, sourceEl, svg, verdictEl, reasonEl, condEl, captionEl, errorEl);
   document.querySelector('main').append(panel);
-  const toggle = el('button', { type: 'button', 'data-testid': 'teach', 'aria-pressed': 'false' }, 'Teach');
+  const toggle = el('button', { type: 'button', 'data-testid': 'teach', 'aria-pressed': 'false', title: 'Dupin duality inset; or click a mesh vertex in the 3D view' }, 'Teach');
+  toggleBtn = toggle;
   toggle.addEventListener('click', () => {
     panel.hidden = !panel.hidden;
     toggle.setAttribute('aria-pressed', String(!panel.hidden));
     if (!panel.hidden && !lesson) load();
   });
   document.querySelector('header .buttons')?.append(toggle);
+  setPicked(null);
   for (const c of [surfaceSel, uIn, vIn]) c.addEventListener('change', load);
   svg.addEventListener('pointermove', moveDrag);
   const endDrag = () => { dragIndex = -1; };

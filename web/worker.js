@@ -2,8 +2,9 @@
 // the page's thread only draws. Protocol (all messages carry the load generation `gen`; stale
 // ones are dropped on both sides):
 //   in:  load {config, steps, mode} | step | play | pause | ack | mode {mode} | export {kind, panelEdge}
+//        | pick {origin, direction} (a view ray)
 //   out: ready | state {metrics, steps, done, mesh: typed arrays (transferred)} | error {message, field}
-//        | export {kind, text}
+//        | export {kind, text} | pick {pick | error} (Session.pickVertex's answer)
 import init, { Session } from './pkg/dupin_web.js';
 
 let session = null;
@@ -21,16 +22,30 @@ function meshMessage() {
 }
 
 function send() {
+  const t0 = performance.now();
   const mesh = meshMessage();
+  const t1 = performance.now();
   const done = session.done();
+  if (lastMetrics?.timing) lastMetrics.timing.mesh = t1 - t0;
   postMessage({ type: 'state', gen, metrics: lastMetrics, steps, done, playing: playing && !done, mesh },
     [mesh.positions.buffer, mesh.normals.buffer, mesh.indices.buffer, mesh.colors.buffer, mesh.edges.buffer]);
+  // Posting (structured clone of the metrics; the typed arrays are transferred) is timed for
+  // the step log of the next state.
+  postMs = performance.now() - t1;
 }
 
+let postMs = 0;
+
+// `ms` is the step as the contract's `session.step()` (solver + metrics); `timing` splits the
+// worker's time per step: solver, metrics, render buffers (mesh) and the previous post.
 function stepOnce() {
-  const t = performance.now();
-  const m = session.step();
-  m.ms = performance.now() - t;
+  const t0 = performance.now();
+  session.advance();
+  const t1 = performance.now();
+  const m = session.metrics();
+  const t2 = performance.now();
+  m.ms = t2 - t0;
+  m.timing = { solve: t1 - t0, metrics: t2 - t1, mesh: 0, prevPost: postMs };
   steps += 1;
   lastMetrics = m;
 }
@@ -86,6 +101,12 @@ const handlers = {
   mode(msg) {
     mode = msg.mode;
     if (session) { try { send(); } catch (e) { fail(e, 'color-mode'); } }
+  },
+  pick(msg) {
+    if (!session) return;
+    try {
+      postMessage({ type: 'pick', gen, pick: session.pickVertex(msg.origin, msg.direction) });
+    } catch (e) { postMessage({ type: 'pick', gen, error: e?.message ?? String(e) }); }
   },
   export(msg) {
     if (!session) return;

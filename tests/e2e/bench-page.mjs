@@ -4,6 +4,15 @@
 import { byId, openPage, waitDone, waitSteps } from './harness.mjs';
 
 const median = (a) => { const s = [...a].sort((x, y) => x - y); return s.length ? s[Math.floor(s.length / 2)] : NaN; };
+// Where a step's time goes: solver, metrics and render buffers in the worker, posting, and the
+// page's handling of the state (buffers to the GPU, metrics panel).
+const split = (log) => {
+  const opt = log.filter((s) => (s.phase === 'optimisation' || s.phase === 'done') && s.timing);
+  const r = {};
+  for (const k of ['solve', 'metrics', 'mesh', 'prevPost']) r[k] = Math.round(10 * median(opt.map((s) => s.timing[k]))) / 10;
+  r.main = Math.round(10 * median(opt.map((s) => s.mainMs))) / 10;
+  return r;
+};
 const out = {};
 for (const [backend, webgpu] of [['WebGPU', true], ['WebGL2', false]]) {
   const { browser, page } = await openPage({ webgpu });
@@ -19,6 +28,7 @@ for (const [backend, webgpu] of [['WebGPU', true], ['WebGL2', false]]) {
     const opt = log.filter((s) => s.phase === 'optimisation' || s.phase === 'done').map((s) => s.ms);
     out['10k faces'] = log.at(-1).faces;
     out['10k optimisation step ms (median, all)'] = [median(opt), opt.map(Math.round)];
+    out['10k split ms (median over optimisation steps)'] = split(log);
   }
   const frameMs = await page.evaluate(async () => {
     const c = document.querySelector('[data-testid=canvas]');
@@ -48,6 +58,7 @@ for (const [backend, webgpu] of [['WebGPU', true], ['WebGL2', false]]) {
     const opt = log.filter((s) => s.phase === 'optimisation' || s.phase === 'done').map((s) => s.ms);
     out['1k faces'] = log.at(-1).faces;
     out['1k optimisation step ms (median, all)'] = [median(opt), opt.map(Math.round)];
+    out['1k split ms (median over optimisation steps)'] = split(log);
   }
   await browser.close();
 }

@@ -1,8 +1,9 @@
 // The teaching inset (P-Hex paper sections 3-5.1): it opens, draws, and reacts to a drag of a star
-// vertex (its pixels and its Proposition 4 verdict change); the section 5.1 steps and bad input.
+// vertex (its pixels and its Proposition 4 verdict change); the section 5.1 steps and bad input;
+// a click on a mesh vertex in the 3D view opens it at that vertex's real star.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { SHOTS, byId, openPage, pixelStats } from './harness.mjs';
+import { SHOTS, byId, drag, exportText, openPage, pixelStats, waitSteps } from './harness.mjs';
 
 /** Screen position of a star handle (or the star centre for index -1). */
 async function handle(page, i) {
@@ -84,6 +85,121 @@ test('teach inset: hyperbolic point (Proposition 5) and bad input shown inline',
     assert.match(await byId(page, 'teach-error').textContent(), /K = 0|5\.3/);
     // The page stays usable.
     assert.equal(await byId(page, 'step').count(), 1);
+  } finally {
+    await browser.close();
+  }
+});
+
+/** Vertices and faces of OBJ text. */
+function parseObjFull(text) {
+  const v = [], f = [];
+  for (const l of text.split('\n')) {
+    const p = l.trim().split(/\s+/);
+    if (p[0] === 'v') v.push(p.slice(1, 4).map(Number));
+    else if (p[0] === 'f') f.push(p.slice(1).map((s) => Number(s.split('/')[0]) - 1));
+  }
+  return { v, f };
+}
+
+/** Canvas pixel (page coordinates) of the 3D point `p` in the current view, with its depth. */
+async function screenOf(page, p) {
+  return page.evaluate(([x, y, z]) => {
+    const q = window.dupin.viewer.project(x, y, z);
+    if (!q) return null;
+    const r = document.querySelector('[data-testid=canvas]').getBoundingClientRect();
+    return { x: r.left + (q[0] + 1) / 2 * r.width, y: r.top + (1 - q[1]) / 2 * r.height, ndc: [q[0], q[1]], depth: q[2] };
+  }, p);
+}
+
+const picked = (page) => byId(page, 'teach-inset').getAttribute('data-picked-vertex');
+
+test('teach inset from a clicked 3D vertex: its real star, a boundary message, dragging still works', async () => {
+  const { browser, page, errors } = await openPage({ hash: '#scene=free&surface=torus&method=prescribed&size=0.5' });
+  try {
+    await waitSteps(page, 1);
+    await byId(page, 'step').click();
+    await waitSteps(page, 2);
+    // Step 2 shows the base curve and one layer of triangles: every vertex is on the boundary.
+    let mesh = parseObjFull(await exportText(page, 'export-obj'));
+    // Click a triangle's centroid (inside the strip even after rounding to pixels).
+    let s = null;
+    for (const f of mesh.f) {
+      const c = [0, 1, 2].map((d) => f.reduce((acc, i) => acc + mesh.v[i][d], 0) / f.length);
+      const q = await screenOf(page, c);
+      if (q && q.ndc[0] > 0.1 && q.ndc[0] < 0.9 && Math.abs(q.ndc[1]) < 0.9) { s = q; break; }
+    }
+    assert.ok(s, 'a triangle of the first layer in view');
+    await page.mouse.click(s.x, s.y);
+    await page.waitForFunction(() => /boundary/.test(document.querySelector('[data-testid=teach-error]').textContent));
+    assert.equal(await byId(page, 'teach-panel').isHidden(), false, 'the inset opens');
+    // Layers until all are shown (the mesh on screen is then the whole triangulation).
+    const phase = () => page.evaluate(() => document.querySelector('[data-testid=metrics]').dataset.phase);
+    for (let n = 3; (await phase()) !== 'hexagons'; n++) {
+      await byId(page, 'step').click();
+      await waitSteps(page, n);
+    }
+    mesh = parseObjFull(await exportText(page, 'export-obj'));
+    assert.ok(mesh.f.every((f) => f.length === 3), 'the triangulation is on screen');
+    // Interior valence-6 vertices (six triangles around them) and their neighbour sets.
+    const around = mesh.v.map(() => []);
+    for (const f of mesh.f) for (const i of f) around[i].push(f);
+    const nbrs = (i) => [...new Set(around[i].flat().filter((j) => j !== i))].sort((a, b) => a - b);
+    // The vertex nearest the eye among those projecting right of the inset (x > 0 in NDC).
+    let best = null;
+    for (let i = 0; i < mesh.v.length; i++) {
+      if (around[i].length !== 6 || nbrs(i).length !== 6) continue;
+      const q = await screenOf(page, mesh.v[i]);
+      if (!q || q.ndc[0] < 0.1 || q.ndc[0] > 0.8 || Math.abs(q.ndc[1]) > 0.7) continue;
+      if (!best || q.depth < best.q.depth) best = { i, q };
+    }
+    assert.ok(best, 'an interior vertex in view');
+    await page.mouse.click(best.q.x, best.q.y);
+    await page.waitForFunction((i) => document.querySelector('[data-testid=teach-inset]').dataset.pickedVertex === String(i), best.i);
+    const inset = byId(page, 'teach-inset');
+    const got = (await inset.getAttribute('data-picked-neighbours')).split(',').map(Number);
+    assert.deepEqual([...got].sort((a, b) => a - b), nbrs(best.i), 'the star is the vertex\'s six neighbours');
+    // Counter-clockwise ring: consecutive neighbours span a triangle of the vertex.
+    for (let k = 0; k < 6; k++) {
+      const [a, b] = [got[k], got[(k + 1) % 6]];
+      assert.ok(around[best.i].some((f) => f.includes(a) && f.includes(b)), `ring edge ${a}-${b} is not a triangle`);
+    }
+    // The inset's star is those neighbours projected onto the tangent plane: lengths of the
+    // projected spokes are at most, and within 5 % of, the 3D edge lengths.
+    const ring = JSON.parse(await inset.getAttribute('data-ring'));
+    assert.equal(await inset.getAttribute('data-star'), 'mesh');
+    const p0 = mesh.v[best.i];
+    ring.forEach(([x, y], k) => {
+      const e = Math.hypot(...mesh.v[got[k]].map((c, d) => c - p0[d]));
+      const r = Math.hypot(x, y);
+      assert.ok(r <= e * (1 + 1e-9) && r >= 0.95 * e, `spoke ${k}: projected ${r}, 3D ${e}`);
+    });
+    assert.match(await byId(page, 'teach-verdict').getAttribute('data-verdict'), /^(valid|invalid)$/);
+    assert.equal(await byId(page, 'pick-marker').isVisible(), true, 'the picked vertex is marked');
+    await inset.screenshot({ path: `${SHOTS}/teach-picked-vertex.png` });
+    // Dragging a star vertex still changes the inset's star (only that vertex moves).
+    const [hx, hy] = await handle(page, 2);
+    const [cx, cy] = await handle(page, -1);
+    await page.mouse.move(hx, hy);
+    await page.mouse.down();
+    for (let k = 1; k <= 6; k++) await page.mouse.move(hx + ((cx - hx) * 0.3 * k) / 6, hy + ((cy - hy) * 0.3 * k) / 6);
+    await page.mouse.up();
+    const ring2 = JSON.parse(await inset.getAttribute('data-ring'));
+    ring2.forEach((q, k) => assert.equal(q[0] === ring[k][0] && q[1] === ring[k][1], k !== 2, `vertex ${k} after dragging vertex 2`));
+    // Orbiting the 3D view by a drag still works and does not pick.
+    const cam0 = await page.evaluate(() => Array.from(window.dupin.viewer.camera()));
+    await drag(page, 60, 0);
+    const cam1 = await page.evaluate(() => Array.from(window.dupin.viewer.camera()));
+    assert.notDeepEqual(cam1, cam0, 'the drag orbits');
+    assert.equal(await picked(page), String(best.i), 'a drag is not a click');
+    await drag(page, -60, 0);
+    // The hexagon mesh: the same screen point picks the same triangulation vertex.
+    await page.evaluate((c) => window.dupin.viewer.setCamera(c), cam0);
+    await byId(page, 'step').click();
+    await page.waitForFunction(() => document.querySelector('[data-testid=metrics]').dataset.phase !== 'hexagons');
+    await page.evaluate(() => { document.querySelector('[data-testid=teach-inset]').dataset.pickedVertex = ''; });
+    await page.mouse.click(best.q.x, best.q.y);
+    await page.waitForFunction((i) => document.querySelector('[data-testid=teach-inset]').dataset.pickedVertex === String(i), best.i);
+    assert.deepEqual(errors, [], 'console errors');
   } finally {
     await browser.close();
   }

@@ -12,7 +12,9 @@
 //! - [`Curvature`], [`PointType`], [`CurvatureTolerance`] (section 3);
 //! - [`DupinIndicatrix`], [`DupinConic`], conjugate and asymptotic directions (sections 3, 4.2);
 //! - [`dupin_center`], [`tangent_dual_point`], [`TriangleStar`] (section 4, Propositions 3-5);
-//! - [`ideal_triangle`] (section 5.1); [`is_simple_polygon`] (exact predicates).
+//! - [`ideal_triangle`] (section 5.1); [`is_simple_polygon`] (exact predicates);
+//! - [`pick_vertex`] and [`vertex_ring`]: the mesh vertex under a view ray and its triangle star
+//!   (section 4.1), for the page's teaching inset.
 //! ## P-Hex meshes (P-Hex paper, sections 5 to 7)
 //! - [`triangulate`] (methods 1 and 2 of section 5.2, parabolic rules of 5.3, [`bounded_ratio`]);
 //! - [`dual_mesh`] (section 6 initialisation, tangent duality), [`PlanarityOptimiser`]
@@ -52,6 +54,7 @@ mod support_structure;
 mod surface;
 mod tangent_duality;
 mod triangle_star;
+mod vertex_pick;
 
 pub use circular::{circular_residual, quad_circularity};
 pub use conical::{
@@ -120,3 +123,4 @@ pub use surface::{
 };
 pub use tangent_duality::{TangentDualPoint, TangentDualityError, tangent_dual_point};
 pub use triangle_star::{DupinHexagon, TriangleStar, TriangleStarError};
+pub use vertex_pick::{VertexPick, VertexStarError, pick_vertex, vertex_ring};

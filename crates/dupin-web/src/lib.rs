@@ -7,6 +7,7 @@
 
 mod hexd2d;
 mod mesh_data;
+mod pick;
 mod present;
 mod session;
 mod teach;

@@ -71,6 +71,9 @@ enum Run {
 pub struct Session {
     run: Run,
     config: SessionConfig,
+    /// Per-face planarity of the current mesh, computed once per step: the metrics and the
+    /// planarity colours of the render buffers both need it (a worker step asks for both).
+    per_face: std::cell::RefCell<Option<Vec<f64>>>,
 }
 
 /// Every scene a `Session` accepts: the P-Hex scenes, then the PQ scenes.
@@ -281,12 +284,24 @@ impl Session {
                 ));
             }
         };
-        Ok(Session { run, config: cfg })
+        Ok(Session {
+            run,
+            config: cfg,
+            per_face: Default::default(),
+        })
     }
 
     /// Advances one observable step (a triangulation layer, the dual mesh, one Gauss-Newton
     /// iteration; a whole PQ scene) and returns the metrics.
     pub fn step(&mut self) -> Result<JsValue, JsError> {
+        self.advance()?;
+        self.metrics()
+    }
+
+    /// [`Session::step`] without building the metrics (the worker times the solver and the
+    /// metrics separately, then calls `metrics()`).
+    pub fn advance(&mut self) -> Result<(), JsError> {
+        self.per_face.replace(None);
         match &mut self.run {
             Run::Phex(p) => {
                 if !p.done() {
@@ -305,7 +320,7 @@ impl Session {
                 }
             }
         }
-        self.metrics()
+        Ok(())
     }
 
     /// True once the run has finished.
@@ -413,6 +428,29 @@ impl Session {
         Ok(panel_schedule_svg(&sched, scale))
     }
 
+    /// The P-Hex triangulation vertex under a click: `origin` and `direction` (3 numbers each)
+    /// are the view ray (`Viewer.pickRay`). Returns `null` when the ray misses the triangles on
+    /// screen, else `{ vertex, uv, point, normal, k1, k2, dir1, dir2, neighbours, ring,
+    /// message }`: the surface point, its principal frame and the six ring neighbours (indices
+    /// and positions, counter-clockwise), or `message` saying why there is no complete star.
+    /// Throws for a PQ scene (no triangulation) or a malformed ray.
+    #[wasm_bindgen(js_name = pickVertex)]
+    pub fn pick_vertex(&self, origin: Vec<f64>, direction: Vec<f64>) -> Result<JsValue, JsError> {
+        let Run::Phex(p) = &self.run else {
+            return Err(JsError::new(
+                "vertex picking needs a P-Hex run: PQ scenes have no triangulation",
+            ));
+        };
+        if origin.len() != 3 || direction.len() != 3 {
+            return Err(JsError::new("a ray needs 3 origin and 3 direction numbers"));
+        }
+        let v = |a: &[f64]| dupin_core::Vec3::new(a[0], a[1], a[2]);
+        match crate::pick::pick_star(p, v(&origin), v(&direction)) {
+            Some(pick) => to_js(&pick),
+            None => Ok(JsValue::NULL),
+        }
+    }
+
     /// The current mesh for the viewer: flat panels coloured by `mode` (`planarity`: blue
     /// planar, through white, to red at 1e-2 and above, log scale; `convexity`; `regularity`:
     /// the P-Hex paper's section 4.2 deviation from the affine (quasi-)regular hexagon) and
@@ -421,8 +459,10 @@ impl Session {
         let mode = ColorMode::parse(mode.as_deref().unwrap_or(""))?;
         let m = self.current_mesh().unwrap_or_default();
         let colors: Vec<[f32; 3]> = match mode {
-            ColorMode::Planarity => (0..m.num_faces())
-                .map(|i| planarity_color(face_planarity(&m, i)))
+            ColorMode::Planarity => self
+                .face_planarities(&m)
+                .iter()
+                .map(|&p| planarity_color(p))
                 .collect(),
             ColorMode::Convexity => (0..m.num_faces())
                 .map(|i| {
@@ -459,6 +499,21 @@ impl Session {
 }
 
 impl Session {
+    /// Per-face planarity of `mesh` (the current mesh), cached until the next step.
+    fn face_planarities(&self, mesh: &PolyMesh) -> Vec<f64> {
+        let mut cache = self.per_face.borrow_mut();
+        match &*cache {
+            Some(v) if v.len() == mesh.num_faces() => v.clone(),
+            _ => {
+                let v: Vec<f64> = (0..mesh.num_faces())
+                    .map(|i| face_planarity(mesh, i))
+                    .collect();
+                *cache = Some(v.clone());
+                v
+            }
+        }
+    }
+
     fn current_mesh(&self) -> Option<PolyMesh> {
         match &self.run {
             Run::Phex(p) => Some(p.mesh()),
@@ -468,9 +523,7 @@ impl Session {
 
     fn metrics_struct(&self) -> Metrics {
         let mesh = self.current_mesh().unwrap_or_default();
-        let per_face: Vec<f64> = (0..mesh.num_faces())
-            .map(|i| face_planarity(&mesh, i))
-            .collect();
+        let per_face = self.face_planarities(&mesh);
         let mean_planarity = if per_face.is_empty() {
             0.0
         } else {
@@ -567,6 +620,110 @@ fn planarity_color(p: f64) -> [f32; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Not a test: where a worker step of the page's 10k-face benchmark configuration goes,
+    /// natively (thread CPU time per Gauss-Newton iteration, CG iterations and Cholesky
+    /// factorisations), against the page's metrics and render buffers for the same mesh.
+    /// `cargo test -p dupin-web --lib profile_10k -- --ignored --nocapture`.
+    #[test]
+    #[ignore]
+    fn profile_10k_worker_step() {
+        use dupin_core::{
+            Initialisation, PhexConfig, PhexPipeline, PlanarityOptimiser, PlanarityOptions,
+            TriangulationMethod, dual_mesh_options,
+        };
+        let cpu = || {
+            let s = std::fs::read_to_string("/proc/thread-self/schedstat").unwrap_or_default();
+            s.split_whitespace()
+                .next()
+                .and_then(|t| t.parse::<f64>().ok())
+                .unwrap_or(0.0)
+                * 1e-9
+        };
+        let mut cfg =
+            PhexConfig::for_surface("torus", &[], TriangulationMethod::Prescribed, Some(0.155));
+        cfg.initialisation = Initialisation::DupinDuality;
+        let p = PhexPipeline::new(cfg.clone()).unwrap();
+        let mut d = dual_mesh_options(
+            p.triangulation(),
+            p.surface(),
+            cfg.initialisation,
+            cfg.boundary_faces,
+        )
+        .unwrap();
+        let mut opt = PlanarityOptimiser::new(
+            &d.mesh,
+            Some(&d.vertex_uv),
+            PlanarityOptions {
+                max_iterations: cfg.iterations,
+                fairness: cfg.lambda,
+                distance: cfg.mu,
+                ..PlanarityOptions::default()
+            },
+        )
+        .unwrap();
+        println!("faces {}", d.mesh.num_faces());
+        while !opt.done() {
+            let (t, cg, f) = (cpu(), opt.cg_iterations(), opt.factorizations());
+            let st = opt.step(&mut d.mesh, p.surface()).unwrap();
+            println!(
+                "iteration {}: {:.3} s CPU, CG {}, factorisations {}, nnz(L) {}, max planarity {:.2e}",
+                st.iteration,
+                cpu() - t,
+                opt.cg_iterations() - cg,
+                opt.factorizations() - f,
+                opt.factor_len(),
+                st.max_planarity
+            );
+        }
+        let t = cpu();
+        let per_face: Vec<f64> = (0..d.mesh.num_faces())
+            .map(|i| face_planarity(&d.mesh, i))
+            .collect();
+        let t_metrics = cpu() - t;
+        let t = cpu();
+        let colors: Vec<[f32; 3]> = per_face.iter().map(|&q| planarity_color(q)).collect();
+        let m = MeshData::panels(d.mesh.clone(), &colors);
+        println!(
+            "metrics (per-face planarity) {:.1} ms, render buffers {:.1} ms ({} triangles)",
+            t_metrics * 1e3,
+            (cpu() - t) * 1e3,
+            m.buffers.triangle_count()
+        );
+    }
+
+    /// The per-face planarity cache follows every step: the metrics' mean and histogram and
+    /// the planarity colours always match a fresh computation on the current mesh.
+    #[test]
+    fn cached_face_planarity_follows_every_step() {
+        let mut cfg =
+            PhexConfig::for_surface("torus", &[], TriangulationMethod::Prescribed, Some(0.6));
+        cfg.initialisation = Initialisation::DupinDuality;
+        let mut session = Session {
+            run: Run::Phex(Box::new(PhexPipeline::new(cfg).unwrap())),
+            config: serde_json::from_str(r#"{"surface": "torus"}"#).unwrap(),
+            per_face: Default::default(),
+        };
+        let mut optimised = 0;
+        while !session.done() {
+            session.advance().unwrap();
+            let mesh = session.current_mesh().unwrap();
+            let fresh: Vec<f64> = (0..mesh.num_faces())
+                .map(|i| face_planarity(&mesh, i))
+                .collect();
+            let m = session.metrics_struct();
+            let mean = if fresh.is_empty() {
+                0.0
+            } else {
+                fresh.iter().sum::<f64>() / fresh.len() as f64
+            };
+            assert_eq!(m.mean_planarity, mean);
+            assert_eq!(m.histogram, planarity_histogram(&fresh));
+            assert_eq!(session.face_planarities(&mesh), fresh);
+            optimised += usize::from(m.phase == "optimisation" || m.phase == "done");
+        }
+        assert!(optimised >= 2, "the run optimised");
+    }
 
     #[test]
     fn histogram_counts_every_face_in_its_decade() {

@@ -8,9 +8,10 @@
 //! Propositions 4 and 5 (section 4.2) and the ideal-triangle construction (section 5.1). All
 //! geometry is the core's; this file only arranges it for drawing.
 
+use crate::pick::StarPick;
 use dupin_core::{
-    DupinConic, DupinIndicatrix, PointType, TriangleStar, Vec2, dupin_conic_through,
-    ideal_triangle, surface_by_name,
+    Curvature, DupinConic, DupinIndicatrix, PointType, TriangleStar, Vec2, Vec3,
+    dupin_conic_through, ideal_triangle, is_simple_polygon, surface_by_name,
 };
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -29,7 +30,7 @@ type Curves = Vec<Vec<f64>>;
 /// One proposition condition and whether it holds.
 #[derive(Serialize, Debug, Clone)]
 pub(crate) struct Condition {
-    pub(crate) text: &'static str,
+    pub(crate) text: String,
     pub(crate) holds: bool,
 }
 
@@ -45,6 +46,8 @@ pub(crate) struct TriangleConic {
 #[serde(rename_all = "camelCase")]
 pub(crate) struct LessonState {
     pub(crate) kind: &'static str,
+    /// `lattice` (an editable star of congruent triangles) or `mesh` (a vertex's real star).
+    pub(crate) star: &'static str,
     pub(crate) k1: f64,
     pub(crate) k2: f64,
     /// Half-width of the square the inset should show.
@@ -54,7 +57,7 @@ pub(crate) struct LessonState {
     /// Asymptotic directions (hyperbolic points only).
     pub(crate) asymptotes: Vec<P>,
     pub(crate) center: P,
-    /// The six ring vertices a, b, b - a, -a, -b, a - b around the centre.
+    /// The six ring vertices around the centre (lattice: a, b, b - a, -a, -b, a - b).
     pub(crate) ring: Vec<P>,
     /// Dupin conics of the six triangles (empty when K = 0).
     pub(crate) triangle_conics: Vec<TriangleConic>,
@@ -94,6 +97,12 @@ pub struct DupinLesson {
     /// Semi-axis scale of the indicatrix, for framing.
     extent: f64,
     dragged: Option<Vec2>,
+    /// A mesh vertex's real star (ring offsets, counter-clockwise), when the lesson was built
+    /// from one: six independent triangles instead of a lattice star.
+    ring: Option<[Vec2; 6]>,
+    /// Level of the drawn indicatrix Q = +-level (1 for the lattice lesson; a mesh star is
+    /// small against the unit indicatrix, so it is drawn scaled to the star).
+    level: f64,
 }
 
 fn err(e: impl std::fmt::Display) -> JsError {
@@ -143,7 +152,52 @@ impl DupinLesson {
             b,
             extent,
             dragged: None,
+            ring: None,
+            level: 1.0,
         })
+    }
+
+    /// The lesson at a mesh vertex: `curv` is the curvature at the vertex (its point is the
+    /// star's centre), `ring` the six neighbours in counter-clockwise order. The neighbours are
+    /// projected orthogonally onto the tangent plane in the principal frame (section 6, step 2:
+    /// the projected triangle star). Errors: planar or non-finite curvature, a projected
+    /// triangle that is degenerate.
+    pub(crate) fn from_star(curv: &Curvature, ring: &[Vec3; 6]) -> Result<Self, String> {
+        if !ring.iter().all(|p| p.iter().all(|x| x.is_finite())) {
+            return Err("star vertices must be finite".into());
+        }
+        let mut l = Self::from_curvatures(curv.k1, curv.k2)?;
+        let f = curv.frame();
+        let r: [Vec2; 6] = ring.map(|p| f.to_local(&p));
+        for i in 0..6 {
+            TriangleStar::new(Vec2::zeros(), r[i], r[(i + 1) % 6]).map_err(|e| {
+                format!("{e}: triangle {i} of the star is flat in the tangent plane")
+            })?;
+        }
+        let reach = r.iter().map(|q| q.norm()).fold(0.0, f64::max);
+        // The indicatrix scaled to pass at the star's mean |Q| (its shape is what matters).
+        let q = r.iter().map(|q| l.ind.quadratic(q).abs()).sum::<f64>() / 6.0;
+        l.level = if q > 0.0 { q } else { reach * reach };
+        l.extent = 1.6 * reach;
+        l.a = r[0];
+        l.b = r[1];
+        l.ring = Some(r);
+        Ok(l)
+    }
+
+    /// [`DupinLesson::from_star`] for a page pick that has a complete star.
+    pub(crate) fn from_pick(pick: &StarPick) -> Result<Self, String> {
+        if let Some(m) = &pick.message {
+            return Err(m.clone());
+        }
+        let ring: [Vec3; 6] = pick
+            .ring
+            .iter()
+            .map(|p| Vec3::new(p[0], p[1], p[2]))
+            .collect::<Vec<_>>()
+            .try_into()
+            .map_err(|r: Vec<Vec3>| format!("a star needs 6 ring vertices, got {}", r.len()))?;
+        Self::from_star(&pick.curvature(), &ring)
     }
 
     fn star(&self) -> Result<TriangleStar, String> {
@@ -157,6 +211,22 @@ impl DupinLesson {
             return Err(format!("vertex position must be finite, got ({x}, {y})"));
         }
         let q = Vec2::new(x, y);
+        if let Some(mut r) = self.ring {
+            // A mesh star: only the dragged vertex moves.
+            if index >= 6 {
+                return Err(format!("star vertex index must be 0..5, got {index}"));
+            }
+            r[index] = q;
+            for i in [(index + 5) % 6, index] {
+                TriangleStar::new(Vec2::zeros(), r[i], r[(i + 1) % 6]).map_err(|e| {
+                    format!("{e}: the dragged vertex would make the star's triangles flat")
+                })?;
+            }
+            self.ring = Some(r);
+            (self.a, self.b) = (r[0], r[1]);
+            self.dragged = Some(q);
+            return Ok(());
+        }
         let (a, b) = match index {
             0 => (q, self.b),
             1 => (self.a, q),
@@ -184,6 +254,8 @@ impl DupinLesson {
     pub(crate) fn make_ideal(&mut self) -> Result<(), String> {
         let t = ideal_triangle(&self.ind, &Vec2::zeros(), &self.a).map_err(|e| e.to_string())?;
         self.b = t.c;
+        // A mesh star becomes the ideal lattice star on its first edge.
+        self.ring = None;
         Ok(())
     }
 
@@ -226,19 +298,21 @@ impl DupinLesson {
         let kind = ind.point_type();
         let far = 4.0 * self.extent;
         let indicatrix = match kind {
-            PointType::Elliptic => self.conic_curves(&ind.conic(Vec2::zeros(), ind.k1().signum())),
+            PointType::Elliptic => {
+                self.conic_curves(&ind.conic(Vec2::zeros(), self.level * ind.k1().signum()))
+            }
             PointType::Hyperbolic => {
-                let mut c = self.conic_curves(&ind.conic(Vec2::zeros(), 1.0));
-                c.extend(self.conic_curves(&ind.conic(Vec2::zeros(), -1.0)));
+                let mut c = self.conic_curves(&ind.conic(Vec2::zeros(), self.level));
+                c.extend(self.conic_curves(&ind.conic(Vec2::zeros(), -self.level)));
                 c
             }
             // k x^2 = 1 along the curved axis: two parallel lines (section 5.3).
             _ => {
                 if ind.k1().abs() >= ind.k2().abs() {
-                    let x = 1.0 / ind.k1().abs().sqrt();
+                    let x = (self.level / ind.k1().abs()).sqrt();
                     vec![vec![x, -far, x, far], vec![-x, -far, -x, far]]
                 } else {
-                    let y = 1.0 / ind.k2().abs().sqrt();
+                    let y = (self.level / ind.k2().abs()).sqrt();
                     vec![vec![-far, y, far, y], vec![-far, -y, far, -y]]
                 }
             }
@@ -249,6 +323,11 @@ impl DupinLesson {
             .unwrap_or_default();
         let mut st = LessonState {
             kind: kind.name(),
+            star: if self.ring.is_some() {
+                "mesh"
+            } else {
+                "lattice"
+            },
             k1: ind.k1(),
             k2: ind.k2(),
             extent: self.extent,
@@ -268,6 +347,10 @@ impl DupinLesson {
                 .and_then(|d| ind.conjugate_direction(&d).ok())
                 .map(p),
         };
+        if let Some(ring) = self.ring {
+            self.mesh_star_state(&mut st, &ring);
+            return st;
+        }
         let star = match self.star() {
             Ok(s) => s,
             Err(e) => {
@@ -306,15 +389,16 @@ impl DupinLesson {
                 .unwrap_or(false);
             st.conditions = vec![
                 Condition {
-                    text: "1) the Dupin hexagon is simple",
+                    text: "1) the Dupin hexagon is simple".into(),
                     holds: valid,
                 },
                 Condition {
-                    text: "2) the Dupin center of the fundamental triangle is inside it",
+                    text: "2) the Dupin center of the fundamental triangle is inside it".into(),
                     holds: inside,
                 },
                 Condition {
-                    text: "3) no conjugate pair of directions encloses the three edge directions",
+                    text: "3) no conjugate pair of directions encloses the three edge directions"
+                        .into(),
                     holds: open,
                 },
             ];
@@ -328,15 +412,15 @@ impl DupinLesson {
             let ranges = star.edges_not_in_one_asymptotic_range(ind).unwrap_or(false);
             st.conditions = vec![
                 Condition {
-                    text: "1) the Dupin hexagon is simple",
+                    text: "1) the Dupin hexagon is simple".into(),
                     holds: valid,
                 },
                 Condition {
-                    text: "2) the triangle's vertices lie on different branches of its Dupin hyperbola",
+                    text: "2) the triangle's vertices lie on different branches of its Dupin hyperbola".into(),
                     holds: branches,
                 },
                 Condition {
-                    text: "3) the edge directions are not all in one range between the asymptotes",
+                    text: "3) the edge directions are not all in one range between the asymptotes".into(),
                     holds: ranges,
                 },
             ];
@@ -347,6 +431,75 @@ impl DupinLesson {
             };
         }
         st
+    }
+
+    /// A mesh vertex's star: six independent triangles (centre, r_i, r_i+1). Its Dupin hexagon
+    /// joins their Dupin centers; it is valid when that hexagon is simple (the definition,
+    /// section 4.1). Propositions 4 and 5 are about lattice stars, so they are evaluated per
+    /// triangle, each as the fundamental triangle of its own lattice star.
+    fn mesh_star_state(&self, st: &mut LessonState, ring: &[Vec2; 6]) {
+        let ind = &self.ind;
+        st.ring = ring.iter().map(|v| p(*v)).collect();
+        let o = Vec2::zeros();
+        let mut centers = Vec::new();
+        for i in 0..6 {
+            let (a, b) = (ring[i], ring[(i + 1) % 6]);
+            match dupin_conic_through(ind, &o, &a, &b) {
+                Ok(c) => {
+                    centers.push(c.center);
+                    st.triangle_conics.push(TriangleConic {
+                        center: p(c.center),
+                        curves: self.conic_curves(&c),
+                    });
+                }
+                Err(e) => {
+                    st.reason = format!(
+                        "{e}. At a {} point the Dupin conics degenerate: no Dupin hexagon (section 5.3).",
+                        ind.point_type().name()
+                    );
+                    return;
+                }
+            }
+        }
+        st.hexagon = centers.iter().map(|v| p(*v)).collect();
+        let simple = is_simple_polygon(&centers).unwrap_or(false);
+        st.verdict = if simple { "valid" } else { "invalid" };
+        let elliptic = ind.point_type() == PointType::Elliptic;
+        st.conditions.push(Condition {
+            text: "the Dupin hexagon of this star is simple (validity, section 4.1)".into(),
+            holds: simple,
+        });
+        let mut lattice_valid = 0;
+        for i in 0..6 {
+            let Ok(t) = TriangleStar::new(o, ring[i], ring[(i + 1) % 6]) else {
+                continue;
+            };
+            let (holds, what) = if elliptic {
+                (
+                    t.dupin_center_inside(ind).unwrap_or(false),
+                    "its Dupin center lies inside it (Prop. 4)",
+                )
+            } else {
+                (
+                    t.vertices_on_different_branches(ind).unwrap_or(false),
+                    "its vertices lie on both branches of its Dupin hyperbola (Prop. 5)",
+                )
+            };
+            lattice_valid += usize::from(holds);
+            st.conditions.push(Condition {
+                text: format!("triangle {}: {what}", i + 1),
+                holds,
+            });
+        }
+        st.reason = format!(
+            "The projected star of a mesh vertex: six different triangles, so its validity is the definition: the Dupin hexagon joining their Dupin centers is {} (section 4.1). {lattice_valid} of 6 triangles would give a valid lattice star by Proposition {} (section 4.2).",
+            if simple {
+                "simple"
+            } else {
+                "self-intersecting"
+            },
+            if elliptic { 4 } else { 5 }
+        );
     }
 
     /// The section 5.1 construction on the base A = centre, B = ring vertex a.
@@ -417,6 +570,16 @@ impl DupinLesson {
         };
         let list: Vec<(&str, f64)> = params.iter().map(|(k, v)| (k.as_str(), *v)).collect();
         DupinLesson::build(surface, &list, u, v).map_err(err)
+    }
+
+    /// The lesson at a picked mesh vertex: `pick` is what `Session.pickVertex` returned (the
+    /// surface point, its principal frame and the six ring neighbours). Throws with the pick's
+    /// message for a vertex without a complete star, and for planar points or flat triangles.
+    #[wasm_bindgen(js_name = fromStar)]
+    pub fn from_star_js(pick: JsValue) -> Result<DupinLesson, JsError> {
+        let pick: StarPick = serde_wasm_bindgen::from_value(pick)
+            .map_err(|e| err(format!("not a vertex pick: {e}")))?;
+        DupinLesson::from_pick(&pick).map_err(err)
     }
 
     /// A lesson with given principal curvatures (k1, k2), for experiments and tests.
@@ -562,5 +725,114 @@ mod tests {
         let inner = DupinLesson::build("torus", &[], 0.0, PI).unwrap();
         assert_eq!(inner.lesson_state().kind, "hyperbolic");
         assert_eq!(inner.lesson_state().asymptotes.len(), 2);
+    }
+}
+
+#[cfg(test)]
+mod mesh_star_tests {
+    use super::*;
+    use dupin_core::{Surface, Torus};
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// A lattice star (a, b) lifted onto the osculating paraboloid z = Q(x)/2 at a torus point.
+    fn lifted(c: &Curvature, ind: &DupinIndicatrix, a: Vec2, b: Vec2) -> [Vec3; 6] {
+        let f = c.frame();
+        [a, b, b - a, -a, -b, a - b].map(|q| f.to_world(&q) + c.normal * (0.5 * ind.quadratic(&q)))
+    }
+
+    /// The projected star of a lifted lattice star is that lattice star, and its verdict (the
+    /// definition: the Dupin hexagon is simple) agrees with Propositions 4 and 5 evaluated on
+    /// every one of its six triangles, on seeded random stars at elliptic and hyperbolic points.
+    #[test]
+    fn mesh_star_of_a_lattice_star_follows_propositions_4_and_5() {
+        let torus = Torus {
+            major: 2.0,
+            minor: 0.7,
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let mut seen = std::collections::BTreeSet::new();
+        for (u, v) in [(0.3, 0.2), (1.0, 3.0)] {
+            let c = torus.curvature(u, v).unwrap();
+            let ind = c.indicatrix().unwrap();
+            for _ in 0..300 {
+                let mut r = || Vec2::new(rng.random_range(-0.2..0.2), rng.random_range(-0.2..0.2));
+                let (a, b) = (r(), r());
+                let Ok(star) = TriangleStar::new(Vec2::zeros(), a, b) else {
+                    continue;
+                };
+                let Ok(valid) = star.is_valid(&ind) else {
+                    continue;
+                };
+                let l = DupinLesson::from_star(&c, &lifted(&c, &ind, a, b)).unwrap();
+                let s = l.lesson_state();
+                assert_eq!(s.star, "mesh");
+                for (got, want) in s.ring.iter().zip(star.ring()) {
+                    assert!((Vec2::new(got[0], got[1]) - want).norm() < 1e-12);
+                }
+                let verdict = if valid { "valid" } else { "invalid" };
+                assert_eq!(s.verdict, verdict, "a = {a:?}, b = {b:?}");
+                assert_eq!(s.conditions.len(), 7);
+                assert!(
+                    s.conditions.iter().all(|k| k.holds == valid),
+                    "{:?}",
+                    s.conditions
+                );
+                seen.insert((s.kind, s.verdict));
+            }
+        }
+        assert_eq!(seen.len(), 4, "both verdicts at both point types: {seen:?}");
+    }
+
+    #[test]
+    fn mesh_star_drag_moves_one_vertex_and_errors_are_messages() {
+        let torus = Torus {
+            major: 2.0,
+            minor: 0.7,
+        };
+        let c = torus.curvature(0.3, 0.2).unwrap();
+        let ind = c.indicatrix().unwrap();
+        let ring = lifted(&c, &ind, Vec2::new(0.1, 0.02), Vec2::new(0.03, 0.1));
+        let mut l = DupinLesson::from_star(&c, &ring).unwrap();
+        let before = l.lesson_state().ring;
+        l.drag(2, -0.09, 0.11).unwrap();
+        let after = l.lesson_state().ring;
+        for i in 0..6 {
+            assert_eq!(before[i] == after[i], i != 2, "vertex {i}");
+        }
+        assert_eq!(after[2], [-0.09, 0.11]);
+        // Onto the line through the centre and a neighbour: triangle 1 (or 2) is flat.
+        assert!(l.drag(2, 2.0 * after[1][0], 2.0 * after[1][1]).is_err());
+        assert_eq!(
+            l.lesson_state().ring,
+            after,
+            "a refused drag changes nothing"
+        );
+        // A collapsed ring vertex is refused at construction.
+        let mut flat = ring;
+        flat[3] = c.point;
+        assert!(DupinLesson::from_star(&c, &flat).is_err());
+        // A pick without a star carries its message through.
+        let pick = StarPick {
+            vertex: 3,
+            uv: [0.3, 0.2],
+            point: [c.point.x, c.point.y, c.point.z],
+            normal: [c.normal.x, c.normal.y, c.normal.z],
+            k1: c.k1,
+            k2: c.k2,
+            dir1: [c.dir1.x, c.dir1.y, c.dir1.z],
+            dir2: [c.dir2.x, c.dir2.y, c.dir2.z],
+            neighbours: Vec::new(),
+            ring: Vec::new(),
+            message: Some("vertex 3 is on the boundary".into()),
+        };
+        assert_eq!(
+            DupinLesson::from_pick(&pick).err().as_deref(),
+            Some("vertex 3 is on the boundary")
+        );
+        // make_ideal turns a mesh star into the ideal lattice star: valid.
+        l.make_ideal().unwrap();
+        let s = l.lesson_state();
+        assert_eq!((s.star, s.verdict), ("lattice", "valid"));
     }
 }

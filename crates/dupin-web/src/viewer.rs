@@ -85,17 +85,31 @@ impl Viewer {
     /// non-finite values or a distance that is not positive.
     #[wasm_bindgen(js_name = setCamera)]
     pub fn set_camera(&mut self, v: Vec<f32>) -> Result<(), JsError> {
-        if v.len() != 6 || !v.iter().all(|x| x.is_finite()) || v[3] <= 0.0 {
-            return Err(JsError::new(
-                "camera needs 6 finite numbers: target x, y, z, distance > 0, yaw, pitch",
-            ));
-        }
-        self.camera.target = glam::Vec3::new(v[0], v[1], v[2]);
-        self.camera.distance = v[3];
-        self.camera.yaw = v[4];
-        // The orbit camera's own pitch limits.
-        self.camera.pitch = v[5].clamp(-1.55, 1.55);
+        // The orbit camera's own pitch limits apply.
+        self.camera = crate::pick::camera_from(&v).map_err(|e| JsError::new(&e))?;
         Ok(())
+    }
+
+    /// The view ray through a canvas point given in normalised device coordinates (x, y in
+    /// [-1, 1], y up): `[origin x, y, z, direction x, y, z]` (unit direction), for
+    /// `Session.pickVertex`. Throws for non-finite input.
+    #[wasm_bindgen(js_name = pickRay)]
+    pub fn pick_ray(&self, ndc_x: f32, ndc_y: f32) -> Result<Vec<f64>, JsError> {
+        let (o, d) = crate::pick::view_ray(&self.camera, self.aspect(), ndc_x, ndc_y)
+            .filter(|_| ndc_x.is_finite() && ndc_y.is_finite())
+            .ok_or_else(|| JsError::new("the click is not a finite canvas point"))?;
+        Ok([o.x, o.y, o.z, d.x, d.y, d.z].map(f64::from).to_vec())
+    }
+
+    /// Normalised device coordinates and depth `[x, y, z]` of the 3D point (x, y, z) in the
+    /// current view (to mark a picked vertex); `undefined` behind the eye.
+    pub fn project(&self, x: f32, y: f32, z: f32) -> Option<Vec<f32>> {
+        crate::pick::project(&self.camera, self.aspect(), glam::Vec3::new(x, y, z))
+            .map(|p| p.to_vec())
+    }
+
+    fn aspect(&self) -> f32 {
+        self.config.width as f32 / self.config.height.max(1) as f32
     }
 
     /// Moves the camera closer (`factor` < 1) or farther (`factor` > 1).
