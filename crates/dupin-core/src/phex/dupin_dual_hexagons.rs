@@ -13,6 +13,14 @@
 //! of each of its triangles are consistent, so the initial mesh is already planar up to the
 //! conditioning of those planes; the Gauss-Newton pass of `planarity_optimisation` removes the
 //! rest.
+//!
+//! With the surface at hand ([`dual_mesh_options`], used by the pipeline), triangles in a
+//! parabolic region (section 6, step (1): K of mixed sign at the vertices, or |K| < 1e-8) get
+//! their centroid, as in the Dupin duality. Their tangent planes turn in one direction only, by
+//! a small net amount, so the planes can be nearly parallel yet above the rank cut-off, and
+//! their point is thrown far from the triangle (on the vase, along the meridian next to a
+//! parabolic circle, where it made a ring of hexagons self-intersect). The faces around them
+//! then start slightly non-planar and Gauss-Newton makes them planar.
 
 use super::PhexError;
 use super::triangulation::Triangulation;
@@ -72,7 +80,8 @@ pub fn tangent_plane_point(p: [Vec3; 3], n: [Vec3; 3]) -> Vec3 {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Initialisation {
     /// Tangent duality (section 4.1): the point of the three tangent planes nearest the
-    /// centroid. Faces start planar wherever the planes are well conditioned.
+    /// centroid, the centroid in parabolic regions (section 6, step (1)). Faces start planar
+    /// wherever the planes are well conditioned.
     #[default]
     TangentDuality,
     /// Approximate Dupin duality (section 6, steps 1 to 4: per-vertex Dupin centers averaged,
@@ -81,10 +90,19 @@ pub enum Initialisation {
     DupinDuality,
 }
 
-/// Parabolic threshold on |K| for [`Initialisation::DupinDuality`] (the paper's 1e-8).
+/// Parabolic threshold on |K| of the parabolic-region rule (the paper's 1e-8).
 pub const PARABOLIC_THRESHOLD: f64 = 1e-8;
 
-/// Builds the dual polygon mesh of `t` by tangent duality (section 6 initialisation).
+/// Section 6, step (1), parabolic region detection: the Gaussian curvatures `k` at a
+/// triangle's vertices are not all of one sign, or one of them is within
+/// [`PARABOLIC_THRESHOLD`] of zero.
+fn in_parabolic_region(k: [f64; 3]) -> bool {
+    let same_sign = k.iter().all(|&x| x > 0.0) || k.iter().all(|&x| x < 0.0);
+    !same_sign || k.iter().any(|x| x.abs() < PARABOLIC_THRESHOLD)
+}
+
+/// Builds the dual polygon mesh of `t` by tangent duality (section 6 initialisation), without
+/// the parabolic-region rule (no curvature at hand; see [`dual_mesh_options`]).
 ///
 /// Errors: [`PhexError::NoValidTriangulation`] when no interior vertex exists.
 pub fn dual_mesh(t: &Triangulation) -> Result<DualMesh, PhexError> {
@@ -114,7 +132,23 @@ pub fn dual_mesh_options(
     boundary_faces: bool,
 ) -> Result<DualMesh, PhexError> {
     let positions = match init {
-        Initialisation::TangentDuality => tangent_points(t),
+        Initialisation::TangentDuality => {
+            let k: Vec<Option<f64>> =
+                t.uv.iter()
+                    .map(|uv| surface.curvature(uv.x, uv.y).ok().map(|c| c.gaussian))
+                    .collect();
+            let mut points = tangent_points(t);
+            for (point, tr) in points.iter_mut().zip(&t.triangles) {
+                let parabolic = match tr.map(|i| k[i as usize]) {
+                    [Some(a), Some(b), Some(c)] => in_parabolic_region([a, b, c]),
+                    _ => true,
+                };
+                if parabolic {
+                    *point = tr.iter().map(|&i| t.positions[i as usize]).sum::<Vec3>() / 3.0;
+                }
+            }
+            points
+        }
         Initialisation::DupinDuality => {
             let curv: Vec<Option<crate::Curvature>> =
                 t.uv.iter()
@@ -346,6 +380,54 @@ mod tests {
                 assert!((x - p[k]).dot(&n[k]).abs() < 1e-9, "plane {k}");
             }
         }
+    }
+
+    #[test]
+    fn parabolic_region_is_mixed_signs_or_a_vanishing_curvature() {
+        assert!(!in_parabolic_region([1.0, 2.0, 0.5]));
+        assert!(!in_parabolic_region([-1.0, -2.0, -0.5]));
+        assert!(in_parabolic_region([1.0, -2.0, 0.5]));
+        assert!(in_parabolic_region([-1.0, 2.0, -0.5]));
+        assert!(in_parabolic_region([1.0, 2.0, 0.5 * PARABOLIC_THRESHOLD]));
+        assert!(in_parabolic_region([-1.0, -2.0, 0.0]));
+    }
+
+    #[test]
+    fn parabolic_triangles_get_their_centroid_and_the_rest_tangent_duality() {
+        // Section 6, step (1), on the vase profile whose ring next to the middle parabolic
+        // circle was invalid before the optimisation: triangles with K of mixed sign get the
+        // centroid, all others the tangent-plane point, and the initial mesh is valid.
+        let mut cfg = crate::phex_scene("vase-bottom-up").unwrap().config;
+        cfg.params = vec![("radius".into(), 1.0), ("amplitude".into(), 0.3)];
+        cfg.optimize = false;
+        let r = crate::phex_run(cfg.clone()).unwrap();
+        assert_eq!(r.report.invalid_faces, 0);
+        let t = &r.triangulation;
+        let s = crate::surface_by_name("vase", &[("radius", 1.0), ("amplitude", 0.3)]).unwrap();
+        let d = dual_mesh_options(t, s.as_ref(), Initialisation::TangentDuality, false).unwrap();
+        let plain = dual_mesh(t).unwrap();
+        let (mut parabolic, mut crossing) = (0, 0);
+        for (i, tr) in t.triangles.iter().enumerate() {
+            let v = tr.map(|j| t.uv[j as usize].y);
+            if v.iter().any(|&x| x < 1.5) && v.iter().any(|&x| x > 1.5) {
+                crossing += 1;
+            }
+            let k = tr.map(|v| {
+                let uv = t.uv[v as usize];
+                s.curvature(uv.x, uv.y).unwrap().gaussian
+            });
+            let p = tr.map(|v| t.positions[v as usize]);
+            let x = d.mesh.positions[i];
+            if in_parabolic_region(k) {
+                parabolic += 1;
+                assert!((x - (p[0] + p[1] + p[2]) / 3.0).norm() < 1e-12);
+            } else {
+                assert_eq!(x, plain.mesh.positions[i]);
+            }
+        }
+        // Every triangle across the circle v = 1.5 (one layer: two per base segment) is one.
+        assert_eq!(crossing, 2 * t.layers[0].len());
+        assert!(parabolic >= crossing, "{parabolic} parabolic triangles");
     }
 
     #[test]
