@@ -599,10 +599,9 @@ fn parabolic_ahead(
 
 /// Section 5.3, crossing a parabolic curve that runs along the layers: the step `h` is
 /// adjusted so that the parabolic curve lies midway in one layer, so that the vertex layers on
-/// both sides keep a distance from it. Off-centre, the vertex layer next to the curve has
-/// |K| near 0 and its hexagons, half of whose vertices come from the parabolic-region rule
-/// (triangle centroids), are distorted (vase radius 0.8, amplitude 0.16: shape deviation 1.11
-/// without the centring).
+/// both sides keep a distance from it. Off-centre, the three tangent planes of a crossing
+/// triangle are nearly but not exactly parallel and their dual point flies off along the
+/// meridian (an invalid ring of hexagons on the vase; see docs/phex.md).
 fn centre_crossing(
     s: &dyn Surface,
     spec: &TriangulationSpec,
