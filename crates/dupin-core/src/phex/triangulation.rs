@@ -593,7 +593,7 @@ fn parabolic_ahead(
         ds.push(0.5 * (lo + hi));
     }
     ds.sort_by(|a, b| a.total_cmp(b));
-    let (d0, d1) = (ds[0], ds[ds.len() - 1]);
+    let (d0, d1) = (*ds.first()?, *ds.last()?);
     (d1 - d0 < 0.05 * reach).then_some(0.5 * (d0 + d1))
 }
 
