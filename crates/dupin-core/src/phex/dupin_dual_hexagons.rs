@@ -13,6 +13,17 @@
 //! of each of its triangles are consistent, so the initial mesh is already planar up to the
 //! conditioning of those planes; the Gauss-Newton pass of `planarity_optimisation` removes the
 //! rest.
+//!
+//! With the surface at hand ([`dual_mesh_options`], used by the pipeline), a triangle in a
+//! parabolic region (section 6, step (1): K of mixed sign at the vertices, or |K| < 1e-8) whose
+//! tangent-plane point lies more than its longest edge from its centroid gets the centroid
+//! instead, as in the Dupin duality: there the tangent duality is unstable (section 6). On the
+//! vase next to a parabolic circle the normals turn across the layer by a small net amount, so
+//! the planes are nearly parallel yet above the rank cut-off and their point is thrown far
+//! along the meridian, which made a ring of hexagons self-intersect. Where the point stays near
+//! the triangle (the torus's and cyclide's parabolic circles) it is kept, so those faces still
+//! start planar. Faces around a replaced point start slightly non-planar; Gauss-Newton makes
+//! them planar.
 
 use super::PhexError;
 use super::triangulation::Triangulation;
@@ -72,7 +83,9 @@ pub fn tangent_plane_point(p: [Vec3; 3], n: [Vec3; 3]) -> Vec3 {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Initialisation {
     /// Tangent duality (section 4.1): the point of the three tangent planes nearest the
-    /// centroid. Faces start planar wherever the planes are well conditioned.
+    /// centroid; the centroid where that point is unstable in a parabolic region (section 6,
+    /// step (1), see the module docs). Faces start planar wherever the planes are well
+    /// conditioned.
     #[default]
     TangentDuality,
     /// Approximate Dupin duality (section 6, steps 1 to 4: per-vertex Dupin centers averaged,
@@ -81,10 +94,25 @@ pub enum Initialisation {
     DupinDuality,
 }
 
-/// Parabolic threshold on |K| for [`Initialisation::DupinDuality`] (the paper's 1e-8).
+/// In a parabolic region, a tangent-plane point farther than this many longest triangle edges
+/// from the centroid counts as unstable and is replaced by the centroid (0.5 and 1 both keep
+/// every scene's Gauss-Newton iteration count; without a limit the torus and cyclide scenes,
+/// whose points stay near their triangles, lose their planar start).
+const UNSTABLE_DISTANCE: f64 = 1.0;
+
+/// Parabolic threshold on |K| of the parabolic-region rule (the paper's 1e-8).
 pub const PARABOLIC_THRESHOLD: f64 = 1e-8;
 
-/// Builds the dual polygon mesh of `t` by tangent duality (section 6 initialisation).
+/// Section 6, step (1), parabolic region detection: the Gaussian curvatures `k` at a
+/// triangle's vertices are not all of one sign, or one of them is within
+/// [`PARABOLIC_THRESHOLD`] of zero.
+fn in_parabolic_region(k: [f64; 3]) -> bool {
+    let same_sign = k.iter().all(|&x| x > 0.0) || k.iter().all(|&x| x < 0.0);
+    !same_sign || k.iter().any(|x| x.abs() < PARABOLIC_THRESHOLD)
+}
+
+/// Builds the dual polygon mesh of `t` by tangent duality (section 6 initialisation), without
+/// the parabolic-region rule (no curvature at hand; see [`dual_mesh_options`]).
 ///
 /// Errors: [`PhexError::NoValidTriangulation`] when no interior vertex exists.
 pub fn dual_mesh(t: &Triangulation) -> Result<DualMesh, PhexError> {
@@ -114,7 +142,30 @@ pub fn dual_mesh_options(
     boundary_faces: bool,
 ) -> Result<DualMesh, PhexError> {
     let positions = match init {
-        Initialisation::TangentDuality => tangent_points(t),
+        Initialisation::TangentDuality => {
+            let k: Vec<Option<f64>> =
+                t.uv.iter()
+                    .map(|uv| surface.curvature(uv.x, uv.y).ok().map(|c| c.gaussian))
+                    .collect();
+            let mut points = tangent_points(t);
+            for (point, tr) in points.iter_mut().zip(&t.triangles) {
+                let parabolic = match tr.map(|i| k[i as usize]) {
+                    [Some(a), Some(b), Some(c)] => in_parabolic_region([a, b, c]),
+                    _ => true,
+                };
+                if parabolic {
+                    let p = tr.map(|i| t.positions[i as usize]);
+                    let c = (p[0] + p[1] + p[2]) / 3.0;
+                    let longest = (0..3)
+                        .map(|j| (p[j] - p[(j + 1) % 3]).norm())
+                        .fold(0.0, f64::max);
+                    if !((*point - c).norm() <= UNSTABLE_DISTANCE * longest) {
+                        *point = c;
+                    }
+                }
+            }
+            points
+        }
         Initialisation::DupinDuality => {
             let curv: Vec<Option<crate::Curvature>> =
                 t.uv.iter()
@@ -346,6 +397,88 @@ mod tests {
                 assert!((x - p[k]).dot(&n[k]).abs() < 1e-9, "plane {k}");
             }
         }
+    }
+
+    #[test]
+    fn parabolic_region_is_mixed_signs_or_a_vanishing_curvature() {
+        assert!(!in_parabolic_region([1.0, 2.0, 0.5]));
+        assert!(!in_parabolic_region([-1.0, -2.0, -0.5]));
+        assert!(in_parabolic_region([1.0, -2.0, 0.5]));
+        assert!(in_parabolic_region([-1.0, 2.0, -0.5]));
+        assert!(in_parabolic_region([1.0, 2.0, 0.5 * PARABOLIC_THRESHOLD]));
+        assert!(in_parabolic_region([-1.0, -2.0, 0.0]));
+    }
+
+    #[test]
+    fn unstable_parabolic_points_become_centroids_and_the_rest_stay_tangent_dual() {
+        // Section 6, step (1), on the vase over its whole domain: the base curve lies on the
+        // bottom parabolic circle, the first layer is not centred on it and its tangent-plane
+        // points fly off (52 invalid faces in the initial mesh). The unstable points of
+        // parabolic triangles become centroids, every other triangle keeps its tangent-plane
+        // point, and the initial mesh is valid.
+        let params = [("radius", 1.0), ("amplitude", 0.35)];
+        let mut cfg = crate::PhexConfig::for_surface(
+            "vase",
+            &[],
+            crate::TriangulationMethod::Prescribed,
+            Some(0.12),
+        );
+        cfg.optimize = false;
+        let r = crate::phex_run(cfg).unwrap();
+        assert_eq!(r.report.invalid_faces, 0);
+        let t = &r.triangulation;
+        let s = crate::surface_by_name("vase", &params).unwrap();
+        let d = dual_mesh_options(t, s.as_ref(), Initialisation::TangentDuality, false).unwrap();
+        let plain = dual_mesh(t).unwrap();
+        let mut replaced = 0;
+        for (i, tr) in t.triangles.iter().enumerate() {
+            let k = tr.map(|v| {
+                let uv = t.uv[v as usize];
+                s.curvature(uv.x, uv.y).unwrap().gaussian
+            });
+            let p = tr.map(|v| t.positions[v as usize]);
+            let c = (p[0] + p[1] + p[2]) / 3.0;
+            let longest = (0..3)
+                .map(|j| (p[j] - p[(j + 1) % 3]).norm())
+                .fold(0.0, f64::max);
+            let tangent = plain.mesh.positions[i];
+            if in_parabolic_region(k) && (tangent - c).norm() > longest {
+                replaced += 1;
+                assert!((d.mesh.positions[i] - c).norm() < 1e-12);
+            } else {
+                assert_eq!(d.mesh.positions[i], tangent);
+            }
+        }
+        assert!(replaced > 0);
+    }
+
+    #[test]
+    fn stable_parabolic_points_are_kept_on_the_torus() {
+        // The torus's parabolic circles: the tangent-plane points stay near their triangles,
+        // so the rule keeps the exact tangent duality and the faces start planar.
+        let mut cfg = crate::phex_scene("torus-bound").unwrap().config;
+        cfg.optimize = false;
+        let r = crate::phex_run(cfg).unwrap();
+        let t = &r.triangulation;
+        let s = crate::surface_by_name("torus", &[]).unwrap();
+        let parabolic = t
+            .triangles
+            .iter()
+            .filter(|tr| {
+                in_parabolic_region(tr.map(|v| {
+                    let uv = t.uv[v as usize];
+                    s.curvature(uv.x, uv.y).unwrap().gaussian
+                }))
+            })
+            .count();
+        assert!(parabolic > 100, "{parabolic} parabolic triangles");
+        let d = dual_mesh_options(t, s.as_ref(), Initialisation::TangentDuality, false).unwrap();
+        assert_eq!(d.mesh, dual_mesh(t).unwrap().mesh);
+        assert!(
+            r.report.max_planarity < 1e-12,
+            "{:e}",
+            r.report.max_planarity
+        );
     }
 
     #[test]

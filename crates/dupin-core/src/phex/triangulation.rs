@@ -21,6 +21,14 @@ pub const MAX_RATIO: f64 = 4.0;
 /// only grows large next to a parabolic curve).
 pub const MAX_RATIO_ELLIPTIC: f64 = 1.5;
 
+/// Position of a parabolic curve inside the layer that crosses it (see `centre_crossing`):
+/// midway, as the step re-use of section 5.3 intends (the layer straddles the curve).
+const CROSSING_FRACTION: f64 = 0.5;
+
+/// A parabolic curve closer than this share of the step is not centred on (the layer would
+/// be narrow; the parabolic-region rule of the dual mesh handles such a layer).
+const MIN_CROSSING: f64 = 0.25;
+
 /// Which triangulation method of section 5.2 to run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TriangulationMethod {
@@ -106,6 +114,11 @@ fn to_uv(swap: bool, along: f64, across: f64) -> Vec2 {
 /// Ratio |CM|/|AB| of the ideal triangle on AB (surface points with parameters `a`, `b`), or
 /// `None` where no ideal triangle exists (parabolic point, degenerate segment).
 pub(super) fn ideal_ratio(s: &dyn Surface, a: Vec2, b: Vec2) -> Option<f64> {
+    ideal_ratio_limited(s, a, b, MAX_RATIO_ELLIPTIC)
+}
+
+/// [`ideal_ratio`] with `elliptic_limit` in place of [`MAX_RATIO_ELLIPTIC`].
+fn ideal_ratio_limited(s: &dyn Surface, a: Vec2, b: Vec2, elliptic_limit: f64) -> Option<f64> {
     let m = (a + b) / 2.0;
     let curv = s.curvature(m.x, m.y).ok()?;
     let (pa, pb) = (s.position(a.x, a.y), s.position(b.x, b.y));
@@ -118,7 +131,7 @@ pub(super) fn ideal_ratio(s: &dyn Surface, a: Vec2, b: Vec2) -> Option<f64> {
     let ab = (pb - pa).norm();
     let r = (c - (pa + pb) / 2.0).norm() / ab;
     let limit = if curv.gaussian > 0.0 {
-        MAX_RATIO_ELLIPTIC
+        elliptic_limit
     } else {
         MAX_RATIO
     };
@@ -269,7 +282,21 @@ impl<'a> Builder<'a> {
                     let along: Vec<f64> = (0..self.layer_len(j))
                         .map(|i| self.along_at(j, i))
                         .collect();
-                    match layer_step(self.s, spec, &along, across, self.ds, prev_step) {
+                    let (s, ds) = (self.s, self.ds);
+                    match layer_step(s, spec, &along, across, ds, prev_step, MAX_RATIO_ELLIPTIC) {
+                        Some(h) if matches!(spec.rule, LayerRule::Ideal { .. }) => {
+                            // Section 5.3 re-uses the step only where the layers approach a
+                            // parabolic curve; moving away from one (a base curve next to it),
+                            // the large ideal ratio is kept: a re-used, flatter step makes the
+                            // elliptic hexagons of the next layer self-intersect.
+                            let h = if parabolic_ahead(s, spec, &along, across, 2.5 * h).is_none() {
+                                layer_step(s, spec, &along, across, ds, prev_step, MAX_RATIO)
+                                    .unwrap_or(h)
+                            } else {
+                                h
+                            };
+                            centre_crossing(s, spec, &along, across, h)
+                        }
                         Some(h) => h,
                         None => break,
                     }
@@ -479,6 +506,7 @@ fn layer_step(
     across: f64,
     ds: f64,
     prev: Option<f64>,
+    elliptic_limit: f64,
 ) -> Option<f64> {
     let mut hs = vec![];
     let stride = (along.len() / 16).max(1);
@@ -489,7 +517,7 @@ fn layer_step(
         let ab = (pb - pa).norm();
         let r = match spec.rule {
             LayerRule::Fixed(r) => Some(r),
-            LayerRule::Ideal { bound } => match ideal_ratio(s, a, b) {
+            LayerRule::Ideal { bound } => match ideal_ratio_limited(s, a, b, elliptic_limit) {
                 Some(r) if r < MAX_RATIO => Some(bounded_ratio(r, bound)),
                 _ => None,
             },
@@ -522,6 +550,81 @@ fn layer_step(
     (h.is_finite() && h > 0.0).then_some(h)
 }
 
+/// Distance (in the across parameter, >= 0) from `across` to the parabolic curve ahead, when
+/// K changes sign within `reach` on every sampled along-position of the layer (a parabolic
+/// curve running along the layers, as the vase's circle); `None` otherwise.
+fn parabolic_ahead(
+    s: &dyn Surface,
+    spec: &TriangulationSpec,
+    along: &[f64],
+    across: f64,
+    reach: f64,
+) -> Option<f64> {
+    let dir = if spec.end >= spec.start { 1.0 } else { -1.0 };
+    let k = |a: f64, x: f64| {
+        let p = to_uv(spec.swap, a, x);
+        s.curvature(p.x, p.y).ok().map(|c| c.gaussian)
+    };
+    let stride = (along.len() / 8).max(1);
+    let mut ds = vec![];
+    for &a in along.iter().step_by(stride) {
+        let k0 = k(a, across)?;
+        // Scan in 16 steps for a sign change, then bisect it.
+        let n = 16;
+        let mut lo = 0.0;
+        let mut hit = None;
+        for i in 1..=n {
+            let t = reach * i as f64 / n as f64;
+            if k(a, across + dir * t)? * k0 <= 0.0 {
+                hit = Some((lo, t));
+                break;
+            }
+            lo = t;
+        }
+        let (mut lo, mut hi) = hit?;
+        for _ in 0..40 {
+            let mid = 0.5 * (lo + hi);
+            if k(a, across + dir * mid)? * k0 > 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        ds.push(0.5 * (lo + hi));
+    }
+    ds.sort_by(|a, b| a.total_cmp(b));
+    let (d0, d1) = (*ds.first()?, *ds.last()?);
+    (d1 - d0 < 0.05 * reach).then_some(0.5 * (d0 + d1))
+}
+
+/// Section 5.3, crossing a parabolic curve that runs along the layers: the step `h` is
+/// adjusted so that the parabolic curve lies midway in one layer, so that the vertex layers on
+/// both sides keep a distance from it. Off-centre, the three tangent planes of a crossing
+/// triangle are nearly but not exactly parallel and their dual point flies off along the
+/// meridian (an invalid ring of hexagons on the vase; see docs/phex.md).
+fn centre_crossing(
+    s: &dyn Surface,
+    spec: &TriangulationSpec,
+    along: &[f64],
+    across: f64,
+    h: f64,
+) -> f64 {
+    let f = CROSSING_FRACTION;
+    match parabolic_ahead(s, spec, along, across, 2.5 * h) {
+        // Already (nearly) on the curve: a centred layer would be too narrow.
+        Some(d) if d < MIN_CROSSING * h => h,
+        // This layer crosses the curve (at most twice the step wide).
+        Some(d) if d <= f * 2.0 * h => d / f,
+        // Approach in whole steps no smaller than h (flatter triangles than ideal make the
+        // elliptic hexagons self-intersect) so that the crossing layer starts f h before it.
+        Some(d) => {
+            let rest = d - f * h;
+            (rest / (rest / h).floor().max(1.0)).max(h)
+        }
+        None => h,
+    }
+}
+
 /// Steps of a closed across-direction (method 2): the ideal steps around the period, scaled so
 /// that an even number of layers closes exactly.
 fn plan_closed_steps(
@@ -543,7 +646,7 @@ fn plan_closed_steps(
                 spec.max_layers
             )));
         }
-        let h = layer_step(s, spec, &along, x, ds, prev).ok_or_else(|| {
+        let h = layer_step(s, spec, &along, x, ds, prev, MAX_RATIO_ELLIPTIC).ok_or_else(|| {
             PhexError::NoValidTriangulation("no ideal triangle on the base curve".into())
         })?;
         prev = Some(h);
@@ -652,6 +755,30 @@ mod tests {
         let e: Vec<f64> = (0..3).map(|k| (tri[k] - tri[(k + 1) % 3]).norm()).collect();
         let mean = e.iter().sum::<f64>() / 3.0;
         assert!(e.iter().all(|x| (x - mean).abs() < 0.05 * mean), "{e:?}");
+    }
+
+    #[test]
+    fn layer_crossing_a_parabolic_circle_along_the_layers_is_centred_on_it() {
+        // Section 5.3 on the vase (method 2, bottom up): the middle parabolic circle v = 1.5
+        // runs along the layers and lies midway in the one layer that crosses it.
+        for (radius, amplitude) in [(1.0, 0.2), (1.0, 0.3), (1.0, 0.35), (0.8, 0.3), (1.3, 0.5)] {
+            let mut c = crate::phex_scene("vase-bottom-up").unwrap().config;
+            c.params = vec![("radius".into(), radius), ("amplitude".into(), amplitude)];
+            let p = crate::PhexPipeline::new(c).unwrap();
+            let t = p.triangulation();
+            let v: Vec<f64> = t.layers.iter().map(|l| t.uv[l[0] as usize].y).collect();
+            let j = v
+                .windows(2)
+                .position(|w| w[0] < 1.5 && w[1] > 1.5)
+                .expect("a layer crosses the circle");
+            let mid = 0.5 * (v[j] + v[j + 1]);
+            assert!(
+                (mid - 1.5).abs() < 1e-9 * (v[j + 1] - v[j]),
+                "radius {radius} amplitude {amplitude}: layer {} to {}",
+                v[j],
+                v[j + 1]
+            );
+        }
     }
 
     /// Property test: seeded random parameters of each surface family; the whole pipeline meets
