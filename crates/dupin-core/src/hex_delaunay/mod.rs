@@ -31,6 +31,7 @@ mod extended_refinement;
 mod hierarchy;
 mod lattice;
 mod min_enclosing_circle;
+mod pslg;
 mod quality;
 mod simple_refinement;
 mod stepper;
@@ -66,6 +67,10 @@ pub struct HexTriangulation {
     pub domain: [Vec2; 6],
     /// Deepest full-hexagon level reached (the paper's level is twice this).
     pub depth: u32,
+    /// The input segments as chains of triangle edges (vertex index pairs); empty without
+    /// segments. A triangle meets a segment iff it has a vertex of one of these edges; the
+    /// others keep the mode's angle bounds and the Delaunay property (section 7).
+    pub segment_edges: Vec<[u32; 2]>,
 }
 
 impl HexTriangulation {
@@ -78,6 +83,21 @@ impl HexTriangulation {
             a += (c[i] - c[0]).perp(&(c[i + 1] - c[0]));
         }
         0.5 * a
+    }
+
+    /// For every triangle, whether it meets a segment, i.e. has a vertex of
+    /// [`segment_edges`](Self::segment_edges): the triangles exempt from the mode's angle
+    /// bounds and the Delaunay property (section 7). All `false` without segments.
+    pub fn meets_segments(&self) -> Vec<bool> {
+        let mut on = vec![false; self.vertices.len()];
+        for e in &self.segment_edges {
+            on[e[0] as usize] = true;
+            on[e[1] as usize] = true;
+        }
+        self.triangles
+            .iter()
+            .map(|t| t.iter().any(|&v| on[v as usize]))
+            .collect()
     }
 
     /// The triangles as a polygon mesh with z = 0 (for OBJ output).
@@ -110,7 +130,7 @@ pub fn hex_delaunay(
 ) -> Result<HexTriangulation, HexDelaunayError> {
     let mut s = HexDelaunayStepper::new(points, segments, mode)?;
     s.run()?;
-    Ok(s.triangulation())
+    s.try_triangulation()
 }
 
 #[cfg(test)]
