@@ -78,10 +78,7 @@ impl HexDelaunayStepper {
             HexDelaunayMode::Simple => 2.0 * rho,
             HexDelaunayMode::Extended => 4.0 * rho,
         };
-        let base: Vec<[u32; 2]> = segments
-            .iter()
-            .map(|s| s.map(|i| input_map[i]))
-            .collect();
+        let base: Vec<[u32; 2]> = segments.iter().map(|s| s.map(|i| input_map[i])).collect();
         let mut s = Self::build(unique, input_map, circle.center, root, mode)?;
         s.segments = split_at_points(&s.refinement.points, &base);
         s.base_segments = base;
@@ -362,7 +359,9 @@ impl HexDelaunayStepper {
         let mut snapped: Vec<(Key, Vec2)> = Vec::new();
         if snap {
             for (key, p) in snapped_centres(&self.refinement, &self.segments) {
-                let before = moved.insert(key, p).unwrap_or_else(|| lattice_position(h, key));
+                let before = moved
+                    .insert(key, p)
+                    .unwrap_or_else(|| lattice_position(h, key));
                 snapped.push((key, before));
             }
         }
@@ -485,7 +484,10 @@ fn check_points(points: &[Vec2]) -> Result<(Vec<Vec2>, Vec<u32>), HexDelaunayErr
 }
 
 /// Checks segment indices, lengths and crossings (exact orientation predicates).
-fn check_segments(points: &[Vec2], segments: &[[usize; 2]]) -> Result<(), HexDelaunayError> {
+pub(super) fn check_segments(
+    points: &[Vec2],
+    segments: &[[usize; 2]],
+) -> Result<(), HexDelaunayError> {
     for (segment, s) in segments.iter().enumerate() {
         for &index in s {
             if index >= points.len() {
