@@ -71,7 +71,7 @@ pub fn run(args: HexDelaunayArgs) -> Result<(), CliError> {
         .collect();
     let qa = triangulation_quality(&tri.vertices, &away);
     write_text(&args.out, &write_obj(&tri.to_mesh()))?;
-    let report = serde_json::json!({
+    let mut report = serde_json::json!({
         "input_points": points.len(),
         "vertices": tri.vertices.len(),
         "triangles": tri.triangles.len(),
@@ -79,13 +79,21 @@ pub fn run(args: HexDelaunayArgs) -> Result<(), CliError> {
         "max_angle_deg": q.max_angle_deg,
         "delaunay": q.is_delaunay(),
         "seconds": seconds,
-        "segments": segments.len(),
-        "segment_edges": tri.segment_edges.len(),
-        "triangles_meeting_segments": tri.triangles.len() - away.len(),
-        "away_min_angle_deg": qa.min_angle_deg,
-        "away_max_angle_deg": qa.max_angle_deg,
-        "away_delaunay": qa.is_delaunay(),
     });
+    if !segments.is_empty() {
+        // Contract fields above; these extend the report only when segments were given.
+        let extra = serde_json::json!({
+            "segments": segments.len(),
+            "segment_edges": tri.segment_edges.len(),
+            "triangles_meeting_segments": tri.triangles.len() - away.len(),
+            "away_min_angle_deg": qa.min_angle_deg,
+            "away_max_angle_deg": qa.max_angle_deg,
+            "away_delaunay": qa.is_delaunay(),
+        });
+        if let (Some(r), Some(e)) = (report.as_object_mut(), extra.as_object()) {
+            r.extend(e.clone());
+        }
+    }
     write_report(args.report.as_deref(), &report)?;
     println!(
         "hexdelaunay: {} points -> {} vertices, {} triangles, angles {:.4}..{:.4} deg, delaunay {}, {:.3} s",

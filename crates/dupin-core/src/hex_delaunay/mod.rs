@@ -19,9 +19,12 @@
 //! nearby hexagon changes, and the dual is extracted by a recursion over the lattice triangles
 //! that costs O(1) per output triangle. See `hierarchy.rs`, `simple_refinement.rs`, `dual.rs`.
 //!
-//! Not implemented yet (each returns [`HexDelaunayError::Unsupported`] where it is asked for):
-//! PSLG input (section 7: segments are validated, then refused); in the extended refinement,
-//! MOVED_CENTER_3/4 relocations and blossom coarsening with split counters, merge and break
+//! PSLG input (section 7, `pslg.rs`): segments refine the hexagons they meet, the centres of
+//! met hexagons move onto them, and each segment becomes a chain of output edges
+//! ([`HexTriangulation::segment_edges`]); the mode's angle bounds and the Delaunay property
+//! hold for every triangle that does not meet a segment ([`HexTriangulation::meets_segments`]).
+//!
+//! Not implemented: in the extended refinement, MOVED_CENTER_3/4 relocations and blossom coarsening with split counters, merge and break
 //! (sections 3.2, 5.3; MOVED_CENTER_3 hexagons are subdivided instead, see
 //! `extended_refinement.rs`). Incremental insertion is [`HexDelaunayStepper::insert`].
 
@@ -118,11 +121,12 @@ pub const MIN_EXTENT: f64 = 1e-100;
 /// Cap on the full-hexagon levels of the hierarchy.
 pub const MAX_LEVEL: u32 = 48;
 
-/// Triangulates `points` (and, once implemented, the segments `segments`, each a pair of point
-/// indices) by hexagonal subdivision. One-shot form of [`HexDelaunayStepper`].
+/// Triangulates `points` and the segments `segments` (each a pair of point indices; they may
+/// share endpoints but not cross or overlap) by hexagonal subdivision. One-shot form of
+/// [`HexDelaunayStepper`].
 ///
 /// Errors: empty input, NaN/infinite or out-of-range coordinates, points too close for the
-/// hierarchy depth cap, bad segments, or an unimplemented mode.
+/// hierarchy depth cap, bad segments, or a numerical breakdown of the segment insertion.
 pub fn hex_delaunay(
     points: &[Vec2],
     segments: &[[usize; 2]],

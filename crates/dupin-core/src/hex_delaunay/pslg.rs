@@ -821,7 +821,13 @@ pub(crate) mod tests {
         for mode in [HexDelaunayMode::Simple, HexDelaunayMode::Extended] {
             let t = hex_delaunay(&pts, &segs, mode).unwrap();
             let (n, exempt) = check_pslg(&t, &pts, &segs, mode, "IMR");
-            eprintln!("IMR {mode:?}: {n} triangles, {exempt} meet a segment");
+            assert!(exempt < n);
+            let alone = hex_delaunay(&pts, &[], mode).unwrap().triangles.len();
+            eprintln!(
+                "IMR {mode:?}: {n} triangles ({alone} for the points alone), {exempt} meet a \
+                 segment, {} segment edges",
+                t.segment_edges.len()
+            );
         }
     }
 }

@@ -152,7 +152,9 @@ impl HexDelaunayStepper {
         })
     }
 
-    /// One subdivision step. Returns `Ok(false)` once refinement is finished.
+    /// One subdivision step. Returns `Ok(false)` once refinement is finished. With segments,
+    /// once the point rules (and extended passes) find nothing, one pass of the segment rules
+    /// (section 7.2, see `pslg.rs`) is one step.
     pub fn step(&mut self) -> Result<bool, HexDelaunayError> {
         self.last = self.refinement.step()?;
         if self.mode == HexDelaunayMode::Extended {
