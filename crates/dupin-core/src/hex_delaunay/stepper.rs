@@ -343,7 +343,11 @@ impl HexDelaunayStepper {
         let (mut t, segs, orig) = self.dual(with_segments);
         if with_segments {
             undo_inverting_snaps(&mut t.vertices, &t.triangles, &orig);
-            t.segment_edges = insert_segments(&mut t.vertices, &mut t.triangles, &segs)?;
+            let mut fixed = vec![false; t.vertices.len()];
+            for &v in &t.input_vertex {
+                fixed[v as usize] = true;
+            }
+            t.segment_edges = insert_segments(&mut t.vertices, &mut t.triangles, &segs, fixed)?;
         }
         Ok(t)
     }
