@@ -60,8 +60,18 @@ pub fn run(args: HexDelaunayArgs) -> Result<(), CliError> {
     let tri = hex_delaunay(&points, &segments, mode).map_err(|e| CliError::input("", e))?;
     let seconds = start.elapsed().as_secs_f64();
     let q = triangulation_quality(&tri.vertices, &tri.triangles);
+    // With segments (section 7) the bounds hold only for triangles that do not meet one.
+    let meets = tri.meets_segments();
+    let away: Vec<[u32; 3]> = tri
+        .triangles
+        .iter()
+        .zip(&meets)
+        .filter(|&(_, &m)| !m)
+        .map(|(t, _)| *t)
+        .collect();
+    let qa = triangulation_quality(&tri.vertices, &away);
     write_text(&args.out, &write_obj(&tri.to_mesh()))?;
-    let report = serde_json::json!({
+    let mut report = serde_json::json!({
         "input_points": points.len(),
         "vertices": tri.vertices.len(),
         "triangles": tri.triangles.len(),
@@ -70,6 +80,20 @@ pub fn run(args: HexDelaunayArgs) -> Result<(), CliError> {
         "delaunay": q.is_delaunay(),
         "seconds": seconds,
     });
+    if !segments.is_empty() {
+        // Contract fields above; these extend the report only when segments were given.
+        let extra = serde_json::json!({
+            "segments": segments.len(),
+            "segment_edges": tri.segment_edges.len(),
+            "triangles_meeting_segments": tri.triangles.len() - away.len(),
+            "away_min_angle_deg": qa.min_angle_deg,
+            "away_max_angle_deg": qa.max_angle_deg,
+            "away_delaunay": qa.is_delaunay(),
+        });
+        if let (Some(r), Some(e)) = (report.as_object_mut(), extra.as_object()) {
+            r.extend(e.clone());
+        }
+    }
     write_report(args.report.as_deref(), &report)?;
     println!(
         "hexdelaunay: {} points -> {} vertices, {} triangles, angles {:.4}..{:.4} deg, delaunay {}, {:.3} s",
@@ -81,5 +105,16 @@ pub fn run(args: HexDelaunayArgs) -> Result<(), CliError> {
         q.is_delaunay(),
         seconds
     );
+    if !segments.is_empty() {
+        println!(
+            "hexdelaunay: {} segments as {} edges; {} triangles meet them; the others: angles {:.4}..{:.4} deg, delaunay {}",
+            segments.len(),
+            tri.segment_edges.len(),
+            tri.triangles.len() - away.len(),
+            qa.min_angle_deg,
+            qa.max_angle_deg,
+            qa.is_delaunay()
+        );
+    }
     Ok(())
 }

@@ -152,8 +152,11 @@ fn bad_input_exits_2_with_one_error_line() {
     assert!(bad(square, Some("0 1\n2 3\n"), &[]).contains("cross"));
     assert!(bad(square, Some("0 9\n"), &[]).contains("point 9"));
     assert!(bad(square, Some("0 1\nx\n"), &[]).contains("line 2"));
-    // PSLG refinement (section 7) is not implemented: valid segments are refused clearly.
-    assert!(bad(square, Some("0 2\n"), &[]).contains("not implemented"));
+    // Overlapping collinear segments and zero-length ones are refused too.
+    let line = "0 0\n1 0\n2 0\n3 0\n";
+    assert!(bad(line, Some("0 2\n1 3\n"), &[]).contains("cross"));
+    assert!(bad(line, Some("0 3\n1 2\n"), &["--mode", "extended"]).contains("cross"));
+    assert!(bad("0 0\n1 0\n0 0\n", Some("0 2\n"), &[]).contains("zero length"));
     assert!(bad(square, None, &["--mode", "fancy"]).contains("error"));
     let missing = temp("missing.txt", None);
     let out = temp("out.obj", None);
@@ -166,4 +169,72 @@ fn bad_input_exits_2_with_one_error_line() {
     ]);
     assert_eq!(code, 2);
     assert!(stderr.starts_with("error:"));
+}
+
+#[test]
+fn pslg_segments_become_edges_and_report_the_exempt_triangles() {
+    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../dupin-core/tests/data/");
+    let pts = format!("{data}imr_points.txt");
+    let segs = format!("{data}imr_segments.txt");
+    for (mode, lo, hi) in [("simple", 29.99, 120.01), ("extended", 43.89, 90.0001)] {
+        let out = temp("out.obj", None);
+        let rep = temp("r.json", None);
+        let (code, stdout, stderr) = run(&[
+            "hexdelaunay",
+            "--points",
+            &pts,
+            "--segments",
+            &segs,
+            "--mode",
+            mode,
+            "--out",
+            out.to_str().unwrap(),
+            "--report",
+            rep.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{stderr}");
+        assert!(stdout.contains("75 segments"), "{stdout}");
+        let r: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&rep).unwrap()).unwrap();
+        assert_eq!(r["input_points"], 75);
+        assert_eq!(r["segments"], 75);
+        assert!(r["segment_edges"].as_u64().unwrap() >= 75, "{r}");
+        assert!(r["triangles_meeting_segments"].as_u64().unwrap() > 0, "{r}");
+        assert!(r["away_min_angle_deg"].as_f64().unwrap() >= lo, "{r}");
+        assert!(r["away_max_angle_deg"].as_f64().unwrap() <= hi, "{r}");
+        assert_eq!(r["away_delaunay"], true, "{r}");
+        let mesh = dupin_core::parse_obj(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        assert_eq!(mesh.num_faces() as u64, r["triangles"].as_u64().unwrap());
+        // Each segment's endpoints are exact vertices and the segment is covered by edges:
+        // the edges lying on it (all vertices within 2e-9 of its length) sum to its length.
+        let p = dupin_core::parse_points(&std::fs::read_to_string(&pts).unwrap()).unwrap();
+        let s = dupin_core::parse_segments(&std::fs::read_to_string(&segs).unwrap()).unwrap();
+        let mut edges = std::collections::HashSet::new();
+        for vs in mesh.faces() {
+            for i in 0..vs.len() {
+                let (a, b) = (vs[i] as usize, vs[(i + 1) % vs.len()] as usize);
+                edges.insert((a.min(b), a.max(b)));
+            }
+        }
+        for [i, j] in s {
+            let (a, b) = (p[i], p[j]);
+            let d = b - a;
+            let on = |v: usize| {
+                let q = mesh.positions[v];
+                let q = dupin_core::Vec2::new(q.x, q.y);
+                let t = (q - a).dot(&d) / d.norm_squared();
+                d.perp(&(q - a)).abs() <= 2e-9 * d.norm_squared() && (0.0..=1.0).contains(&t)
+            };
+            let covered: f64 = edges
+                .iter()
+                .filter(|&&(u, v)| on(u) && on(v))
+                .map(|&(u, v)| (mesh.positions[u] - mesh.positions[v]).norm())
+                .sum();
+            assert!(
+                (covered - d.norm()).abs() <= 1e-9 * d.norm(),
+                "{mode}: segment {i}-{j} covered {covered} of {}",
+                d.norm()
+            );
+        }
+    }
 }

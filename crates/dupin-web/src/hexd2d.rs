@@ -4,8 +4,9 @@
 //! Input: points (and segments) the user places, and a mode. Output for drawing: the current
 //! hexagon cells after each subdivision step, the dual triangulation, and its angle statistics
 //! (min, max, a histogram in 2-degree bins) to compare with the paper's bounds (simple mode
-//! [30, 120] degrees, extended [43.9, 90]). Whatever the core refuses (segments, until PSLG input
-//! lands) comes back as the core's error message.
+//! [30, 120] degrees, extended [43.9, 90]; with segments (section 7) the bounds hold only for
+//! triangles that do not meet a segment). Whatever the core refuses (crossing segments, bad
+//! points) comes back as the core's error message.
 
 use dupin_core::{HexDelaunayMode, HexDelaunayStepper, Vec2, triangulation_quality};
 use serde::Serialize;
@@ -142,7 +143,7 @@ impl HexDelaunayLab {
     }
 
     /// Replaces the input and restarts at the bounding hexagon: `xy` holds x y pairs, `segments`
-    /// point-index pairs. Throws the core's message (bad points, segments not implemented...).
+    /// point-index pairs. Throws the core's message (bad points, crossing segments...).
     #[wasm_bindgen(js_name = setInput)]
     pub fn set_input_js(&mut self, xy: Vec<f64>, segments: Vec<u32>) -> Result<(), JsError> {
         self.set_input(&xy, &segments).map_err(|e| JsError::new(&e))
@@ -217,8 +218,20 @@ mod tests {
     #[test]
     fn refusals_carry_the_core_message() {
         let mut lab = HexDelaunayLab::with_mode("simple").unwrap();
-        let e = lab.set_input(&[0.0, 0.0, 1.0, 0.0, 0.0, 1.0], &[0, 1]);
-        assert!(e.unwrap_err().contains("not implemented"));
+        // Segments are triangulated (section 7); crossing ones are refused with the reason.
+        lab.set_input(&[0.0, 0.0, 1.0, 0.0, 0.0, 1.0], &[0, 1])
+            .unwrap();
+        while lab.stepper.as_mut().unwrap().step().unwrap() {}
+        assert!(
+            !lab.stepper
+                .as_ref()
+                .unwrap()
+                .triangulation()
+                .segment_edges
+                .is_empty()
+        );
+        let e = lab.set_input(&[0.0, 0.0, 1.0, 1.0, 0.0, 1.0, 1.0, 0.0], &[0, 1, 2, 3]);
+        assert!(e.unwrap_err().contains("cross"));
         assert!(lab.set_input(&[0.0, f64::NAN], &[]).is_err());
         assert!(lab.set_input(&[0.0], &[]).is_err());
         assert!(lab.set_input(&[], &[]).is_err());

@@ -73,6 +73,14 @@ pub enum HexDelaunayError {
         /// Index of the second segment (0-based).
         second: usize,
     },
+    /// A segment could not be inserted as a chain of triangle edges (a numerical failure of
+    /// the walk through the triangles; not expected for valid input, reported rather than
+    /// looping or panicking).
+    #[error("segment {segment} could not be inserted into the triangulation")]
+    SegmentInsertion {
+        /// Index of the segment after splitting at points on it (0-based).
+        segment: usize,
+    },
     /// A requested feature is not implemented yet; the message says which.
     #[error("not implemented: {0}")]
     Unsupported(&'static str),

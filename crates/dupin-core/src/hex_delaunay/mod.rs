@@ -19,9 +19,12 @@
 //! nearby hexagon changes, and the dual is extracted by a recursion over the lattice triangles
 //! that costs O(1) per output triangle. See `hierarchy.rs`, `simple_refinement.rs`, `dual.rs`.
 //!
-//! Not implemented yet (each returns [`HexDelaunayError::Unsupported`] where it is asked for):
-//! PSLG input (section 7: segments are validated, then refused); in the extended refinement,
-//! MOVED_CENTER_3/4 relocations and blossom coarsening with split counters, merge and break
+//! PSLG input (section 7, `pslg.rs`): segments refine the hexagons they meet, the centres of
+//! met hexagons move onto them, and each segment becomes a chain of output edges
+//! ([`HexTriangulation::segment_edges`]); the mode's angle bounds and the Delaunay property
+//! hold for every triangle that does not meet a segment ([`HexTriangulation::meets_segments`]).
+//!
+//! Not implemented: in the extended refinement, MOVED_CENTER_3/4 relocations and blossom coarsening with split counters, merge and break
 //! (sections 3.2, 5.3; MOVED_CENTER_3 hexagons are subdivided instead, see
 //! `extended_refinement.rs`). Incremental insertion is [`HexDelaunayStepper::insert`].
 
@@ -31,6 +34,7 @@ mod extended_refinement;
 mod hierarchy;
 mod lattice;
 mod min_enclosing_circle;
+mod pslg;
 mod quality;
 mod simple_refinement;
 mod stepper;
@@ -66,6 +70,10 @@ pub struct HexTriangulation {
     pub domain: [Vec2; 6],
     /// Deepest full-hexagon level reached (the paper's level is twice this).
     pub depth: u32,
+    /// The input segments as chains of triangle edges (vertex index pairs); empty without
+    /// segments. A triangle meets a segment iff it has a vertex of one of these edges; the
+    /// others keep the mode's angle bounds and the Delaunay property (section 7).
+    pub segment_edges: Vec<[u32; 2]>,
 }
 
 impl HexTriangulation {
@@ -78,6 +86,21 @@ impl HexTriangulation {
             a += (c[i] - c[0]).perp(&(c[i + 1] - c[0]));
         }
         0.5 * a
+    }
+
+    /// For every triangle, whether it meets a segment, i.e. has a vertex of
+    /// [`segment_edges`](Self::segment_edges): the triangles exempt from the mode's angle
+    /// bounds and the Delaunay property (section 7). All `false` without segments.
+    pub fn meets_segments(&self) -> Vec<bool> {
+        let mut on = vec![false; self.vertices.len()];
+        for e in &self.segment_edges {
+            on[e[0] as usize] = true;
+            on[e[1] as usize] = true;
+        }
+        self.triangles
+            .iter()
+            .map(|t| t.iter().any(|&v| on[v as usize]))
+            .collect()
     }
 
     /// The triangles as a polygon mesh with z = 0 (for OBJ output).
@@ -98,11 +121,12 @@ pub const MIN_EXTENT: f64 = 1e-100;
 /// Cap on the full-hexagon levels of the hierarchy.
 pub const MAX_LEVEL: u32 = 48;
 
-/// Triangulates `points` (and, once implemented, the segments `segments`, each a pair of point
-/// indices) by hexagonal subdivision. One-shot form of [`HexDelaunayStepper`].
+/// Triangulates `points` and the segments `segments` (each a pair of point indices; they may
+/// share endpoints but not cross or overlap) by hexagonal subdivision. One-shot form of
+/// [`HexDelaunayStepper`].
 ///
 /// Errors: empty input, NaN/infinite or out-of-range coordinates, points too close for the
-/// hierarchy depth cap, bad segments, or an unimplemented mode.
+/// hierarchy depth cap, bad segments, or a numerical breakdown of the segment insertion.
 pub fn hex_delaunay(
     points: &[Vec2],
     segments: &[[usize; 2]],
@@ -110,7 +134,7 @@ pub fn hex_delaunay(
 ) -> Result<HexTriangulation, HexDelaunayError> {
     let mut s = HexDelaunayStepper::new(points, segments, mode)?;
     s.run()?;
-    Ok(s.triangulation())
+    s.try_triangulation()
 }
 
 #[cfg(test)]

@@ -100,6 +100,11 @@ impl Refinement {
         }
     }
 
+    /// The points (distinct-point indices) in the leaf cell `c`.
+    pub fn occupants_of(&self, c: &Cell) -> &[u32] {
+        self.occupants.get(c).map_or(&[], Vec::as_slice)
+    }
+
     fn occupied(&self, c: &Cell) -> usize {
         self.occupants.get(c).map_or(0, Vec::len)
     }

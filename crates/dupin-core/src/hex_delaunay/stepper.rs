@@ -7,6 +7,9 @@ use super::extended_refinement::{ExtendedState, extended_pass, relocated_centres
 use super::hierarchy::{Cell, Hierarchy};
 use super::lattice::{Axial, DIRS, Frame, add, parents_of_midpoint};
 use super::min_enclosing_circle::min_enclosing_circle;
+use super::pslg::{
+    insert_segments, segment_pass, snapped_centres, split_at_points, undo_inverting_snaps,
+};
 use super::simple_refinement::Refinement;
 use super::{HexDelaunayMode, HexTriangulation, MAX_COORDINATE, MAX_LEVEL, MIN_EXTENT};
 use crate::math::Vec2;
@@ -38,6 +41,12 @@ pub struct HexDelaunayStepper {
     /// splits and insertions.
     extended_clean: bool,
     extended: ExtendedState,
+    /// Input segments as distinct-point index pairs.
+    base_segments: Vec<[u32; 2]>,
+    /// `base_segments` split at the points lying on them (what refinement and dual use).
+    segments: Vec<[u32; 2]>,
+    /// Whether the last segment pass found nothing to split; reset by any split.
+    segments_clean: bool,
 }
 
 impl HexDelaunayStepper {
@@ -49,11 +58,6 @@ impl HexDelaunayStepper {
     ) -> Result<Self, HexDelaunayError> {
         let (unique, input_map) = check_points(points)?;
         check_segments(points, segments)?;
-        if !segments.is_empty() {
-            return Err(HexDelaunayError::Unsupported(
-                "PSLG segments (section 7); triangulate the points alone",
-            ));
-        }
         let circle = min_enclosing_circle(&unique).ok_or(HexDelaunayError::Empty)?;
         let rho = if unique.len() > 1 {
             if circle.radius < MIN_EXTENT {
@@ -74,7 +78,11 @@ impl HexDelaunayStepper {
             HexDelaunayMode::Simple => 2.0 * rho,
             HexDelaunayMode::Extended => 4.0 * rho,
         };
-        Self::build(unique, input_map, circle.center, root, mode)
+        let base: Vec<[u32; 2]> = segments.iter().map(|s| s.map(|i| input_map[i])).collect();
+        let mut s = Self::build(unique, input_map, circle.center, root, mode)?;
+        s.segments = split_at_points(&s.refinement.points, &base);
+        s.base_segments = base;
+        Ok(s)
     }
 
     /// Like [`new`](Self::new) but triangulating a given bounding hexagon Ω (centre `center`,
@@ -138,10 +146,15 @@ impl HexDelaunayStepper {
             mode,
             extended_clean: false,
             extended: ExtendedState::default(),
+            base_segments: Vec::new(),
+            segments: Vec::new(),
+            segments_clean: true,
         })
     }
 
-    /// One subdivision step. Returns `Ok(false)` once refinement is finished.
+    /// One subdivision step. Returns `Ok(false)` once refinement is finished. With segments,
+    /// once the point rules (and extended passes) find nothing, one pass of the segment rules
+    /// (section 7.2, see `pslg.rs`) is one step.
     pub fn step(&mut self) -> Result<bool, HexDelaunayError> {
         self.last = self.refinement.step()?;
         if self.mode == HexDelaunayMode::Extended {
@@ -152,6 +165,17 @@ impl HexDelaunayStepper {
             } else {
                 self.extended.record(&self.last);
             }
+        }
+        if self.last.is_empty() && !self.segments.is_empty() {
+            // Point rules exhausted: one pass of the segment rules (section 7.2) is one step.
+            self.last = segment_pass(&mut self.refinement, &self.segments)?;
+            self.segments_clean = self.last.is_empty();
+            if !self.segments_clean {
+                self.extended_clean = false;
+                self.extended.record(&self.last);
+            }
+        } else if !self.last.is_empty() {
+            self.segments_clean = self.segments.is_empty();
         }
         if self.last.is_empty() {
             Ok(false)
@@ -197,6 +221,10 @@ impl HexDelaunayStepper {
         }
         self.extended_clean = false;
         self.extended.reset();
+        if !self.base_segments.is_empty() {
+            self.segments = split_at_points(&self.refinement.points, &self.base_segments);
+            self.segments_clean = false;
+        }
         Ok(())
     }
 
@@ -207,7 +235,7 @@ impl HexDelaunayStepper {
 
     /// Runs all remaining steps.
     pub fn run(&mut self) -> Result<(), HexDelaunayError> {
-        if self.mode == HexDelaunayMode::Simple {
+        if self.mode == HexDelaunayMode::Simple && self.segments.is_empty() {
             return self.refinement.run();
         }
         while self.step()? {}
@@ -216,7 +244,9 @@ impl HexDelaunayStepper {
 
     /// Whether refinement is finished.
     pub fn is_done(&self) -> bool {
-        self.refinement.is_done() && (self.mode == HexDelaunayMode::Simple || self.extended_clean)
+        self.refinement.is_done()
+            && (self.mode == HexDelaunayMode::Simple || self.extended_clean)
+            && self.segments_clean
     }
 
     /// Number of steps taken through [`step`](Self::step).
@@ -295,13 +325,52 @@ impl HexDelaunayStepper {
     }
 
     /// The dual triangulation of the current hexagon mesh, occupied centres moved to their
-    /// points. Input points are exact vertices only once refinement is finished.
+    /// points. Input points are exact vertices only once refinement is finished; segments are
+    /// edge chains only then too. Should the segment insertion break down numerically (see
+    /// [`HexDelaunayError::SegmentInsertion`]), the triangulation is returned without the
+    /// segments and [`HexTriangulation::segment_edges`] is empty; [`crate::hex_delaunay`]
+    /// reports that error instead.
     pub fn triangulation(&self) -> HexTriangulation {
+        match self.try_triangulation() {
+            Ok(t) => t,
+            Err(_) => self.dual(false).0,
+        }
+    }
+
+    /// [`triangulation`](Self::triangulation), failing if a segment cannot be inserted.
+    pub fn try_triangulation(&self) -> Result<HexTriangulation, HexDelaunayError> {
+        let with_segments = self.is_done() && !self.segments.is_empty();
+        let (mut t, segs, orig) = self.dual(with_segments);
+        if with_segments {
+            undo_inverting_snaps(&mut t.vertices, &t.triangles, &orig);
+            let mut fixed = vec![false; t.vertices.len()];
+            for &v in &t.input_vertex {
+                fixed[v as usize] = true;
+            }
+            t.segment_edges = insert_segments(&mut t.vertices, &mut t.triangles, &segs, fixed)?;
+        }
+        Ok(t)
+    }
+
+    /// The dual, with the segments' hexagons snapped onto them if `snap`; also returns the
+    /// segments as vertex pairs and the unsnapped positions of the snapped vertices.
+    fn dual(&self, snap: bool) -> (HexTriangulation, Vec<[u32; 2]>, FxHashMap<u32, Vec2>) {
         let h = &self.refinement.hierarchy;
         let mut moved: FxHashMap<Key, Vec2> = match self.mode {
             HexDelaunayMode::Extended if self.is_done() => relocated_centres(&self.refinement),
             _ => FxHashMap::default(),
         };
+        // Section 7.3: unoccupied hexagons met by one segment move onto it; their previous
+        // positions are kept so that a snap inverting a triangle can be undone.
+        let mut snapped: Vec<(Key, Vec2)> = Vec::new();
+        if snap {
+            for (key, p) in snapped_centres(&self.refinement, &self.segments) {
+                let before = moved
+                    .insert(key, p)
+                    .unwrap_or_else(|| lattice_position(h, key));
+                snapped.push((key, before));
+            }
+        }
         let mut point_key = Vec::with_capacity(self.refinement.points.len());
         for (i, c) in self.refinement.cell_of.iter().enumerate() {
             let key = match *c {
@@ -322,7 +391,16 @@ impl HexDelaunayStepper {
                     .unwrap_or(u32::MAX)
             })
             .collect();
-        HexTriangulation {
+        let orig = snapped
+            .into_iter()
+            .filter_map(|(key, before)| dual.moved_vertex.get(&key).map(|&v| (v, before)))
+            .collect();
+        let segs = self
+            .segments
+            .iter()
+            .map(|s| s.map(|u| unique_vertex[u as usize]))
+            .collect();
+        let t = HexTriangulation {
             vertices: dual.positions,
             triangles: dual.triangles,
             input_vertex: self
@@ -332,8 +410,17 @@ impl HexDelaunayStepper {
                 .collect(),
             domain: h.frame.domain_corners(),
             depth: h.depth(),
-        }
+            segment_edges: Vec::new(),
+        };
+        (t, segs, orig)
     }
+}
+
+/// The lattice position of a packed dual key.
+fn lattice_position(h: &Hierarchy, key: Key) -> Vec2 {
+    let level = (key.0 >> 56) as u32;
+    let a = (key.0 & ((1 << 56) - 1)) - (1 << 50);
+    h.frame.position(level, (a, key.1))
 }
 
 fn bits(p: &Vec2) -> (u64, u64) {
@@ -403,7 +490,10 @@ fn check_points(points: &[Vec2]) -> Result<(Vec<Vec2>, Vec<u32>), HexDelaunayErr
 }
 
 /// Checks segment indices, lengths and crossings (exact orientation predicates).
-fn check_segments(points: &[Vec2], segments: &[[usize; 2]]) -> Result<(), HexDelaunayError> {
+pub(super) fn check_segments(
+    points: &[Vec2],
+    segments: &[[usize; 2]],
+) -> Result<(), HexDelaunayError> {
     for (segment, s) in segments.iter().enumerate() {
         for &index in s {
             if index >= points.len() {
