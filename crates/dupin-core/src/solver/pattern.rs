@@ -35,6 +35,12 @@ enum Symbolic {
 }
 
 /// A square sparse matrix assembled repeatedly from the same index pattern.
+///
+/// Two assembly modes: while a pattern is being built ([`Self::begin`]) positions and values
+/// are recorded; once the pattern is analysed ([`Self::begin_values_only`]) every pushed
+/// value goes straight to its precomputed CSC slot (no intermediate list, no sorting). A
+/// base point ([`Self::mark_base`]) lets the caller redo the tail of an assembly (e.g. the
+/// damping terms of a retried step) without redoing the rest.
 pub(crate) struct PatternMatrix {
     kind: Factor,
     n: usize,
@@ -43,14 +49,25 @@ pub(crate) struct PatternMatrix {
     /// Cached analysis: the CSC pattern, the CSC slot of every assembled entry (so assembly
     /// is a scatter-add without re-sorting or allocating) and the symbolic factorisation.
     cached: Option<(SymbolicSparseColMat<u32>, Vec<u32>, Symbolic)>,
-    /// CSC values of the matrix being factored.
+    /// CSC values of the matrix being factored (filled directly in values-only mode).
     csc_values: Vec<f64>,
-    /// Pairs of the matrix being assembled.
-    pub new_pairs: Vec<(u32, u32)>,
-    /// Values of the matrix being assembled, aligned with `new_pairs`.
-    pub values: Vec<f64>,
-    /// The caller promised the same pattern as the cached one (values only were pushed).
+    /// CSC values at the base point, restored by [`Self::truncate_to_base`].
+    csc_base: Vec<f64>,
+    /// Whether `csc_base` holds the base point of the current assembly.
+    base_valid: bool,
+    /// Number of entries pushed before the base point.
+    base_len: usize,
+    /// Number of entries pushed in values-only mode (index into the cached slots).
+    cursor: usize,
+    /// Pairs of the matrix being assembled (build mode).
+    new_pairs: Vec<(u32, u32)>,
+    /// Values of the matrix being assembled, aligned with `new_pairs` (build mode).
+    values: Vec<f64>,
+    /// Values-only mode: entries follow the cached pattern and go straight to `csc_values`.
     same_pattern: bool,
+    /// The cached slots follow the entry order of the last build-mode assembly (false while
+    /// a new one has not been analysed, e.g. after a failed analysis).
+    fresh: bool,
 }
 
 impl PatternMatrix {
@@ -61,53 +78,83 @@ impl PatternMatrix {
             pairs: Vec::new(),
             cached: None,
             csc_values: Vec::new(),
+            csc_base: Vec::new(),
+            base_valid: false,
+            base_len: 0,
+            cursor: 0,
             new_pairs: Vec::new(),
             values: Vec::new(),
             same_pattern: false,
+            fresh: false,
         }
     }
 
     /// Whether a pattern has been analysed for size `n` (so values-only assembly is possible).
     pub(crate) fn has_pattern(&self, n: usize) -> bool {
-        self.cached.is_some() && self.n == n
+        self.cached.is_some() && self.n == n && self.fresh
     }
 
-    /// Starts a values-only assembly: the caller pushes values with [`Self::add_value`] in the
-    /// exact order of the cached pattern.
+    /// Starts a values-only assembly: the caller pushes values with [`Self::push`] in the
+    /// exact order of the cached pattern (see [`Self::has_pattern`]).
     pub(crate) fn begin_values_only(&mut self) {
-        self.values.clear();
+        debug_assert!(self.cached.is_some());
+        let nnz = self.cached.as_ref().map_or(0, |c| c.0.row_idx().len());
+        self.csc_values.clear();
+        self.csc_values.resize(nnz, 0.0);
+        self.cursor = 0;
+        self.base_valid = false;
         self.same_pattern = true;
     }
 
-    /// Adds the next value of a values-only assembly.
-    #[inline]
-    pub(crate) fn add_value(&mut self, value: f64) {
-        self.values.push(value);
-    }
-
-    /// Number of values assembled so far.
+    /// Number of entries assembled so far.
     pub(crate) fn len(&self) -> usize {
-        self.values.len()
-    }
-
-    /// Drops the values (and, while the pattern is being built, the positions) after the
-    /// first `len`, so the tail of an assembly can be redone (e.g. for a new damping).
-    pub(crate) fn truncate(&mut self, len: usize) {
-        self.values.truncate(len);
-        if !self.same_pattern {
-            self.new_pairs.truncate(len);
+        if self.same_pattern {
+            self.cursor
+        } else {
+            self.values.len()
         }
     }
 
-    /// Adds the next entry in either mode: its position is recorded only while the pattern
-    /// is being built (after [`Self::begin`]); in values-only mode it must follow the cached
-    /// order.
+    /// Marks the current point of the assembly as the base that [`Self::truncate_to_base`]
+    /// returns to.
+    pub(crate) fn mark_base(&mut self) {
+        self.base_len = self.len();
+        if self.same_pattern {
+            self.csc_base.clone_from(&self.csc_values);
+            self.base_valid = true;
+        } else {
+            self.base_valid = false;
+        }
+    }
+
+    /// Drops everything assembled after the base point, so the tail of an assembly can be
+    /// redone (e.g. for a new damping).
+    pub(crate) fn truncate_to_base(&mut self) {
+        if self.same_pattern {
+            debug_assert!(self.base_valid);
+            self.csc_values.copy_from_slice(&self.csc_base);
+            self.cursor = self.base_len;
+        } else {
+            self.values.truncate(self.base_len);
+            self.new_pairs.truncate(self.base_len);
+        }
+    }
+
+    /// Adds the next entry in either mode: its position is recorded while the pattern is being
+    /// built (after [`Self::begin`]); in values-only mode it must follow the cached order.
     #[inline]
     pub(crate) fn push(&mut self, row: u32, col: u32, value: f64) {
-        if !self.same_pattern {
+        if self.same_pattern {
+            let slots = &self.cached.as_ref().expect("values-only mode has a pattern").1;
+            if let Some(&slot) = slots.get(self.cursor) {
+                self.csc_values[slot as usize] += value;
+            }
+            // Past the end: caught by `solve` as a pattern mismatch.
+            self.cursor += 1;
+        } else {
             self.new_pairs.push((row, col));
+            self.values.push(value);
         }
-        self.values.push(value);
     }
 
     /// Starts a new assembly of an `n x n` matrix.
@@ -118,7 +165,10 @@ impl PatternMatrix {
         }
         self.new_pairs.clear();
         self.values.clear();
+        self.base_valid = false;
+        self.base_len = 0;
         self.same_pattern = false;
+        self.fresh = false;
     }
 
     /// Adds `value` at (row, col); repeated positions are summed.
@@ -132,12 +182,16 @@ impl PatternMatrix {
     pub(crate) fn solve(&mut self, rhs: &mut [f64]) -> Result<(), SolverError> {
         let n = self.n;
         let fe = |e: &dyn std::fmt::Debug| SolverError::Factorization(format!("{e:?}"));
-        let mut reuse = self.cached.is_some()
-            && if self.same_pattern {
-                self.values.len() == self.pairs.len()
-            } else {
-                self.pairs == self.new_pairs
-            };
+        if self.same_pattern {
+            // Values-only assembly: the values are in place if exactly the cached entries came.
+            let expected = self.cached.as_ref().map_or(usize::MAX, |c| c.1.len());
+            if self.cursor != expected {
+                return Err(SolverError::Factorization(
+                    "values-only assembly without a matching pattern".into(),
+                ));
+            }
+        }
+        let mut reuse = self.same_pattern || (self.cached.is_some() && self.pairs == self.new_pairs);
         // A Cholesky pattern contained in the cached one (e.g. the constraints-only phase after
         // the penalty phase) reuses its symbolic factorisation: the missing entries are zeros.
         if !reuse
@@ -174,11 +228,6 @@ impl PatternMatrix {
             }
         }
         if !reuse {
-            if self.same_pattern {
-                return Err(SolverError::Factorization(
-                    "values-only assembly without a matching pattern".into(),
-                ));
-            }
             let idx: Vec<Pair<u32, u32>> = self
                 .new_pairs
                 .iter()
@@ -226,14 +275,24 @@ impl PatternMatrix {
             std::mem::swap(&mut self.pairs, &mut self.new_pairs);
             self.new_pairs.clear();
         }
-        // The values now follow the cached pattern: further solves with changed values (e.g.
-        // damping retries) reuse it without comparing.
-        self.same_pattern = true;
+        self.fresh = true;
         let (sym, slots, symbolic) = self.cached.as_mut().expect("cache built above");
-        self.csc_values.clear();
-        self.csc_values.resize(sym.row_idx().len(), 0.0);
-        for (&slot, &v) in slots.iter().zip(&self.values) {
-            self.csc_values[slot as usize] += v;
+        if !self.same_pattern {
+            // Scatter the recorded values (the part before the base point kept aside), then go
+            // on in values-only mode: further tails (e.g. damping retries) need no comparison.
+            self.csc_values.clear();
+            self.csc_values.resize(sym.row_idx().len(), 0.0);
+            let base = self.base_len.min(self.values.len());
+            for (&slot, &v) in slots.iter().zip(&self.values[..base]) {
+                self.csc_values[slot as usize] += v;
+            }
+            self.csc_base.clone_from(&self.csc_values);
+            self.base_valid = true;
+            for (&slot, &v) in slots[base..].iter().zip(&self.values[base..]) {
+                self.csc_values[slot as usize] += v;
+            }
+            self.cursor = self.values.len();
+            self.same_pattern = true;
         }
         let mat = SparseColMatRef::<u32, f64>::new(sym.as_ref(), &self.csc_values);
         let rhs_mat = faer::MatMut::from_column_major_slice_mut(rhs, n, 1);
@@ -286,7 +345,6 @@ pub(crate) fn add_gram(
     pm: &mut PatternMatrix,
     upper_only: bool,
     scratch: &mut GramScratch,
-    values_only: bool,
 ) -> Vec<f64> {
     let m = sys.residuals.len();
     // Group the entries by row (counting sort).
@@ -316,11 +374,7 @@ pub(crate) fn add_gram(
             for &b in row {
                 let eb = sys.entries[b];
                 if !upper_only || ea.col <= eb.col {
-                    if values_only {
-                        pm.add_value(ea.value * eb.value);
-                    } else {
-                        pm.add(ea.col, eb.col, ea.value * eb.value);
-                    }
+                    pm.add(ea.col, eb.col, ea.value * eb.value);
                 }
                 if ea.col == eb.col {
                     diag[ea.col as usize] += ea.value * eb.value;
