@@ -34,7 +34,8 @@ pub(crate) struct BlockSchur {
     order: Vec<u32>,
     /// Per row: the block its block entries belong to, or `NONE`.
     row_block: Vec<u32>,
-    /// Per position of `order` (global entries of block rows): the index of its row of `B`.
+    /// Per position of `order`: for a global entry of a block row the index of its row of
+    /// `B`, for a block entry its component in the block.
     b_slot: Vec<u32>,
     /// Rows of `B` per block: `b_col[b_start[k]..b_start[k + 1]]` (sorted global variables)
     /// and their values `b_val` (padded to 4).
@@ -135,12 +136,19 @@ impl BlockSchur {
                 self.b_start[blk as usize] as usize,
                 self.b_start[blk as usize + 1] as usize,
             );
-            for p in s..s + self.row_global[r] as usize {
+            let (ng, e) = (
+                s + self.row_global[r] as usize,
+                self.row_start[r + 1] as usize,
+            );
+            for p in s..ng {
                 let col = ents[self.order[p] as usize].col;
                 let at = self.b_col[bs..be]
                     .binary_search(&col)
                     .expect("every coupling is listed");
                 self.b_slot[p] = (bs + at) as u32;
+            }
+            for p in ng..e {
+                self.b_slot[p] = ((ents[self.order[p] as usize].col as usize - first) % size) as u32;
             }
         }
         self.b_val.clear();
@@ -170,9 +178,10 @@ impl BlockSchur {
         self.b_val.fill(Vector4::zeros());
         let ents = &sys.entries;
         for (r, &res) in sys.residuals.iter().enumerate() {
-            let s = self.row_start[r] as usize;
-            let row = &self.order[s..self.row_start[r + 1] as usize];
-            let (glob, local) = row.split_at(self.row_global[r] as usize);
+            let (s, e) = (self.row_start[r] as usize, self.row_start[r + 1] as usize);
+            let ng = self.row_global[r] as usize;
+            let (glob, local) = self.order[s..e].split_at(ng);
+            let local_k = &self.b_slot[s + ng..e];
             let blk = self.row_block[r];
             for (i, &a) in glob.iter().enumerate() {
                 let ea = ents[a as usize];
@@ -193,21 +202,18 @@ impl BlockSchur {
                 }
                 if blk != NONE {
                     let bv = &mut self.b_val[self.b_slot[s + i] as usize];
-                    for &b in local {
-                        let eb = ents[b as usize];
-                        bv[(eb.col as usize - first) % size] += va * eb.value;
+                    for (&b, &k) in local.iter().zip(local_k) {
+                        bv[k as usize] += va * ents[b as usize].value;
                     }
                 }
             }
             if blk != NONE {
                 let c = &mut self.c[blk as usize];
-                for &a in local {
+                for (&a, &ka) in local.iter().zip(local_k) {
                     let ea = ents[a as usize];
                     g[ea.col as usize] += ea.value * res;
-                    let ka = (ea.col as usize - first) % size;
-                    for &b in local {
-                        let eb = ents[b as usize];
-                        c[(ka, (eb.col as usize - first) % size)] += ea.value * eb.value;
+                    for (&b, &kb) in local.iter().zip(local_k) {
+                        c[(ka as usize, kb as usize)] += ea.value * ents[b as usize].value;
                     }
                 }
             }
