@@ -157,6 +157,23 @@ impl PatternMatrix {
         }
     }
 
+    /// The destination of the next entries, for tight assembly loops: the same as calling
+    /// [`Self::push`] for each, without looking up the mode every time.
+    pub(crate) fn sink(&mut self) -> Sink<'_> {
+        if self.same_pattern {
+            Sink::Direct {
+                slots: &self.cached.as_ref().expect("values-only mode has a pattern").1,
+                csc: &mut self.csc_values,
+                cursor: &mut self.cursor,
+            }
+        } else {
+            Sink::Build {
+                pairs: &mut self.new_pairs,
+                values: &mut self.values,
+            }
+        }
+    }
+
     /// Starts a new assembly of an `n x n` matrix.
     pub(crate) fn begin(&mut self, n: usize) {
         if n != self.n {
@@ -326,6 +343,43 @@ impl PatternMatrix {
             Err(SolverError::Factorization(
                 "the solve produced non-finite values (singular matrix)".into(),
             ))
+        }
+    }
+}
+
+/// Where the entries of an assembly go, from [`PatternMatrix::sink`].
+pub(crate) enum Sink<'a> {
+    /// Pattern being built: positions and values are recorded.
+    Build {
+        pairs: &'a mut Vec<(u32, u32)>,
+        values: &'a mut Vec<f64>,
+    },
+    /// Values-only: each value is added at its cached CSC slot.
+    Direct {
+        slots: &'a [u32],
+        csc: &'a mut [f64],
+        cursor: &'a mut usize,
+    },
+}
+
+impl Sink<'_> {
+    /// Adds the next entry (see [`PatternMatrix::push`]).
+    #[inline(always)]
+    pub(crate) fn push(&mut self, row: u32, col: u32, value: f64) {
+        match self {
+            Sink::Build { pairs, values } => {
+                pairs.push((row, col));
+                values.push(value);
+            }
+            Sink::Direct { slots, csc, cursor } => {
+                // Past the end of the pattern: caught by `solve` as a mismatch.
+                if let Some(&slot) = slots.get(**cursor)
+                    && let Some(c) = csc.get_mut(slot as usize)
+                {
+                    *c += value;
+                }
+                **cursor += 1;
+            }
         }
     }
 }

@@ -177,6 +177,7 @@ impl BlockSchur {
         self.c.fill(Matrix4::zeros());
         self.b_val.fill(Vector4::zeros());
         let ents = &sys.entries;
+        let mut sink = pm.sink();
         for (r, &res) in sys.residuals.iter().enumerate() {
             let (s, e) = (self.row_start[r] as usize, self.row_start[r + 1] as usize);
             let ng = self.row_global[r] as usize;
@@ -188,16 +189,16 @@ impl BlockSchur {
                 let (ca, va) = (ea.col, ea.value);
                 g[ca as usize] += va * res;
                 diag[ca as usize] += va * va;
-                pm.push(ca, ca, va * va);
+                sink.push(ca, ca, va * va);
                 for &b in &glob[i + 1..] {
                     let eb = ents[b as usize];
                     let v = va * eb.value;
                     if eb.col == ca {
                         // A repeated column: both ordered pairs land on the diagonal.
                         diag[ca as usize] += 2.0 * v;
-                        pm.push(ca, ca, 2.0 * v);
+                        sink.push(ca, ca, 2.0 * v);
                     } else {
-                        pm.push(ca, eb.col, v);
+                        sink.push(ca, eb.col, v);
                     }
                 }
                 if blk != NONE {
@@ -236,6 +237,7 @@ impl BlockSchur {
     ) -> Result<(), super::SolverError> {
         let (first, size) = (self.first, self.size);
         let mut y: Vec<Vector4<f64>> = Vec::new();
+        let mut sink = pm.sink();
         for (blk, c) in self.c.iter().enumerate() {
             let mut ct = *c;
             for k in 0..4 {
@@ -263,7 +265,7 @@ impl BlockSchur {
             // Columns are sorted, so (ci, cj) with j >= i is in the upper triangle.
             for (i, (&ci, yi)) in cols.iter().zip(&y).enumerate() {
                 for (&cj, bj) in cols[i..].iter().zip(&rows[i..]) {
-                    pm.push(ci, cj, -yi.dot(bj));
+                    sink.push(ci, cj, -yi.dot(bj));
                 }
             }
             self.inv[blk] = inv;
