@@ -11,7 +11,7 @@ use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
 };
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
-use faer::sparse::{Pair, SparseColMatRef, SymbolicSparseColMat};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, Par};
 
 /// Which factorisation a cached pattern feeds.
@@ -145,7 +145,11 @@ impl PatternMatrix {
     #[inline]
     pub(crate) fn push(&mut self, row: u32, col: u32, value: f64) {
         if self.same_pattern {
-            let slots = &self.cached.as_ref().expect("values-only mode has a pattern").1;
+            let slots = &self
+                .cached
+                .as_ref()
+                .expect("values-only mode has a pattern")
+                .1;
             if let Some(&slot) = slots.get(self.cursor) {
                 self.csc_values[slot as usize] += value;
             }
@@ -162,7 +166,11 @@ impl PatternMatrix {
     pub(crate) fn sink(&mut self) -> Sink<'_> {
         if self.same_pattern {
             Sink::Direct {
-                slots: &self.cached.as_ref().expect("values-only mode has a pattern").1,
+                slots: &self
+                    .cached
+                    .as_ref()
+                    .expect("values-only mode has a pattern")
+                    .1,
                 csc: &mut self.csc_values,
                 cursor: &mut self.cursor,
             }
@@ -208,7 +216,8 @@ impl PatternMatrix {
                 ));
             }
         }
-        let mut reuse = self.same_pattern || (self.cached.is_some() && self.pairs == self.new_pairs);
+        let mut reuse =
+            self.same_pattern || (self.cached.is_some() && self.pairs == self.new_pairs);
         // A Cholesky pattern contained in the cached one (e.g. the constraints-only phase after
         // the penalty phase) reuses its symbolic factorisation: the missing entries are zeros.
         if !reuse
@@ -245,26 +254,7 @@ impl PatternMatrix {
             }
         }
         if !reuse {
-            let idx: Vec<Pair<u32, u32>> = self
-                .new_pairs
-                .iter()
-                .map(|&(r, c)| Pair::new(r, c))
-                .collect();
-            let (sym, _) =
-                SymbolicSparseColMat::try_new_from_indices(n, n, &idx).map_err(|e| fe(&e))?;
-            // The CSC position of every entry (rows are sorted within each column).
-            let (col_ptr, row_idx) = (sym.col_ptr(), sym.row_idx());
-            let slots = self
-                .new_pairs
-                .iter()
-                .map(|&(r, c)| {
-                    let range = col_ptr[c as usize] as usize..col_ptr[c as usize + 1] as usize;
-                    let at = row_idx[range.clone()]
-                        .binary_search(&r)
-                        .expect("every entry is in the pattern built from the entries");
-                    (range.start + at) as u32
-                })
-                .collect();
+            let (sym, slots) = csc_pattern(n, &self.new_pairs)?;
             let symbolic = match self.kind {
                 Factor::CholeskyUpper => {
                     let symbolic = factorize_symbolic_cholesky(
@@ -345,6 +335,71 @@ impl PatternMatrix {
             ))
         }
     }
+}
+
+/// The CSC pattern (sorted rows per column) of a list of positions with repeats, and the CSC
+/// position of every listed entry. Written by hand: faer's `try_new_from_indices` sorts all
+/// entries, repeats included (several per product of the Gauss-Newton assembly, millions on
+/// the large meshes); here bucketing by column and a per-row marker make it linear, and
+/// only the distinct rows of a column are sorted.
+fn csc_pattern(
+    n: usize,
+    pairs: &[(u32, u32)],
+) -> Result<(SymbolicSparseColMat<u32>, Vec<u32>), SolverError> {
+    if pairs
+        .iter()
+        .any(|&(r, c)| r as usize >= n || c as usize >= n)
+        || pairs.len() >= u32::MAX as usize
+    {
+        return Err(SolverError::Factorization(
+            "matrix entry outside the matrix".into(),
+        ));
+    }
+    // Bucket the entries by column (counting sort).
+    let mut start = vec![0u32; n + 1];
+    for &(_, c) in pairs {
+        start[c as usize + 1] += 1;
+    }
+    for c in 0..n {
+        start[c + 1] += start[c];
+    }
+    let mut by_col = vec![0u32; pairs.len()];
+    let mut fill = start.clone();
+    for (k, &(_, c)) in pairs.iter().enumerate() {
+        by_col[fill[c as usize] as usize] = k as u32;
+        fill[c as usize] += 1;
+    }
+    // Distinct rows per column, sorted; `pos[r]` is the CSC position of row r in the column
+    // being scanned, valid while `mark[r]` is that column.
+    let mut mark = vec![u32::MAX; n];
+    let mut pos = vec![0u32; n];
+    let mut col_ptr = Vec::with_capacity(n + 1);
+    let mut row_idx: Vec<u32> = Vec::new();
+    let mut slots = vec![0u32; pairs.len()];
+    col_ptr.push(0u32);
+    for c in 0..n {
+        let ks = &by_col[start[c] as usize..start[c + 1] as usize];
+        let begin = row_idx.len();
+        for &k in ks {
+            let r = pairs[k as usize].0 as usize;
+            if mark[r] != c as u32 {
+                mark[r] = c as u32;
+                row_idx.push(r as u32);
+            }
+        }
+        row_idx[begin..].sort_unstable();
+        for (at, &r) in row_idx[begin..].iter().enumerate() {
+            pos[r as usize] = (begin + at) as u32;
+        }
+        for &k in ks {
+            slots[k as usize] = pos[pairs[k as usize].0 as usize];
+        }
+        col_ptr.push(row_idx.len() as u32);
+    }
+    Ok((
+        SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx),
+        slots,
+    ))
 }
 
 /// Where the entries of an assembly go, from [`PatternMatrix::sink`].
@@ -437,4 +492,38 @@ pub(crate) fn add_gram(
         }
     }
     diag
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// Every listed position maps to the CSC slot of its own (row, column), each column's rows
+    /// are strictly increasing, and no position is missing or invented.
+    #[test]
+    fn csc_pattern_maps_every_entry_to_its_position() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let n = 30;
+        let pairs: Vec<(u32, u32)> = (0..2000)
+            .map(|_| (rng.random_range(0..n) as u32, rng.random_range(0..n) as u32))
+            .collect();
+        let (sym, slots) = csc_pattern(n, &pairs).unwrap();
+        let (col_ptr, row_idx) = (sym.col_ptr(), sym.row_idx());
+        for (&(r, c), &slot) in pairs.iter().zip(&slots) {
+            let range = col_ptr[c as usize] as usize..col_ptr[c as usize + 1] as usize;
+            assert!(range.contains(&(slot as usize)));
+            assert_eq!(row_idx[slot as usize], r);
+        }
+        let mut distinct: Vec<(u32, u32)> = pairs.clone();
+        distinct.sort_unstable_by_key(|&(r, c)| (c, r));
+        distinct.dedup();
+        assert_eq!(distinct.len(), row_idx.len());
+        for c in 0..n {
+            let rows = &row_idx[col_ptr[c] as usize..col_ptr[c + 1] as usize];
+            assert!(rows.windows(2).all(|w| w[0] < w[1]));
+        }
+        assert!(csc_pattern(n, &[(0, n as u32)]).is_err());
+    }
 }

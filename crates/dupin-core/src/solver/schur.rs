@@ -14,6 +14,10 @@
 //! couplings `B C⁻¹ Bᵀ` only touch variables already coupled by the block's residuals, so the
 //! reduced matrix has no more fill than the vertex part of the full one while the sparse
 //! Cholesky works on far fewer unknowns.
+//!
+//! The Jacobian pattern is analysed once ([`BlockSchur::plan`]: rows grouped, sorted by
+//! column, block couplings listed) and reused while it repeats, so an assembly is one pass
+//! over the products. Without blocks (`first == n`) the same code assembles the plain `JᵀJ`.
 
 use super::SparseSystem;
 use super::pattern::PatternMatrix;
@@ -148,7 +152,8 @@ impl BlockSchur {
                 self.b_slot[p] = (bs + at) as u32;
             }
             for p in ng..e {
-                self.b_slot[p] = ((ents[self.order[p] as usize].col as usize - first) % size) as u32;
+                self.b_slot[p] =
+                    ((ents[self.order[p] as usize].col as usize - first) % size) as u32;
             }
         }
         self.b_val.clear();
@@ -255,10 +260,7 @@ impl BlockSchur {
                     ))
                 })?
                 .inverse();
-            let (bs, be) = (
-                self.b_start[blk] as usize,
-                self.b_start[blk + 1] as usize,
-            );
+            let (bs, be) = (self.b_start[blk] as usize, self.b_start[blk + 1] as usize);
             let (cols, rows) = (&self.b_col[bs..be], &self.b_val[bs..be]);
             y.clear();
             y.extend(rows.iter().map(|b| inv * b));
@@ -283,10 +285,7 @@ impl BlockSchur {
                 gc[k] = g[first + blk * size + k];
             }
             let y = inv * gc;
-            let (bs, be) = (
-                self.b_start[blk] as usize,
-                self.b_start[blk + 1] as usize,
-            );
+            let (bs, be) = (self.b_start[blk] as usize, self.b_start[blk + 1] as usize);
             for (ci, bi) in self.b_col[bs..be].iter().zip(&self.b_val[bs..be]) {
                 rhs[*ci as usize] += bi.dot(&y);
             }
@@ -303,10 +302,7 @@ impl BlockSchur {
             for k in 0..size {
                 t[k] = -g[first + blk * size + k];
             }
-            let (bs, be) = (
-                self.b_start[blk] as usize,
-                self.b_start[blk + 1] as usize,
-            );
+            let (bs, be) = (self.b_start[blk] as usize, self.b_start[blk + 1] as usize);
             for (ci, bi) in self.b_col[bs..be].iter().zip(&self.b_val[bs..be]) {
                 t -= bi * ha[*ci as usize];
             }
