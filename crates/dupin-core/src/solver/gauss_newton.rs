@@ -2,7 +2,7 @@
 //! Sec. 2.2: "an unconstrained least squares problem which can be solved effectively by the
 //! Gauss-Newton method with L-M regularization").
 
-use super::pattern::{Factor, GramScratch, PatternMatrix, add_gram};
+use super::pattern::{Factor, PatternMatrix};
 use super::schur::BlockSchur;
 use super::{SolverError, SparseSystem};
 
@@ -80,17 +80,16 @@ pub struct LevenbergMarquardt {
     factorizations: usize,
     /// The accepted point whose evaluation is in `trial_sys`, while still valid.
     cached_x: Option<Vec<f64>>,
-    scratch: GramScratch,
     /// Residual count and Jacobian (row, col) pattern behind the cached normal matrix.
     last_pattern: (usize, Vec<(u32, u32)>),
-    /// Block structure the cached normal matrix was built with (`None`: full system).
+    /// Block structure requested for the current plan (`None`: full system).
     last_blocks: Option<(usize, usize)>,
+    /// Whether `schur` holds a plan for `last_pattern`.
+    planned: bool,
     /// Block elimination of the current assembly, if used.
     schur: BlockSchur,
     /// Whether the current assembly eliminates blocks.
     schur_active: bool,
-    /// Number of values of the Jacobian part of the current assembly.
-    gram_len: usize,
     /// Damping the first rejected try jumps to (0: plain growth), see
     /// [`Self::set_damping_with_fallback`].
     fallback: f64,
@@ -107,12 +106,11 @@ impl LevenbergMarquardt {
             trial_sys: SparseSystem::new(),
             cached_x: None,
             factorizations: 0,
-            scratch: GramScratch::default(),
             last_pattern: (0, Vec::new()),
             last_blocks: None,
+            planned: false,
             schur: BlockSchur::default(),
             schur_active: false,
-            gram_len: 0,
             fallback: 0.0,
         }
     }
@@ -151,12 +149,13 @@ impl LevenbergMarquardt {
     /// Assembles JᵀJ (upper triangle) of the current system, or with `blocks` its part on
     /// the non-block variables plus the block data, and returns the gradient Jᵀr and the
     /// per-variable damping scale `D`. The damping-dependent tail is added by
-    /// [`Self::damped_step`].
+    /// [`Self::damped_step`]. The analysis of the Jacobian pattern (row grouping, block
+    /// couplings, the position of every product in the sparse matrix) is done once per
+    /// pattern; a repeated pattern costs one pass over the products.
     fn assemble(&mut self, n: usize, blocks: Option<(usize, usize)>) -> (Vec<f64>, Vec<f64>) {
         let blocks = blocks.filter(|&(first, size)| {
             (1..=4).contains(&size) && first > 0 && first < n && (n - first).is_multiple_of(size)
         });
-        // Same Jacobian pattern as last time: push the values only, in the cached order.
         let same_jacobian = self.last_pattern.0 == self.sys.residuals.len()
             && self.last_pattern.1.len() == self.sys.entries.len()
             && self
@@ -165,8 +164,7 @@ impl LevenbergMarquardt {
                 .iter()
                 .zip(&self.last_pattern.1)
                 .all(|(e, &(r, c))| e.row == r && e.col == c);
-        let dim = blocks.map_or(n, |b| b.0);
-        let same = same_jacobian && self.last_blocks == blocks && self.normal.has_pattern(dim);
+        let replan = !same_jacobian || self.last_blocks != blocks || !self.planned;
         if !same_jacobian {
             self.last_pattern.0 = self.sys.residuals.len();
             self.last_pattern.1.clear();
@@ -174,64 +172,45 @@ impl LevenbergMarquardt {
                 .1
                 .extend(self.sys.entries.iter().map(|e| (e.row, e.col)));
         }
-        let mut diag = None;
-        if let Some((first, size)) = blocks {
-            if same {
-                self.normal.begin_values_only();
-            } else {
-                self.normal.begin(first);
+        if replan {
+            let ok = blocks.is_some_and(|(first, size)| self.schur.plan(&self.sys, n, first, size));
+            if !ok {
+                self.schur.plan(&self.sys, n, n, 1);
             }
-            diag = self
-                .schur
-                .assemble(&self.sys, n, first, size, &mut self.normal);
+            self.last_blocks = blocks;
+            self.planned = true;
         }
-        self.schur_active = diag.is_some();
-        self.last_blocks = if self.schur_active { blocks } else { None };
-        let diag = match diag {
-            Some(d) => d,
-            None => {
-                if same && blocks.is_none() {
-                    self.normal.begin_values_only();
-                } else {
-                    self.normal.begin(n);
-                }
-                let values_only = same && blocks.is_none();
-                add_gram(
-                    &self.sys,
-                    n,
-                    &mut self.normal,
-                    true,
-                    &mut self.scratch,
-                    values_only,
-                )
-            }
-        };
-        self.gram_len = self.normal.len();
+        let dim = self.schur.reduced_dim();
+        self.schur_active = dim < n;
+        if !replan && self.normal.has_pattern(dim) {
+            self.normal.begin_values_only();
+        } else {
+            self.normal.begin(dim);
+        }
+        let mut g = vec![0.0; n];
+        let mut diag = vec![0.0; n];
+        self.schur
+            .assemble(&self.sys, &mut self.normal, &mut g, &mut diag);
+        self.normal.mark_base();
         let scale = diag.iter().fold(0.0f64, |a, &b| a.max(b)).max(1e-300);
-        let d: Vec<f64> = diag
-            .iter()
-            .map(|&g| {
-                if self.options.marquardt_scaling {
-                    g + 1e-9 * scale
-                } else {
-                    scale
-                }
-            })
-            .collect();
-        (self.sys.gradient(n), d)
+        for v in &mut diag {
+            *v = if self.options.marquardt_scaling {
+                *v + 1e-9 * scale
+            } else {
+                scale
+            };
+        }
+        (g, diag)
     }
 
     /// Solves `(JᵀJ + μ D) h = -g` with the assembled matrix (only the damping-dependent tail
     /// changes between tries).
     fn damped_step(&mut self, g: &[f64], d: &[f64], mu: f64) -> Result<Vec<f64>, SolverError> {
-        let n = g.len();
-        self.normal.truncate(self.gram_len);
-        let dim = if self.schur_active {
+        self.normal.truncate_to_base();
+        if self.schur_active {
             self.schur.add_complement(&mut self.normal, mu, d)?;
-            self.last_blocks.map_or(n, |b| b.0)
-        } else {
-            n
-        };
+        }
+        let dim = self.schur.reduced_dim();
         for (i, di) in d.iter().enumerate().take(dim) {
             self.normal.push(i as u32, i as u32, mu * di);
         }

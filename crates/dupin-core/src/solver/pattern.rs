@@ -11,7 +11,7 @@ use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
 };
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
-use faer::sparse::{Pair, SparseColMatRef, SymbolicSparseColMat};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, Par};
 
 /// Which factorisation a cached pattern feeds.
@@ -35,6 +35,12 @@ enum Symbolic {
 }
 
 /// A square sparse matrix assembled repeatedly from the same index pattern.
+///
+/// Two assembly modes: while a pattern is being built ([`Self::begin`]) positions and values
+/// are recorded; once the pattern is analysed ([`Self::begin_values_only`]) every pushed
+/// value goes straight to its precomputed CSC slot (no intermediate list, no sorting). A
+/// base point ([`Self::mark_base`]) lets the caller redo the tail of an assembly (e.g. the
+/// damping terms of a retried step) without redoing the rest.
 pub(crate) struct PatternMatrix {
     kind: Factor,
     n: usize,
@@ -43,14 +49,25 @@ pub(crate) struct PatternMatrix {
     /// Cached analysis: the CSC pattern, the CSC slot of every assembled entry (so assembly
     /// is a scatter-add without re-sorting or allocating) and the symbolic factorisation.
     cached: Option<(SymbolicSparseColMat<u32>, Vec<u32>, Symbolic)>,
-    /// CSC values of the matrix being factored.
+    /// CSC values of the matrix being factored (filled directly in values-only mode).
     csc_values: Vec<f64>,
-    /// Pairs of the matrix being assembled.
-    pub new_pairs: Vec<(u32, u32)>,
-    /// Values of the matrix being assembled, aligned with `new_pairs`.
-    pub values: Vec<f64>,
-    /// The caller promised the same pattern as the cached one (values only were pushed).
+    /// CSC values at the base point, restored by [`Self::truncate_to_base`].
+    csc_base: Vec<f64>,
+    /// Whether `csc_base` holds the base point of the current assembly.
+    base_valid: bool,
+    /// Number of entries pushed before the base point.
+    base_len: usize,
+    /// Number of entries pushed in values-only mode (index into the cached slots).
+    cursor: usize,
+    /// Pairs of the matrix being assembled (build mode).
+    new_pairs: Vec<(u32, u32)>,
+    /// Values of the matrix being assembled, aligned with `new_pairs` (build mode).
+    values: Vec<f64>,
+    /// Values-only mode: entries follow the cached pattern and go straight to `csc_values`.
     same_pattern: bool,
+    /// The cached slots follow the entry order of the last build-mode assembly (false while
+    /// a new one has not been analysed, e.g. after a failed analysis).
+    fresh: bool,
 }
 
 impl PatternMatrix {
@@ -61,53 +78,108 @@ impl PatternMatrix {
             pairs: Vec::new(),
             cached: None,
             csc_values: Vec::new(),
+            csc_base: Vec::new(),
+            base_valid: false,
+            base_len: 0,
+            cursor: 0,
             new_pairs: Vec::new(),
             values: Vec::new(),
             same_pattern: false,
+            fresh: false,
         }
     }
 
     /// Whether a pattern has been analysed for size `n` (so values-only assembly is possible).
     pub(crate) fn has_pattern(&self, n: usize) -> bool {
-        self.cached.is_some() && self.n == n
+        self.cached.is_some() && self.n == n && self.fresh
     }
 
-    /// Starts a values-only assembly: the caller pushes values with [`Self::add_value`] in the
-    /// exact order of the cached pattern.
+    /// Starts a values-only assembly: the caller pushes values with [`Self::push`] in the
+    /// exact order of the cached pattern (see [`Self::has_pattern`]).
     pub(crate) fn begin_values_only(&mut self) {
-        self.values.clear();
+        debug_assert!(self.cached.is_some());
+        let nnz = self.cached.as_ref().map_or(0, |c| c.0.row_idx().len());
+        self.csc_values.clear();
+        self.csc_values.resize(nnz, 0.0);
+        self.cursor = 0;
+        self.base_valid = false;
         self.same_pattern = true;
     }
 
-    /// Adds the next value of a values-only assembly.
-    #[inline]
-    pub(crate) fn add_value(&mut self, value: f64) {
-        self.values.push(value);
-    }
-
-    /// Number of values assembled so far.
+    /// Number of entries assembled so far.
     pub(crate) fn len(&self) -> usize {
-        self.values.len()
-    }
-
-    /// Drops the values (and, while the pattern is being built, the positions) after the
-    /// first `len`, so the tail of an assembly can be redone (e.g. for a new damping).
-    pub(crate) fn truncate(&mut self, len: usize) {
-        self.values.truncate(len);
-        if !self.same_pattern {
-            self.new_pairs.truncate(len);
+        if self.same_pattern {
+            self.cursor
+        } else {
+            self.values.len()
         }
     }
 
-    /// Adds the next entry in either mode: its position is recorded only while the pattern
-    /// is being built (after [`Self::begin`]); in values-only mode it must follow the cached
-    /// order.
+    /// Marks the current point of the assembly as the base that [`Self::truncate_to_base`]
+    /// returns to.
+    pub(crate) fn mark_base(&mut self) {
+        self.base_len = self.len();
+        if self.same_pattern {
+            self.csc_base.clone_from(&self.csc_values);
+            self.base_valid = true;
+        } else {
+            self.base_valid = false;
+        }
+    }
+
+    /// Drops everything assembled after the base point, so the tail of an assembly can be
+    /// redone (e.g. for a new damping).
+    pub(crate) fn truncate_to_base(&mut self) {
+        if self.same_pattern {
+            debug_assert!(self.base_valid);
+            self.csc_values.copy_from_slice(&self.csc_base);
+            self.cursor = self.base_len;
+        } else {
+            self.values.truncate(self.base_len);
+            self.new_pairs.truncate(self.base_len);
+        }
+    }
+
+    /// Adds the next entry in either mode: its position is recorded while the pattern is being
+    /// built (after [`Self::begin`]); in values-only mode it must follow the cached order.
     #[inline]
     pub(crate) fn push(&mut self, row: u32, col: u32, value: f64) {
-        if !self.same_pattern {
+        if self.same_pattern {
+            let slots = &self
+                .cached
+                .as_ref()
+                .expect("values-only mode has a pattern")
+                .1;
+            if let Some(&slot) = slots.get(self.cursor) {
+                self.csc_values[slot as usize] += value;
+            }
+            // Past the end: caught by `solve` as a pattern mismatch.
+            self.cursor += 1;
+        } else {
             self.new_pairs.push((row, col));
+            self.values.push(value);
         }
-        self.values.push(value);
+    }
+
+    /// The destination of the next entries, for tight assembly loops: the same as calling
+    /// [`Self::push`] for each, without looking up the mode every time.
+    pub(crate) fn sink(&mut self) -> Sink<'_> {
+        if self.same_pattern {
+            Sink::Direct {
+                slots: &self
+                    .cached
+                    .as_ref()
+                    .expect("values-only mode has a pattern")
+                    .1,
+                csc: &mut self.csc_values,
+                cursor: &mut self.cursor,
+            }
+        } else {
+            Sink::Build {
+                pairs: &mut self.new_pairs,
+                values: &mut self.values,
+            }
+        }
     }
 
     /// Starts a new assembly of an `n x n` matrix.
@@ -118,7 +190,10 @@ impl PatternMatrix {
         }
         self.new_pairs.clear();
         self.values.clear();
+        self.base_valid = false;
+        self.base_len = 0;
         self.same_pattern = false;
+        self.fresh = false;
     }
 
     /// Adds `value` at (row, col); repeated positions are summed.
@@ -132,12 +207,17 @@ impl PatternMatrix {
     pub(crate) fn solve(&mut self, rhs: &mut [f64]) -> Result<(), SolverError> {
         let n = self.n;
         let fe = |e: &dyn std::fmt::Debug| SolverError::Factorization(format!("{e:?}"));
-        let mut reuse = self.cached.is_some()
-            && if self.same_pattern {
-                self.values.len() == self.pairs.len()
-            } else {
-                self.pairs == self.new_pairs
-            };
+        if self.same_pattern {
+            // Values-only assembly: the values are in place if exactly the cached entries came.
+            let expected = self.cached.as_ref().map_or(usize::MAX, |c| c.1.len());
+            if self.cursor != expected {
+                return Err(SolverError::Factorization(
+                    "values-only assembly without a matching pattern".into(),
+                ));
+            }
+        }
+        let mut reuse =
+            self.same_pattern || (self.cached.is_some() && self.pairs == self.new_pairs);
         // A Cholesky pattern contained in the cached one (e.g. the constraints-only phase after
         // the penalty phase) reuses its symbolic factorisation: the missing entries are zeros.
         if !reuse
@@ -174,31 +254,7 @@ impl PatternMatrix {
             }
         }
         if !reuse {
-            if self.same_pattern {
-                return Err(SolverError::Factorization(
-                    "values-only assembly without a matching pattern".into(),
-                ));
-            }
-            let idx: Vec<Pair<u32, u32>> = self
-                .new_pairs
-                .iter()
-                .map(|&(r, c)| Pair::new(r, c))
-                .collect();
-            let (sym, _) =
-                SymbolicSparseColMat::try_new_from_indices(n, n, &idx).map_err(|e| fe(&e))?;
-            // The CSC position of every entry (rows are sorted within each column).
-            let (col_ptr, row_idx) = (sym.col_ptr(), sym.row_idx());
-            let slots = self
-                .new_pairs
-                .iter()
-                .map(|&(r, c)| {
-                    let range = col_ptr[c as usize] as usize..col_ptr[c as usize + 1] as usize;
-                    let at = row_idx[range.clone()]
-                        .binary_search(&r)
-                        .expect("every entry is in the pattern built from the entries");
-                    (range.start + at) as u32
-                })
-                .collect();
+            let (sym, slots) = csc_pattern(n, &self.new_pairs)?;
             let symbolic = match self.kind {
                 Factor::CholeskyUpper => {
                     let symbolic = factorize_symbolic_cholesky(
@@ -226,14 +282,24 @@ impl PatternMatrix {
             std::mem::swap(&mut self.pairs, &mut self.new_pairs);
             self.new_pairs.clear();
         }
-        // The values now follow the cached pattern: further solves with changed values (e.g.
-        // damping retries) reuse it without comparing.
-        self.same_pattern = true;
+        self.fresh = true;
         let (sym, slots, symbolic) = self.cached.as_mut().expect("cache built above");
-        self.csc_values.clear();
-        self.csc_values.resize(sym.row_idx().len(), 0.0);
-        for (&slot, &v) in slots.iter().zip(&self.values) {
-            self.csc_values[slot as usize] += v;
+        if !self.same_pattern {
+            // Scatter the recorded values (the part before the base point kept aside), then go
+            // on in values-only mode: further tails (e.g. damping retries) need no comparison.
+            self.csc_values.clear();
+            self.csc_values.resize(sym.row_idx().len(), 0.0);
+            let base = self.base_len.min(self.values.len());
+            for (&slot, &v) in slots.iter().zip(&self.values[..base]) {
+                self.csc_values[slot as usize] += v;
+            }
+            self.csc_base.clone_from(&self.csc_values);
+            self.base_valid = true;
+            for (&slot, &v) in slots[base..].iter().zip(&self.values[base..]) {
+                self.csc_values[slot as usize] += v;
+            }
+            self.cursor = self.values.len();
+            self.same_pattern = true;
         }
         let mat = SparseColMatRef::<u32, f64>::new(sym.as_ref(), &self.csc_values);
         let rhs_mat = faer::MatMut::from_column_major_slice_mut(rhs, n, 1);
@@ -271,6 +337,108 @@ impl PatternMatrix {
     }
 }
 
+/// The CSC pattern (sorted rows per column) of a list of positions with repeats, and the CSC
+/// position of every listed entry. Written by hand: faer's `try_new_from_indices` sorts all
+/// entries, repeats included (several per product of the Gauss-Newton assembly, millions on
+/// the large meshes); here bucketing by column and a per-row marker make it linear, and
+/// only the distinct rows of a column are sorted.
+fn csc_pattern(
+    n: usize,
+    pairs: &[(u32, u32)],
+) -> Result<(SymbolicSparseColMat<u32>, Vec<u32>), SolverError> {
+    if pairs
+        .iter()
+        .any(|&(r, c)| r as usize >= n || c as usize >= n)
+        || pairs.len() >= u32::MAX as usize
+    {
+        return Err(SolverError::Factorization(
+            "matrix entry outside the matrix".into(),
+        ));
+    }
+    // Bucket the entries by column (counting sort).
+    let mut start = vec![0u32; n + 1];
+    for &(_, c) in pairs {
+        start[c as usize + 1] += 1;
+    }
+    for c in 0..n {
+        start[c + 1] += start[c];
+    }
+    let mut by_col = vec![0u32; pairs.len()];
+    let mut fill = start.clone();
+    for (k, &(_, c)) in pairs.iter().enumerate() {
+        by_col[fill[c as usize] as usize] = k as u32;
+        fill[c as usize] += 1;
+    }
+    // Distinct rows per column, sorted; `pos[r]` is the CSC position of row r in the column
+    // being scanned, valid while `mark[r]` is that column.
+    let mut mark = vec![u32::MAX; n];
+    let mut pos = vec![0u32; n];
+    let mut col_ptr = Vec::with_capacity(n + 1);
+    let mut row_idx: Vec<u32> = Vec::new();
+    let mut slots = vec![0u32; pairs.len()];
+    col_ptr.push(0u32);
+    for c in 0..n {
+        let ks = &by_col[start[c] as usize..start[c + 1] as usize];
+        let begin = row_idx.len();
+        for &k in ks {
+            let r = pairs[k as usize].0 as usize;
+            if mark[r] != c as u32 {
+                mark[r] = c as u32;
+                row_idx.push(r as u32);
+            }
+        }
+        row_idx[begin..].sort_unstable();
+        for (at, &r) in row_idx[begin..].iter().enumerate() {
+            pos[r as usize] = (begin + at) as u32;
+        }
+        for &k in ks {
+            slots[k as usize] = pos[pairs[k as usize].0 as usize];
+        }
+        col_ptr.push(row_idx.len() as u32);
+    }
+    Ok((
+        SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx),
+        slots,
+    ))
+}
+
+/// Where the entries of an assembly go, from [`PatternMatrix::sink`].
+pub(crate) enum Sink<'a> {
+    /// Pattern being built: positions and values are recorded.
+    Build {
+        pairs: &'a mut Vec<(u32, u32)>,
+        values: &'a mut Vec<f64>,
+    },
+    /// Values-only: each value is added at its cached CSC slot.
+    Direct {
+        slots: &'a [u32],
+        csc: &'a mut [f64],
+        cursor: &'a mut usize,
+    },
+}
+
+impl Sink<'_> {
+    /// Adds the next entry (see [`PatternMatrix::push`]).
+    #[inline(always)]
+    pub(crate) fn push(&mut self, row: u32, col: u32, value: f64) {
+        match self {
+            Sink::Build { pairs, values } => {
+                pairs.push((row, col));
+                values.push(value);
+            }
+            Sink::Direct { slots, csc, cursor } => {
+                // Past the end of the pattern: caught by `solve` as a mismatch.
+                if let Some(&slot) = slots.get(**cursor)
+                    && let Some(c) = csc.get_mut(slot as usize)
+                {
+                    *c += value;
+                }
+                **cursor += 1;
+            }
+        }
+    }
+}
+
 /// Reusable buffers of [`add_gram`].
 #[derive(Default)]
 pub(crate) struct GramScratch {
@@ -286,7 +454,6 @@ pub(crate) fn add_gram(
     pm: &mut PatternMatrix,
     upper_only: bool,
     scratch: &mut GramScratch,
-    values_only: bool,
 ) -> Vec<f64> {
     let m = sys.residuals.len();
     // Group the entries by row (counting sort).
@@ -316,11 +483,7 @@ pub(crate) fn add_gram(
             for &b in row {
                 let eb = sys.entries[b];
                 if !upper_only || ea.col <= eb.col {
-                    if values_only {
-                        pm.add_value(ea.value * eb.value);
-                    } else {
-                        pm.add(ea.col, eb.col, ea.value * eb.value);
-                    }
+                    pm.add(ea.col, eb.col, ea.value * eb.value);
                 }
                 if ea.col == eb.col {
                     diag[ea.col as usize] += ea.value * eb.value;
@@ -329,4 +492,38 @@ pub(crate) fn add_gram(
         }
     }
     diag
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// Every listed position maps to the CSC slot of its own (row, column), each column's rows
+    /// are strictly increasing, and no position is missing or invented.
+    #[test]
+    fn csc_pattern_maps_every_entry_to_its_position() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let n = 30;
+        let pairs: Vec<(u32, u32)> = (0..2000)
+            .map(|_| (rng.random_range(0..n) as u32, rng.random_range(0..n) as u32))
+            .collect();
+        let (sym, slots) = csc_pattern(n, &pairs).unwrap();
+        let (col_ptr, row_idx) = (sym.col_ptr(), sym.row_idx());
+        for (&(r, c), &slot) in pairs.iter().zip(&slots) {
+            let range = col_ptr[c as usize] as usize..col_ptr[c as usize + 1] as usize;
+            assert!(range.contains(&(slot as usize)));
+            assert_eq!(row_idx[slot as usize], r);
+        }
+        let mut distinct: Vec<(u32, u32)> = pairs.clone();
+        distinct.sort_unstable_by_key(|&(r, c)| (c, r));
+        distinct.dedup();
+        assert_eq!(distinct.len(), row_idx.len());
+        for c in 0..n {
+            let rows = &row_idx[col_ptr[c] as usize..col_ptr[c + 1] as usize];
+            assert!(rows.windows(2).all(|w| w[0] < w[1]));
+        }
+        assert!(csc_pattern(n, &[(0, n as u32)]).is_err());
+    }
 }

@@ -14,129 +14,221 @@
 //! couplings `B C⁻¹ Bᵀ` only touch variables already coupled by the block's residuals, so the
 //! reduced matrix has no more fill than the vertex part of the full one while the sparse
 //! Cholesky works on far fewer unknowns.
+//!
+//! The Jacobian pattern is analysed once ([`BlockSchur::plan`]: rows grouped, sorted by
+//! column, block couplings listed) and reused while it repeats, so an assembly is one pass
+//! over the products. Without blocks (`first == n`) the same code assembles the plain `JᵀJ`.
 
 use super::SparseSystem;
 use super::pattern::PatternMatrix;
 use nalgebra::{Matrix4, Vector4};
 
-/// Reusable state of the elimination.
+const NONE: u32 = u32::MAX;
+
+/// Reusable state of the elimination: the analysis of one Jacobian pattern (built once by
+/// [`Self::plan`], reused while the pattern repeats) and the numeric blocks.
 #[derive(Default)]
 pub(crate) struct BlockSchur {
     first: usize,
     size: usize,
+    /// Entries grouped by row: `order[row_start[r]..row_start[r + 1]]`, the first
+    /// `row_global[r]` of them on variables `< first` sorted by column, then the block ones.
+    row_start: Vec<u32>,
+    row_global: Vec<u32>,
+    order: Vec<u32>,
+    /// Per row: the block its block entries belong to, or `NONE`.
+    row_block: Vec<u32>,
+    /// Per position of `order`: for a global entry of a block row the index of its row of
+    /// `B`, for a block entry its component in the block.
+    b_slot: Vec<u32>,
+    /// Rows of `B` per block: `b_col[b_start[k]..b_start[k + 1]]` (sorted global variables)
+    /// and their values `b_val` (padded to 4).
+    b_start: Vec<u32>,
+    b_col: Vec<u32>,
+    b_val: Vec<Vector4<f64>>,
     /// Per block: its Gram block `C` (padded to 4 x 4).
     c: Vec<Matrix4<f64>>,
-    /// Per block: the rows of the coupling `B`, as (global variable < first, row of B).
-    b: Vec<Vec<(u32, Vector4<f64>)>>,
     /// Per block: `(C + μD)⁻¹` of the last damped assembly.
     inv: Vec<Matrix4<f64>>,
-    row_start: Vec<usize>,
-    order: Vec<usize>,
-    fill: Vec<usize>,
 }
 
 impl BlockSchur {
-    /// Adds the upper triangle of `A = J_aᵀ J_a` to `pm` and records the blocks `B`, `C`.
-    /// Returns the diagonal of the whole `JᵀJ` (all `n` variables), or `None` when a residual
-    /// touches two blocks (then nothing useful was added to `pm`).
-    pub(crate) fn assemble(
-        &mut self,
-        sys: &SparseSystem,
-        n: usize,
-        first: usize,
-        size: usize,
-        pm: &mut PatternMatrix,
-    ) -> Option<Vec<f64>> {
+    /// Number of variables left after the elimination (`first`, or `n` without blocks).
+    pub(crate) fn reduced_dim(&self) -> usize {
+        self.first
+    }
+
+    /// Analyses the Jacobian pattern of `sys` for blocks of `size` (1 to 4) from `first` on
+    /// (`first == n`: no blocks, plain `JᵀJ`). Returns false, leaving no usable plan, when a
+    /// residual touches two blocks.
+    pub(crate) fn plan(&mut self, sys: &SparseSystem, n: usize, first: usize, size: usize) -> bool {
         debug_assert!((1..=4).contains(&size) && first <= n && (n - first).is_multiple_of(size));
         self.first = first;
         self.size = size;
         let nb = (n - first) / size;
-        self.c.clear();
-        self.c.resize(nb, Matrix4::zeros());
-        self.b.resize_with(nb, Vec::new);
-        self.b.iter_mut().for_each(Vec::clear);
         let m = sys.residuals.len();
-        // Group the entries by row (counting sort).
+        let ents = &sys.entries;
+        // Group the entries by row (counting sort), then order each row: global variables by
+        // column (so every pair (i, j >= i) is in the upper triangle), then block variables.
         self.row_start.clear();
         self.row_start.resize(m + 1, 0);
-        for e in &sys.entries {
+        for e in ents {
             self.row_start[e.row as usize + 1] += 1;
         }
         for i in 0..m {
             self.row_start[i + 1] += self.row_start[i];
         }
         self.order.clear();
-        self.order.resize(sys.entries.len(), 0);
-        self.fill.clear();
-        self.fill.extend_from_slice(&self.row_start);
-        for (k, e) in sys.entries.iter().enumerate() {
+        self.order.resize(ents.len(), 0);
+        let mut fill = self.row_start.clone();
+        for (k, e) in ents.iter().enumerate() {
             let r = e.row as usize;
-            self.order[self.fill[r]] = k;
-            self.fill[r] += 1;
+            self.order[fill[r] as usize] = k as u32;
+            fill[r] += 1;
         }
-        let mut diag = vec![0.0; n];
-        let ents = &sys.entries;
+        self.row_global.clear();
+        self.row_block.clear();
+        let mut pairs: Vec<(u32, u32)> = Vec::new();
         for r in 0..m {
-            let row = &self.order[self.row_start[r]..self.row_start[r + 1]];
-            let mut blk = usize::MAX;
-            for &a in row {
-                let c = ents[a].col as usize;
-                if c >= first {
-                    let bi = (c - first) / size;
-                    if blk == usize::MAX {
-                        blk = bi;
-                    } else if blk != bi {
-                        return None;
+            let (s, e) = (self.row_start[r] as usize, self.row_start[r + 1] as usize);
+            let row = &mut self.order[s..e];
+            row.sort_unstable_by_key(|&k| {
+                let c = ents[k as usize].col;
+                ((c as usize) >= first, c)
+            });
+            let ng = row
+                .iter()
+                .take_while(|&&k| (ents[k as usize].col as usize) < first)
+                .count();
+            let mut blk = NONE;
+            for &k in &row[ng..] {
+                let b = ((ents[k as usize].col as usize - first) / size) as u32;
+                if blk == NONE {
+                    blk = b;
+                } else if blk != b {
+                    self.first = n;
+                    return false;
+                }
+            }
+            if blk != NONE {
+                pairs.extend(row[..ng].iter().map(|&k| (blk, ents[k as usize].col)));
+            }
+            self.row_global.push(ng as u32);
+            self.row_block.push(blk);
+        }
+        pairs.sort_unstable();
+        pairs.dedup();
+        self.b_start.clear();
+        self.b_start.resize(nb + 1, 0);
+        for &(b, _) in &pairs {
+            self.b_start[b as usize + 1] += 1;
+        }
+        for k in 0..nb {
+            self.b_start[k + 1] += self.b_start[k];
+        }
+        self.b_col.clear();
+        self.b_col.extend(pairs.iter().map(|p| p.1));
+        self.b_slot.clear();
+        self.b_slot.resize(self.order.len(), NONE);
+        for r in 0..m {
+            let blk = self.row_block[r];
+            if blk == NONE {
+                continue;
+            }
+            let s = self.row_start[r] as usize;
+            let (bs, be) = (
+                self.b_start[blk as usize] as usize,
+                self.b_start[blk as usize + 1] as usize,
+            );
+            let (ng, e) = (
+                s + self.row_global[r] as usize,
+                self.row_start[r + 1] as usize,
+            );
+            for p in s..ng {
+                let col = ents[self.order[p] as usize].col;
+                let at = self.b_col[bs..be]
+                    .binary_search(&col)
+                    .expect("every coupling is listed");
+                self.b_slot[p] = (bs + at) as u32;
+            }
+            for p in ng..e {
+                self.b_slot[p] =
+                    ((ents[self.order[p] as usize].col as usize - first) % size) as u32;
+            }
+        }
+        self.b_val.clear();
+        self.b_val.resize(self.b_col.len(), Vector4::zeros());
+        self.c.clear();
+        self.c.resize(nb, Matrix4::zeros());
+        self.inv.clear();
+        self.inv.resize(nb, Matrix4::zeros());
+        true
+    }
+
+    /// Adds the upper triangle of `A = J_aᵀ J_a` to `pm` and records the blocks `B`, `C`, for
+    /// the pattern analysed by [`Self::plan`] (the pushes follow the same order every time).
+    /// Fills `g` with the gradient `Jᵀr` and `diag` with the diagonal of `JᵀJ` (all `n`
+    /// variables).
+    pub(crate) fn assemble(
+        &mut self,
+        sys: &SparseSystem,
+        pm: &mut PatternMatrix,
+        g: &mut [f64],
+        diag: &mut [f64],
+    ) {
+        let (first, size) = (self.first, self.size);
+        g.fill(0.0);
+        diag.fill(0.0);
+        self.c.fill(Matrix4::zeros());
+        self.b_val.fill(Vector4::zeros());
+        let ents = &sys.entries;
+        let mut sink = pm.sink();
+        for (r, &res) in sys.residuals.iter().enumerate() {
+            let (s, e) = (self.row_start[r] as usize, self.row_start[r + 1] as usize);
+            let ng = self.row_global[r] as usize;
+            let (glob, local) = self.order[s..e].split_at(ng);
+            let local_k = &self.b_slot[s + ng..e];
+            let blk = self.row_block[r];
+            for (i, &a) in glob.iter().enumerate() {
+                let ea = ents[a as usize];
+                let (ca, va) = (ea.col, ea.value);
+                g[ca as usize] += va * res;
+                diag[ca as usize] += va * va;
+                sink.push(ca, ca, va * va);
+                for &b in &glob[i + 1..] {
+                    let eb = ents[b as usize];
+                    let v = va * eb.value;
+                    if eb.col == ca {
+                        // A repeated column: both ordered pairs land on the diagonal.
+                        diag[ca as usize] += 2.0 * v;
+                        sink.push(ca, ca, 2.0 * v);
+                    } else {
+                        sink.push(ca, eb.col, v);
+                    }
+                }
+                if blk != NONE {
+                    let bv = &mut self.b_val[self.b_slot[s + i] as usize];
+                    for (&b, &k) in local.iter().zip(local_k) {
+                        bv[k as usize] += va * ents[b as usize].value;
                     }
                 }
             }
-            for &a in row {
-                let ea = ents[a];
-                if (ea.col as usize) < first {
-                    // The row of B for this variable (found once per entry, not per pair).
-                    let slot = if blk == usize::MAX {
-                        usize::MAX
-                    } else {
-                        let list = &mut self.b[blk];
-                        match list.iter().position(|e| e.0 == ea.col) {
-                            Some(i) => i,
-                            None => {
-                                list.push((ea.col, Vector4::zeros()));
-                                list.len() - 1
-                            }
-                        }
-                    };
-                    for &b in row {
-                        let eb = ents[b];
-                        let v = ea.value * eb.value;
-                        if (eb.col as usize) < first {
-                            if ea.col <= eb.col {
-                                pm.push(ea.col, eb.col, v);
-                            }
-                            if ea.col == eb.col {
-                                diag[ea.col as usize] += v;
-                            }
-                        } else {
-                            let k = (eb.col as usize - first) % size;
-                            self.b[blk][slot].1[k] += v;
-                        }
-                    }
-                } else {
-                    let ka = (ea.col as usize - first) % size;
-                    for &b in row {
-                        let eb = ents[b];
-                        if (eb.col as usize) >= first {
-                            let kb = (eb.col as usize - first) % size;
-                            self.c[blk][(ka, kb)] += ea.value * eb.value;
-                            if ka == kb {
-                                diag[ea.col as usize] += ea.value * eb.value;
-                            }
-                        }
+            if blk != NONE {
+                let c = &mut self.c[blk as usize];
+                for (&a, &ka) in local.iter().zip(local_k) {
+                    let ea = ents[a as usize];
+                    g[ea.col as usize] += ea.value * res;
+                    for (&b, &kb) in local.iter().zip(local_k) {
+                        c[(ka as usize, kb as usize)] += ea.value * ents[b as usize].value;
                     }
                 }
             }
         }
-        Some(diag)
+        for (blk, c) in self.c.iter().enumerate() {
+            for k in 0..size {
+                diag[first + blk * size + k] = c[(k, k)];
+            }
+        }
     }
 
     /// Adds `-B (C + μD_c)⁻¹ Bᵀ` (upper triangle) to `pm`, keeping the block inverses for
@@ -149,8 +241,9 @@ impl BlockSchur {
         d: &[f64],
     ) -> Result<(), super::SolverError> {
         let (first, size) = (self.first, self.size);
-        self.inv.clear();
-        for (blk, (c, list)) in self.c.iter().zip(&self.b).enumerate() {
+        let mut y: Vec<Vector4<f64>> = Vec::new();
+        let mut sink = pm.sink();
+        for (blk, c) in self.c.iter().enumerate() {
             let mut ct = *c;
             for k in 0..4 {
                 if k < size {
@@ -167,14 +260,17 @@ impl BlockSchur {
                     ))
                 })?
                 .inverse();
-            for (i, (ci, bi)) in list.iter().enumerate() {
-                let y = inv * bi;
-                for (cj, bj) in &list[i..] {
-                    let s = y.dot(bj);
-                    pm.push((*ci).min(*cj), (*ci).max(*cj), -s);
+            let (bs, be) = (self.b_start[blk] as usize, self.b_start[blk + 1] as usize);
+            let (cols, rows) = (&self.b_col[bs..be], &self.b_val[bs..be]);
+            y.clear();
+            y.extend(rows.iter().map(|b| inv * b));
+            // Columns are sorted, so (ci, cj) with j >= i is in the upper triangle.
+            for (i, (&ci, yi)) in cols.iter().zip(&y).enumerate() {
+                for (&cj, bj) in cols[i..].iter().zip(&rows[i..]) {
+                    sink.push(ci, cj, -yi.dot(bj));
                 }
             }
-            self.inv.push(inv);
+            self.inv[blk] = inv;
         }
         Ok(())
     }
@@ -183,13 +279,14 @@ impl BlockSchur {
     pub(crate) fn reduced_rhs(&self, g: &[f64]) -> Vec<f64> {
         let (first, size) = (self.first, self.size);
         let mut rhs: Vec<f64> = g[..first].iter().map(|v| -v).collect();
-        for (blk, (inv, list)) in self.inv.iter().zip(&self.b).enumerate() {
+        for (blk, inv) in self.inv.iter().enumerate() {
             let mut gc = Vector4::zeros();
             for k in 0..size {
                 gc[k] = g[first + blk * size + k];
             }
             let y = inv * gc;
-            for (ci, bi) in list {
+            let (bs, be) = (self.b_start[blk] as usize, self.b_start[blk + 1] as usize);
+            for (ci, bi) in self.b_col[bs..be].iter().zip(&self.b_val[bs..be]) {
                 rhs[*ci as usize] += bi.dot(&y);
             }
         }
@@ -200,12 +297,13 @@ impl BlockSchur {
     pub(crate) fn back_substitute(&self, mut ha: Vec<f64>, g: &[f64]) -> Vec<f64> {
         let (first, size) = (self.first, self.size);
         ha.resize(g.len(), 0.0);
-        for (blk, (inv, list)) in self.inv.iter().zip(&self.b).enumerate() {
+        for (blk, inv) in self.inv.iter().enumerate() {
             let mut t = Vector4::zeros();
             for k in 0..size {
                 t[k] = -g[first + blk * size + k];
             }
-            for (ci, bi) in list {
+            let (bs, be) = (self.b_start[blk] as usize, self.b_start[blk + 1] as usize);
+            for (ci, bi) in self.b_col[bs..be].iter().zip(&self.b_val[bs..be]) {
                 t -= bi * ha[*ci as usize];
             }
             let hc = inv * t;

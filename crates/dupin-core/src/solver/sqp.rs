@@ -120,7 +120,7 @@ impl Sqp {
         let p = self.cons.residuals.len();
         let size = n + p;
         self.kkt.begin(size);
-        let diag = add_gram(&self.obj, n, &mut self.kkt, false, &mut self.scratch, false);
+        let diag = add_gram(&self.obj, n, &mut self.kkt, false, &mut self.scratch);
         let scale = diag.iter().fold(0.0f64, |a, &b| a.max(b));
         let mu = if scale > 0.0 {
             self.options.damping * scale + self.options.absolute_damping
