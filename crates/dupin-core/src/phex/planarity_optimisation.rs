@@ -334,6 +334,7 @@ pub struct PlanarityOptimiser {
     damping: f64,
     factorizations: usize,
     cg_iterations: usize,
+    planarity_rejections: usize,
 }
 
 impl PlanarityOptimiser {
@@ -410,6 +411,7 @@ impl PlanarityOptimiser {
             damping: INITIAL_DAMPING,
             factorizations: 0,
             cg_iterations: 0,
+            planarity_rejections: 0,
         })
     }
 
@@ -432,6 +434,12 @@ impl PlanarityOptimiser {
     /// Conjugate-gradient iterations done so far.
     pub fn cg_iterations(&self) -> usize {
         self.cg_iterations
+    }
+
+    /// CG steps rejected so far because they lowered the cost but raised `max_planarity`
+    /// (each retried with more damping).
+    pub fn planarity_rejections(&self) -> usize {
+        self.planarity_rejections
     }
 
     /// Current `max_planarity`.
@@ -777,14 +785,24 @@ impl PlanarityOptimiser {
                 }
                 let c = self.cost(mesh, &trial, &feet);
                 if c < cost_before {
-                    cost_after = c;
                     mesh.positions.copy_from_slice(&trial);
-                    self.damping = (self.damping / 3.0).max(1e-15);
-                    break;
-                }
-                failures += 1;
-                if !self.direct && failures >= CG_FAILURES {
-                    self.direct = true;
+                    // A truncated-CG step can lower the cost through the fairness and distance
+                    // terms while its unresolved soft directions break planarity (once the
+                    // volumes are tiny, those terms dominate the cost). Such a step is rejected
+                    // and retried with more damping, which shrinks the soft motions and speeds
+                    // up CG, instead of handing over to the Cholesky fallback.
+                    if self.direct || max_planarity(mesh) <= self.max_planarity {
+                        cost_after = c;
+                        self.damping = (self.damping / 3.0).max(1e-15);
+                        break;
+                    }
+                    mesh.positions.copy_from_slice(&x);
+                    self.planarity_rejections += 1;
+                } else {
+                    failures += 1;
+                    if !self.direct && failures >= CG_FAILURES {
+                        self.direct = true;
+                    }
                 }
                 self.damping = (self.damping * 10.0).max(1e-12);
             }
