@@ -335,6 +335,8 @@ pub struct PlanarityOptimiser {
     factorizations: usize,
     cg_iterations: usize,
     planarity_rejections: usize,
+    /// CG forcing term η (relative residual reduction) of the current solve.
+    forcing: f64,
 }
 
 impl PlanarityOptimiser {
@@ -412,6 +414,7 @@ impl PlanarityOptimiser {
             factorizations: 0,
             cg_iterations: 0,
             planarity_rejections: 0,
+            forcing: CG_TOLERANCE,
         })
     }
 
@@ -440,6 +443,12 @@ impl PlanarityOptimiser {
     /// (each retried with more damping).
     pub fn planarity_rejections(&self) -> usize {
         self.planarity_rejections
+    }
+
+    /// The CG forcing term of the last iteration (CG stops once the preconditioned residual
+    /// fell by this factor).
+    pub fn forcing(&self) -> f64 {
+        self.forcing
     }
 
     /// Current `max_planarity`.
@@ -712,7 +721,7 @@ impl PlanarityOptimiser {
             }
             precond(&r, &mut z);
             let rz_new = dot(&r, &z);
-            if rz_new <= CG_TOLERANCE * CG_TOLERANCE * rz0 {
+            if rz_new <= self.forcing * self.forcing * rz0 {
                 break;
             }
             let beta = rz_new / rz;
@@ -768,6 +777,7 @@ impl PlanarityOptimiser {
             .map(|c| self.values[self.pattern.diagonal(c)])
             .fold(0.0f64, f64::max)
             .max(1e-300);
+        self.forcing = CG_TOLERANCE;
         let mut cost_after = cost_before;
         if cost_before > 0.0 {
             let mut trial = x.clone();
@@ -798,6 +808,7 @@ impl PlanarityOptimiser {
                     }
                     mesh.positions.copy_from_slice(&x);
                     self.planarity_rejections += 1;
+                    self.forcing = (self.forcing * 10.0).min(0.5);
                 } else {
                     failures += 1;
                     if !self.direct && failures >= CG_FAILURES {
