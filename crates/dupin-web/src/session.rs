@@ -673,7 +673,11 @@ mod tests {
                 opt.cg_iterations() - cg,
                 opt.factorizations() - f,
                 opt.factor_len(),
-                st.max_planarity, st.cost_before, st.cost_after, opt.planarity_rejections(), opt.forcing()
+                st.max_planarity,
+                st.cost_before,
+                st.cost_after,
+                opt.planarity_rejections(),
+                opt.forcing()
             );
         }
         let t = cpu();
