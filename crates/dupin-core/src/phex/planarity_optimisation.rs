@@ -456,7 +456,7 @@ impl PlanarityOptimiser {
         self.planarity_rejections
     }
 
-    /// The CG forcing term of the last iteration (CG stops once the preconditioned residual
+    /// The CG forcing term of the last CG solve (CG stops once the preconditioned residual
     /// fell by this factor).
     pub fn forcing(&self) -> f64 {
         self.forcing
