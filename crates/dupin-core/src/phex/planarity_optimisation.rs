@@ -451,7 +451,7 @@ impl PlanarityOptimiser {
     }
 
     /// CG steps rejected so far because they lowered the cost but raised `max_planarity`
-    /// (each retried with more damping).
+    /// (each retried with a 10x looser CG tolerance and 10x the damping).
     pub fn planarity_rejections(&self) -> usize {
         self.planarity_rejections
     }
@@ -682,7 +682,8 @@ impl PlanarityOptimiser {
     /// inverse 3 x 3 vertex blocks (block Jacobi).
     ///
     /// Why truncated: see the module documentation. CG stops when the preconditioned residual
-    /// fell by the current forcing term (from [`CG_TOLERANCE`]) or after [`CG_MAX_ITERATIONS`]. Every CG iterate lowers the
+    /// fell by the current forcing term (from [`CG_TOLERANCE`]) or after
+    /// [`CG_MAX_ITERATIONS`]. Every CG iterate lowers the
     /// model, and the caller still checks the true cost and the planarity progress
     /// (Levenberg-Marquardt retries, then the Cholesky fallback).
     fn solve_cg(&mut self, g: &[f64], delta: f64) -> Vec<f64> {
@@ -810,8 +811,8 @@ impl PlanarityOptimiser {
                     // A truncated-CG step can lower the cost through the fairness and distance
                     // terms while its unresolved soft directions break planarity (once the
                     // volumes are tiny, those terms dominate the cost). Such a step is rejected
-                    // and retried with more damping, which shrinks the soft motions and speeds
-                    // up CG, instead of handing over to the Cholesky fallback.
+                    // and retried with a looser CG tolerance (CG then stops once the stiff
+                    // planarity part is resolved) instead of handing over to Cholesky.
                     if self.direct || max_planarity(mesh) <= self.max_planarity {
                         cost_after = c;
                         self.damping = (self.damping / 3.0).max(1e-15);
@@ -1063,8 +1064,8 @@ mod tests {
     /// mode): after the volumes are resolved, a truncated-CG step lowered the cost through the
     /// fairness term but raised max_planarity, which used to switch the optimiser to Cholesky
     /// factorisations. Now that step is rejected and retried with a looser CG forcing term, and
-    /// the run reaches the tolerance by CG alone. The same start at 1512 faces (size 0.4), where the old code
-    /// took 7 iterations, the last 3 with a factorisation each.
+    /// the run reaches the tolerance by CG alone. The same start at 1512 faces (size 0.4),
+    /// where the old code took 7 iterations, the last 3 with a factorisation each.
     #[test]
     fn dupin_duality_start_converges_without_cholesky_fallback() {
         use crate::{
