@@ -4,8 +4,9 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use dupin_core::{
-    PhexConfig, PlanarityOptimiser, PlanarityOptions, TriangulationMethod, TriangulationSpec,
-    dual_mesh, phex_run, phex_scene, surface_by_name, triangulate,
+    DualMesh, Initialisation, PhexConfig, PhexPipeline, PlanarityOptimiser, PlanarityOptions,
+    TriangulationMethod, TriangulationSpec, dual_mesh, dual_mesh_options, phex_run, phex_scene,
+    surface_by_name, triangulate,
 };
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -83,12 +84,13 @@ fn bench(c: &mut Criterion) {
                 o.step(&mut m, torus.as_ref()).unwrap();
             }
             eprintln!(
-                "phex torus-bound {label} optimisation from 1e-3 noise: {} faces, thread CPU {:.3} s, {} iterations, {} CG iterations, {} factorisations (nnz(L) {}), max_planarity {:.2e}",
+                "phex torus-bound {label} optimisation from 1e-3 noise: {} faces, thread CPU {:.3} s, {} iterations, {} CG iterations, {} planarity rejections, {} factorisations (nnz(L) {}), max_planarity {:.2e}",
                 m.num_faces(),
                 c0.and_then(|c| Some(thread_cpu_seconds()? - c))
                     .unwrap_or(f64::NAN),
                 o.iteration(),
                 o.cg_iterations(),
+                o.planarity_rejections(),
                 o.factorizations(),
                 o.factor_len(),
                 o.max_planarity()
@@ -106,11 +108,65 @@ fn bench(c: &mut Criterion) {
                 black_box(o.max_planarity())
             })
         });
+        if label != "50k" {
+            bench_dupin_start(&mut g, label, size);
+        }
         g.bench_function("pipeline", |b| {
             b.iter(|| black_box(phex_run(config(size)).unwrap()))
         });
         g.finish();
     }
+}
+
+/// Optimisation from the Dupin-duality start of the page's free-mode torus (method 2, no
+/// parabolic bound), as in `profile_10k` of dupin-web: the run where a planarity-raising CG step
+/// used to switch the optimiser to Cholesky factorisations (issue 4).
+fn bench_dupin_start(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    label: &str,
+    size: f64,
+) {
+    let mut cfg =
+        PhexConfig::for_surface("torus", &[], TriangulationMethod::Prescribed, Some(size));
+    cfg.initialisation = Initialisation::DupinDuality;
+    let p = PhexPipeline::new(cfg.clone()).unwrap();
+    let d = dual_mesh_options(
+        p.triangulation(),
+        p.surface(),
+        cfg.initialisation,
+        cfg.boundary_faces,
+    )
+    .unwrap();
+    let options = PlanarityOptions {
+        max_iterations: cfg.iterations,
+        fairness: cfg.lambda,
+        distance: cfg.mu,
+        ..PlanarityOptions::default()
+    };
+    let run = |d: &DualMesh| {
+        let mut m = d.mesh.clone();
+        let mut o = PlanarityOptimiser::new(&m, Some(&d.vertex_uv), options).unwrap();
+        while !o.done() {
+            o.step(&mut m, p.surface()).unwrap();
+        }
+        o
+    };
+    let c0 = thread_cpu_seconds();
+    let o = run(&d);
+    eprintln!(
+        "phex torus {label} optimisation from the Dupin-duality start: {} faces, thread CPU {:.3} s, {} iterations, {} CG iterations, {} planarity rejections, {} factorisations, max_planarity {:.2e}",
+        d.mesh.num_faces(),
+        c0.and_then(|c| Some(thread_cpu_seconds()? - c))
+            .unwrap_or(f64::NAN),
+        o.iteration(),
+        o.cg_iterations(),
+        o.planarity_rejections(),
+        o.factorizations(),
+        o.max_planarity()
+    );
+    g.bench_function("optimisation_dupin_start", |b| {
+        b.iter(|| black_box(run(&d).max_planarity()))
+    });
 }
 
 criterion_group!(benches, bench);

@@ -667,13 +667,17 @@ mod tests {
             let (t, cg, f) = (cpu(), opt.cg_iterations(), opt.factorizations());
             let st = opt.step(&mut d.mesh, p.surface()).unwrap();
             println!(
-                "iteration {}: {:.3} s CPU, CG {}, factorisations {}, nnz(L) {}, max planarity {:.2e}",
+                "iteration {}: {:.3} s CPU, CG {}, factorisations {}, nnz(L) {}, max planarity {:.2e}, cost {:.3e} -> {:.3e}, rejections {}, forcing {:.2e}",
                 st.iteration,
                 cpu() - t,
                 opt.cg_iterations() - cg,
                 opt.factorizations() - f,
                 opt.factor_len(),
-                st.max_planarity
+                st.max_planarity,
+                st.cost_before,
+                st.cost_after,
+                opt.planarity_rejections(),
+                opt.forcing()
             );
         }
         let t = cpu();
