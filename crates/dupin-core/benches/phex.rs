@@ -5,8 +5,8 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use dupin_core::{
     DualMesh, Initialisation, PhexConfig, PhexPipeline, PlanarityOptimiser, PlanarityOptions,
-    TriangulationMethod, TriangulationSpec, dual_mesh, dual_mesh_options, phex_run, phex_scene,
-    surface_by_name, triangulate,
+    TriangulationMethod, TriangulationSpec, dual_mesh, phex_run, phex_scene, surface_by_name,
+    triangulate,
 };
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -130,19 +130,8 @@ fn bench_dupin_start(
         PhexConfig::for_surface("torus", &[], TriangulationMethod::Prescribed, Some(size));
     cfg.initialisation = Initialisation::DupinDuality;
     let p = PhexPipeline::new(cfg.clone()).unwrap();
-    let d = dual_mesh_options(
-        p.triangulation(),
-        p.surface(),
-        cfg.initialisation,
-        cfg.boundary_faces,
-    )
-    .unwrap();
-    let options = PlanarityOptions {
-        max_iterations: cfg.iterations,
-        fairness: cfg.lambda,
-        distance: cfg.mu,
-        ..PlanarityOptions::default()
-    };
+    let d = p.initial_dual_mesh().unwrap();
+    let options = cfg.planarity_options();
     let run = |d: &DualMesh| {
         let mut m = d.mesh.clone();
         let mut o = PlanarityOptimiser::new(&m, Some(&d.vertex_uv), options).unwrap();

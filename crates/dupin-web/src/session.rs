@@ -629,8 +629,7 @@ mod tests {
     #[ignore]
     fn profile_10k_worker_step() {
         use dupin_core::{
-            Initialisation, PhexConfig, PhexPipeline, PlanarityOptimiser, PlanarityOptions,
-            TriangulationMethod, dual_mesh_options,
+            Initialisation, PhexConfig, PhexPipeline, PlanarityOptimiser, TriangulationMethod,
         };
         let cpu = || {
             let s = std::fs::read_to_string("/proc/thread-self/schedstat").unwrap_or_default();
@@ -644,24 +643,9 @@ mod tests {
             PhexConfig::for_surface("torus", &[], TriangulationMethod::Prescribed, Some(0.155));
         cfg.initialisation = Initialisation::DupinDuality;
         let p = PhexPipeline::new(cfg.clone()).unwrap();
-        let mut d = dual_mesh_options(
-            p.triangulation(),
-            p.surface(),
-            cfg.initialisation,
-            cfg.boundary_faces,
-        )
-        .unwrap();
-        let mut opt = PlanarityOptimiser::new(
-            &d.mesh,
-            Some(&d.vertex_uv),
-            PlanarityOptions {
-                max_iterations: cfg.iterations,
-                fairness: cfg.lambda,
-                distance: cfg.mu,
-                ..PlanarityOptions::default()
-            },
-        )
-        .unwrap();
+        let mut d = p.initial_dual_mesh().unwrap();
+        let mut opt =
+            PlanarityOptimiser::new(&d.mesh, Some(&d.vertex_uv), cfg.planarity_options()).unwrap();
         println!("faces {}", d.mesh.num_faces());
         while !opt.done() {
             let (t, cg, f) = (cpu(), opt.cg_iterations(), opt.factorizations());

@@ -59,6 +59,16 @@ pub struct PhexConfig {
 }
 
 impl PhexConfig {
+    /// The optimiser's options this configuration asks for (iteration cap, lambda, mu).
+    pub fn planarity_options(&self) -> PlanarityOptions {
+        PlanarityOptions {
+            max_iterations: self.iterations,
+            fairness: self.lambda,
+            distance: self.mu,
+            ..PlanarityOptions::default()
+        }
+    }
+
     /// A configuration for a library surface with the whole domain (the sphere and ellipsoid
     /// stop at latitude +-1.2 to avoid the singular poles), lower bound b = 0.3.
     pub fn for_surface(
@@ -209,6 +219,17 @@ fn build_surface(config: &PhexConfig) -> Result<Box<dyn Surface>, PhexError> {
 }
 
 impl PhexPipeline {
+    /// The hexagonal mesh dual to the current triangulation, by the configured initialisation
+    /// (section 6), before any optimisation.
+    pub fn initial_dual_mesh(&self) -> Result<DualMesh, PhexError> {
+        dual_mesh_options(
+            &self.tri,
+            self.surface.as_ref(),
+            self.config.initialisation,
+            self.config.boundary_faces,
+        )
+    }
+
     /// Validates `config`, builds the surface and the triangulation.
     ///
     /// Errors: unknown surface or bad parameters ([`PhexError::Surface`]), a size too large or
@@ -480,12 +501,7 @@ impl PhexPipeline {
                 }
             }
             PhexPhase::Hexagons => {
-                let d = dual_mesh_options(
-                    &self.tri,
-                    self.surface.as_ref(),
-                    self.config.initialisation,
-                    self.config.boundary_faces,
-                )?;
+                let d = self.initial_dual_mesh()?;
                 self.metrics.faces = d.mesh.num_faces();
                 self.metrics.vertices = d.mesh.num_vertices();
                 self.metrics.max_planarity = max_planarity(&d.mesh);
@@ -493,12 +509,7 @@ impl PhexPipeline {
                 let opt = PlanarityOptimiser::new(
                     &d.mesh,
                     Some(&d.vertex_uv),
-                    PlanarityOptions {
-                        max_iterations: self.config.iterations,
-                        fairness: self.config.lambda,
-                        distance: self.config.mu,
-                        ..PlanarityOptions::default()
-                    },
+                    self.config.planarity_options(),
                 )?;
                 self.phase = if self.config.optimize && !opt.done() {
                     PhexPhase::Optimisation

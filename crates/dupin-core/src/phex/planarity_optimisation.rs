@@ -1068,31 +1068,14 @@ mod tests {
     /// where the old code took 7 iterations, the last 3 with a factorisation each.
     #[test]
     fn dupin_duality_start_converges_without_cholesky_fallback() {
-        use crate::{
-            Initialisation, PhexConfig, PhexPipeline, TriangulationMethod, dual_mesh_options,
-        };
+        use crate::{Initialisation, PhexConfig, PhexPipeline, TriangulationMethod};
         let mut cfg =
             PhexConfig::for_surface("torus", &[], TriangulationMethod::Prescribed, Some(0.4));
         cfg.initialisation = Initialisation::DupinDuality;
         let p = PhexPipeline::new(cfg.clone()).unwrap();
-        let mut d = dual_mesh_options(
-            p.triangulation(),
-            p.surface(),
-            cfg.initialisation,
-            cfg.boundary_faces,
-        )
-        .unwrap();
-        let mut opt = PlanarityOptimiser::new(
-            &d.mesh,
-            Some(&d.vertex_uv),
-            PlanarityOptions {
-                max_iterations: cfg.iterations,
-                fairness: cfg.lambda,
-                distance: cfg.mu,
-                ..PlanarityOptions::default()
-            },
-        )
-        .unwrap();
+        let mut d = p.initial_dual_mesh().unwrap();
+        let mut opt =
+            PlanarityOptimiser::new(&d.mesh, Some(&d.vertex_uv), cfg.planarity_options()).unwrap();
         assert!(!opt.direct && opt.max_planarity() > 1e-3);
         while !opt.done() {
             opt.step(&mut d.mesh, p.surface()).unwrap();
