@@ -83,8 +83,13 @@ fn hex_lab_steps_to_the_simple_bounds() {
         get(&d, "maxAngle").as_f64().unwrap(),
     );
     assert!(lo >= 30.0 - 1e-9 && hi <= 120.0 + 1e-9, "{lo}..{hi}");
+    // PSLG input (section 7): a segment is accepted; one naming a missing point is an error.
     assert!(
         lab.set_input_js(vec![0.0, 0.0, 1.0, 1.0], vec![0, 1])
+            .is_ok()
+    );
+    assert!(
+        lab.set_input_js(vec![0.0, 0.0, 1.0, 1.0], vec![0, 5])
             .is_err()
     );
     assert!(HexDelaunayLab::new("other").is_err());
