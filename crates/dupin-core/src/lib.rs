@@ -45,6 +45,7 @@ mod planarity;
 mod point_set;
 mod polygon;
 mod pq_perturbation;
+mod pq_scene_stepper;
 mod pq_scenes;
 mod principal_quad_mesh;
 mod render_buffers;
@@ -103,6 +104,7 @@ pub use pq_perturbation::{
     PqError, PqMode, PqOptions, PqPerturbation, PqPhase, PqResult, PqStepInfo, Refinement,
     pq_perturb,
 };
+pub use pq_scene_stepper::{MeshRule, PqScenePhase, PqSceneStepInfo, PqSceneStepper};
 pub use pq_scenes::{
     PQ_SCENES, PqSceneError, PqSceneResult, pq_scene, skew_quad_grid, torus_centroid_dual,
 };

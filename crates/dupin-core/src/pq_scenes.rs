@@ -156,11 +156,7 @@ fn subdivide_and_perturb(
 fn strip_result(levels: Vec<PqStrip>, iterations: usize, converged: bool) -> PqSceneResult {
     let last = levels.last().expect("at least the control level");
     let mesh = last.to_mesh();
-    let inside = last
-        .singular_curve()
-        .iter()
-        .filter(|p| matches!(p, Some((_, t)) if (0.0..=1.0).contains(t)))
-        .count();
+    let inside = singular_points_inside(last);
     PqSceneResult {
         max_planarity: max_planarity(&mesh),
         conical_residual: None,
@@ -172,6 +168,16 @@ fn strip_result(levels: Vec<PqStrip>, iterations: usize, converged: bool) -> PqS
         iterations,
         converged,
     }
+}
+
+/// Number of quads of `strip` whose singular-curve point lies on the strip (ruling parameter
+/// in \[0, 1\]).
+pub(crate) fn singular_points_inside(strip: &PqStrip) -> usize {
+    strip
+        .singular_curve()
+        .iter()
+        .filter(|p| matches!(p, Some((_, t)) if (0.0..=1.0).contains(t)))
+        .count()
 }
 
 /// A roof of revolution (profile r = 2 + 0.4 cos(1.5 v), z = 1.2 sin v) for the station.
@@ -192,8 +198,27 @@ fn station_roof() -> SurfaceOfRevolution {
     }
 }
 
-/// Builds the named PQ scene (see [`PQ_SCENES`]).
-pub fn pq_scene(name: &str) -> Result<PqSceneResult, PqSceneError> {
+/// What a PQ scene is made of: a control mesh refined by a surface subdivision rule, or a
+/// control strip refined by a curve rule, with the perturbation options of every level.
+#[derive(Debug, Clone)]
+pub(crate) enum SceneSpec {
+    /// Subdivide with Catmull-Clark and perturb, `levels` times, after perturbing `control`.
+    Mesh {
+        control: PolyMesh,
+        levels: usize,
+        options: PqOptions,
+    },
+    /// Developable subdivision of `strip` with `rule`, `rounds` times.
+    Strip {
+        strip: PqStrip,
+        rule: StripRule,
+        rounds: usize,
+        options: PqOptions,
+    },
+}
+
+/// The definition of the named PQ scene (see [`PQ_SCENES`]).
+pub(crate) fn scene_spec(name: &str) -> Result<SceneSpec, PqSceneError> {
     match name {
         "pq-catmull-clark" => {
             // Fig. 7: a coarse non-planar control mesh (dome with a twist), Catmull-Clark and
@@ -217,7 +242,11 @@ pub fn pq_scene(name: &str) -> Result<PqSceneResult, PqSceneError> {
                 })
                 .collect();
             let control = PolyMesh::new(p, faces).expect("valid grid");
-            subdivide_and_perturb(&control, 2, &PqOptions::default())
+            Ok(SceneSpec::Mesh {
+                control,
+                levels: 2,
+                options: PqOptions::default(),
+            })
         }
         "conical-station" => {
             // Figs. 1, 14: control mesh on principal lines of a roof of revolution, then
@@ -227,7 +256,11 @@ pub fn pq_scene(name: &str) -> Result<PqSceneResult, PqSceneError> {
                 mode: PqMode::Conical,
                 ..PqOptions::default()
             };
-            subdivide_and_perturb(&control, 2, &options)
+            Ok(SceneSpec::Mesh {
+                control,
+                levels: 2,
+                options,
+            })
         }
         "circular-principal" => {
             // Fig. 17: a mesh from principal curves (here with a small seeded disturbance)
@@ -248,18 +281,21 @@ pub fn pq_scene(name: &str) -> Result<PqSceneResult, PqSceneError> {
                 mode: PqMode::Circular,
                 ..PqOptions::default()
             };
-            subdivide_and_perturb(&m, 0, &options)
+            Ok(SceneSpec::Mesh {
+                control: m,
+                levels: 0,
+                options,
+            })
         }
         "developable-trefoil" => {
             // Fig. 9: Möbius band along a trefoil knot, 42 control quads, 3 rounds of the
             // cubic Lane-Riesenfeld rule with PQ perturbation: 336 quads.
-            let (levels, it, ok) = developable_subdivision(
-                &trefoil_moebius(42, 0.35),
-                StripRule::LaneRiesenfeldCubic,
-                3,
-                &PqOptions::default(),
-            )?;
-            Ok(strip_result(levels, it, ok))
+            Ok(SceneSpec::Strip {
+                strip: trefoil_moebius(42, 0.35),
+                rule: StripRule::LaneRiesenfeldCubic,
+                rounds: 3,
+                options: PqOptions::default(),
+            })
         }
         "developable-strips" => {
             // Figs. 8, 16: an open control strip, 3 rounds of cubic Lane-Riesenfeld with PQ
@@ -281,20 +317,39 @@ pub fn pq_scene(name: &str) -> Result<PqSceneResult, PqSceneError> {
                     )
                 })
                 .collect();
-            let strip = PqStrip {
-                a,
-                b,
-                closure: StripClosure::Open,
-            };
-            let (levels, it, ok) = developable_subdivision(
-                &strip,
-                StripRule::LaneRiesenfeldCubic,
-                3,
-                &PqOptions::default(),
-            )?;
-            Ok(strip_result(levels, it, ok))
+            Ok(SceneSpec::Strip {
+                strip: PqStrip {
+                    a,
+                    b,
+                    closure: StripClosure::Open,
+                },
+                rule: StripRule::LaneRiesenfeldCubic,
+                rounds: 3,
+                options: PqOptions::default(),
+            })
         }
         other => Err(PqSceneError::UnknownScene(other.to_string())),
+    }
+}
+
+/// Builds the named PQ scene (see [`PQ_SCENES`]) in one go. [`crate::PqSceneStepper`] runs the
+/// same scene one observable step at a time and ends at the same result.
+pub fn pq_scene(name: &str) -> Result<PqSceneResult, PqSceneError> {
+    match scene_spec(name)? {
+        SceneSpec::Mesh {
+            control,
+            levels,
+            options,
+        } => subdivide_and_perturb(&control, levels, &options),
+        SceneSpec::Strip {
+            strip,
+            rule,
+            rounds,
+            options,
+        } => {
+            let (levels, it, ok) = developable_subdivision(&strip, rule, rounds, &options)?;
+            Ok(strip_result(levels, it, ok))
+        }
     }
 }
 
