@@ -40,6 +40,31 @@ impl MeshData {
             panels: Some(mesh),
         }
     }
+
+    /// Adds `mesh` as an extra layer in one colour, with its edges when `edges` is set (the
+    /// renderer draws one triangle mesh and one line set, so layers are merged into them).
+    pub(crate) fn add_layer(&mut self, mesh: &PolyMesh, color: [f32; 3], edges: bool) {
+        let colors = vec![color; mesh.num_faces()];
+        let (b, c) = polymesh_buffers(mesh, Some(&colors));
+        let base = self.buffers.vertex_count() as u32;
+        if self.colors.is_empty() {
+            self.colors = vec![1.0; self.buffers.positions.len()];
+        }
+        self.buffers.positions.extend_from_slice(&b.positions);
+        self.buffers.normals.extend_from_slice(&b.normals);
+        self.buffers
+            .indices
+            .extend(b.indices.iter().map(|&i| i + base));
+        self.colors.extend_from_slice(&c);
+        if edges {
+            self.edges.extend_from_slice(&polymesh_edges(mesh));
+        }
+    }
+
+    /// Adds line segments (x y z of both endpoints per segment).
+    pub(crate) fn add_lines(&mut self, segments: &[f32]) {
+        self.edges.extend_from_slice(segments);
+    }
 }
 
 #[wasm_bindgen]

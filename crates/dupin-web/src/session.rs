@@ -2,9 +2,10 @@
 
 use crate::mesh_data::MeshData;
 use dupin_core::{
-    Initialisation, LayerRule, PHEX_SCENES, PQ_SCENES, PhexConfig, PhexPipeline, PolyMesh,
-    SheetOptions, TriangulationMethod, face_info, face_planarity, max_planarity, panel_schedule,
-    panel_schedule_svg, phex_scene, pq_scene, surface_catalog, write_obj,
+    Initialisation, LayerRule, PHEX_SCENES, PQ_SCENES, PhexConfig, PhexPipeline, PolyMesh, PqMode,
+    PqSceneStepInfo, PqSceneStepper, SheetOptions, TriangulationMethod, face_info, face_planarity,
+    max_planarity, panel_schedule, panel_schedule_svg, phex_scene, support_structure,
+    surface_catalog, write_obj,
 };
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -54,15 +55,65 @@ struct Metrics {
     histogram: Vec<u32>,
     /// `[lo, hi]` of the histogram's log10 axis.
     hist_log10: [f64; 2],
+    /// PQ scenes: subdivision level of the mesh on show (0: control) and the scene's count.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    level: Option<usize>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    levels: Option<usize>,
+    /// Conical scenes: `conical_residual` (radians).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    conical_residual: Option<f64>,
+    /// Circular scenes: `circular_residual`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    circular_residual: Option<f64>,
+    /// Strip scenes: largest determinant term.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    max_determinant: Option<f64>,
+    /// Strip scenes: quads whose singular-curve point lies on the strip.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    singular_points_inside: Option<usize>,
+}
+
+/// The extra layers `Session.mesh` can draw with the panels: `{ offset, support, distance }`
+/// (all optional; no layers by default).
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct LayerConfig {
+    /// The offset mesh at face distance `distance`.
+    #[serde(default)]
+    offset: bool,
+    /// The support structure: one planar quad per edge between the mesh and its offset.
+    #[serde(default)]
+    support: bool,
+    /// Face distance of the offset, in scene units (positive along the face normals);
+    /// [`DEFAULT_OFFSET`] when not given.
+    distance: Option<f64>,
+}
+
+/// Offset distance when the layers do not give one (the conical station is about 5 units
+/// across).
+const DEFAULT_OFFSET: f64 = 0.15;
+
+/// Offset and support beams of a mesh (conical paper, Sec. 4) and their measures.
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct LayerInfo {
+    distance: f64,
+    offset_faces: usize,
+    /// Contract `max_planarity` of the offset faces.
+    offset_planarity: f64,
+    beams: usize,
+    /// Contract `max_planarity` of the support quads (planar for a conical mesh).
+    beam_planarity: f64,
 }
 
 enum Run {
     Phex(Box<PhexPipeline>),
-    /// PQ scenes are computed in one step (subdivision and perturbation levels run together).
+    /// A PQ scene, one perturbation iteration or one subdivision a step; the first step shows
+    /// the control mesh.
     Pq {
-        name: String,
-        mesh: Option<PolyMesh>,
-        iterations: usize,
+        stepper: Box<PqSceneStepper>,
+        started: bool,
     },
 }
 
@@ -74,6 +125,8 @@ pub struct Session {
     /// Per-face planarity of the current mesh, computed once per step: the metrics and the
     /// planarity colours of the render buffers both need it (a worker step asks for both).
     per_face: std::cell::RefCell<Option<Vec<f64>>>,
+    /// Extra layers drawn with the panels (`setLayers`).
+    layers: LayerConfig,
 }
 
 /// Every scene a `Session` accepts: the P-Hex scenes, then the PQ scenes.
@@ -237,9 +290,8 @@ impl Session {
             .map_err(|e| JsError::new(&format!("bad session config: {e}")))?;
         let run = match (&cfg.scene, &cfg.surface) {
             (Some(scene), None) if PQ_SCENES.contains(&scene.as_str()) => Run::Pq {
-                name: scene.clone(),
-                mesh: None,
-                iterations: 0,
+                stepper: Box::new(PqSceneStepper::new(scene).map_err(err)?),
+                started: false,
             },
             (Some(scene), None) => {
                 let scene = phex_scene(scene).map_err(err)?;
@@ -288,11 +340,13 @@ impl Session {
             run,
             config: cfg,
             per_face: Default::default(),
+            layers: LayerConfig::default(),
         })
     }
 
     /// Advances one observable step (a triangulation layer, the dual mesh, one Gauss-Newton
-    /// iteration; a whole PQ scene) and returns the metrics.
+    /// iteration; for PQ scenes the control mesh, one perturbation iteration or one
+    /// subdivision) and returns the metrics.
     pub fn step(&mut self) -> Result<JsValue, JsError> {
         self.advance()?;
         self.metrics()
@@ -308,15 +362,11 @@ impl Session {
                     p.step().map_err(err)?;
                 }
             }
-            Run::Pq {
-                name,
-                mesh,
-                iterations,
-            } => {
-                if mesh.is_none() {
-                    let r = pq_scene(name).map_err(err)?;
-                    *iterations = r.iterations;
-                    *mesh = Some(r.mesh);
+            Run::Pq { stepper, started } => {
+                if !*started {
+                    *started = true;
+                } else {
+                    stepper.step().map_err(err)?;
                 }
             }
         }
@@ -327,7 +377,7 @@ impl Session {
     pub fn done(&self) -> bool {
         match &self.run {
             Run::Phex(p) => p.done(),
-            Run::Pq { mesh, .. } => mesh.is_some(),
+            Run::Pq { stepper, started } => *started && stepper.is_done(),
         }
     }
 
@@ -494,9 +544,86 @@ impl Session {
                     .collect()
             }
         };
-        Ok(MeshData::panels(m, &colors))
+        let mut data = MeshData::panels(m.clone(), &colors);
+        if let Some((offset, beams, segments)) = self.layer_meshes(&m)? {
+            if let Some(offset) = offset {
+                data.add_layer(&offset, OFFSET_COLOR, true);
+            }
+            if let Some(beams) = beams {
+                data.add_layer(&beams, BEAM_COLOR, false);
+                data.add_lines(&segments);
+            }
+        }
+        Ok(data)
+    }
+
+    /// Sets the extra layers `mesh()` draws: `{ offset, support, distance }` (see
+    /// `offsetUnavailable`); `null` or `{}` for none. Throws for a distance that is not a
+    /// finite non-zero number, or layers this run has no offset for.
+    #[wasm_bindgen(js_name = setLayers)]
+    pub fn set_layers(&mut self, layers: JsValue) -> Result<(), JsError> {
+        let l: LayerConfig = if layers.is_null() || layers.is_undefined() {
+            LayerConfig::default()
+        } else {
+            serde_wasm_bindgen::from_value(layers)
+                .map_err(|e| JsError::new(&format!("bad layers: {e}")))?
+        };
+        parse_layers(l, self.offset_reason()).map(|l| self.layers = l)
+    }
+
+    /// Why this run has no offset layer (a sentence for the page), or `undefined` when it has
+    /// one: offsets at a constant face distance with planar support beams exist for conical
+    /// meshes (conical paper, Sec. 4), i.e. the conical PQ scenes.
+    #[wasm_bindgen(js_name = offsetUnavailable)]
+    pub fn offset_unavailable(&self) -> Option<String> {
+        self.offset_reason().map(str::to_string)
+    }
+
+    /// The layers on show and their measures: `{ distance, offsetFaces, offsetPlanarity,
+    /// beams, beamPlanarity }` (contract planarity of the offset faces and of the support
+    /// quads), or `null` when no layer is on.
+    #[wasm_bindgen(js_name = layerInfo)]
+    pub fn layer_info(&self) -> Result<JsValue, JsError> {
+        if !(self.layers.offset || self.layers.support) || self.offset_reason().is_some() {
+            return Ok(JsValue::NULL);
+        }
+        let m = self.current_mesh().unwrap_or_default();
+        let distance = self.layers.distance.unwrap_or(DEFAULT_OFFSET);
+        let (beams, offset) = support_structure(&m, distance).map_err(err)?;
+        to_js(&LayerInfo {
+            distance,
+            offset_faces: offset.num_faces(),
+            offset_planarity: max_planarity(&offset),
+            beams: beams.num_faces(),
+            beam_planarity: max_planarity(&beams),
+        })
     }
 }
+
+/// Checks layer settings: the distance (when given) must be finite and non-zero, and layers
+/// can only be switched on where `unavailable` is `None`.
+fn parse_layers(l: LayerConfig, unavailable: Option<&str>) -> Result<LayerConfig, JsError> {
+    if let Some(d) = l.distance
+        && !(d.is_finite() && d != 0.0)
+    {
+        return Err(JsError::new(&format!(
+            "offset distance must be a finite number other than 0, got {d}"
+        )));
+    }
+    if (l.offset || l.support)
+        && let Some(reason) = unavailable
+    {
+        return Err(JsError::new(reason));
+    }
+    Ok(l)
+}
+
+const OFFSET_COLOR: [f32; 3] = [0.80, 0.62, 0.30];
+const BEAM_COLOR: [f32; 3] = [0.55, 0.56, 0.60];
+
+/// An offset layer, a support-structure layer and the beams' segments between each vertex and
+/// its offset (the quads' other edges are the panels' and the offset's).
+type Layers = (Option<PolyMesh>, Option<PolyMesh>, Vec<f32>);
 
 impl Session {
     /// Per-face planarity of `mesh` (the current mesh), cached until the next step.
@@ -514,10 +641,49 @@ impl Session {
         }
     }
 
+    /// Why this run has no offset layer (see `offsetUnavailable`).
+    fn offset_reason(&self) -> Option<&'static str> {
+        match &self.run {
+            Run::Pq { stepper, .. } if stepper.mode() == PqMode::Conical => None,
+            _ => Some(
+                "offset and support beams need a conical mesh (conical paper, Sec. 4): pick conical-station",
+            ),
+        }
+    }
+
+    /// The offset and support layers of `mesh` that are switched on (None: none).
+    fn layer_meshes(&self, mesh: &PolyMesh) -> Result<Option<Layers>, JsError> {
+        let l = &self.layers;
+        if !(l.offset || l.support) || self.offset_reason().is_some() {
+            return Ok(None);
+        }
+        let d = l.distance.unwrap_or(DEFAULT_OFFSET);
+        let (beams, offset) = support_structure(mesh, d).map_err(err)?;
+        let n = mesh.num_vertices();
+        let mut used = vec![false; n];
+        for f in mesh.faces() {
+            for &v in f {
+                used[v as usize] = true;
+            }
+        }
+        let segments: Vec<f32> = (0..n)
+            .filter(|&v| used[v])
+            .flat_map(|v| {
+                let (a, b) = (mesh.positions[v], offset.positions[v]);
+                [a.x, a.y, a.z, b.x, b.y, b.z].map(|x| x as f32)
+            })
+            .collect();
+        Ok(Some((
+            l.offset.then_some(offset),
+            l.support.then_some(beams),
+            segments,
+        )))
+    }
+
     fn current_mesh(&self) -> Option<PolyMesh> {
         match &self.run {
             Run::Phex(p) => Some(p.mesh()),
-            Run::Pq { mesh, .. } => mesh.clone(),
+            Run::Pq { stepper, .. } => Some(stepper.mesh().clone()),
         }
     }
 
@@ -545,23 +711,50 @@ impl Session {
                     invalid_faces: m.invalid_faces,
                     histogram,
                     hist_log10,
+                    level: None,
+                    levels: None,
+                    conical_residual: None,
+                    circular_residual: None,
+                    max_determinant: None,
+                    singular_points_inside: None,
                 }
             }
-            Run::Pq { iterations, .. } => Metrics {
-                phase: if self.done() { "done" } else { "ready" },
-                layer: 0,
-                iteration: *iterations,
-                faces: mesh.num_faces(),
-                vertices: mesh.num_vertices(),
-                max_planarity: max_planarity(&mesh),
-                mean_planarity,
-                // Self-intersecting panels, tested in each face's least-squares plane.
-                invalid_faces: (0..mesh.num_faces())
-                    .filter(|&i| !face_info(&mesh, i, 0.0).simple)
-                    .count(),
-                histogram,
-                hist_log10,
-            },
+            Run::Pq { stepper, started } => {
+                let PqSceneStepInfo {
+                    level,
+                    levels,
+                    phase,
+                    iteration,
+                    max_planarity,
+                    conical_residual,
+                    circular_residual,
+                    max_determinant,
+                    singular_points_inside,
+                    ..
+                } = stepper.info();
+                Metrics {
+                    // Before the first step nothing is shown yet.
+                    phase: if *started { phase.name() } else { "ready" },
+                    layer: level,
+                    iteration,
+                    faces: mesh.num_faces(),
+                    vertices: mesh.num_vertices(),
+                    max_planarity,
+                    mean_planarity,
+                    // Self-intersecting panels, tested in each face's least-squares plane.
+                    invalid_faces: (0..mesh.num_faces())
+                        .filter(|&i| !face_info(&mesh, i, 0.0).simple)
+                        .count(),
+                    histogram,
+                    hist_log10,
+                    level: Some(level),
+                    levels: Some(levels),
+                    conical_residual,
+                    circular_residual,
+                    max_determinant,
+                    singular_points_inside,
+                }
+            }
         }
     }
 }
@@ -691,6 +884,7 @@ mod tests {
             run: Run::Phex(Box::new(PhexPipeline::new(cfg).unwrap())),
             config: serde_json::from_str(r#"{"surface": "torus"}"#).unwrap(),
             per_face: Default::default(),
+            layers: LayerConfig::default(),
         };
         let mut optimised = 0;
         while !session.done() {
@@ -711,6 +905,97 @@ mod tests {
             optimised += usize::from(m.phase == "optimisation" || m.phase == "done");
         }
         assert!(optimised >= 2, "the run optimised");
+    }
+
+    fn pq_session(scene: &str) -> Session {
+        Session {
+            run: Run::Pq {
+                stepper: Box::new(PqSceneStepper::new(scene).unwrap()),
+                started: false,
+            },
+            config: serde_json::from_str(&format!(r#"{{"scene": "{scene}"}}"#)).unwrap(),
+            per_face: Default::default(),
+            layers: LayerConfig::default(),
+        }
+    }
+
+    /// A PQ scene steps level by level: the control mesh first, then one perturbation
+    /// iteration or one subdivision a step, every step changing the metrics, ending at the
+    /// one-shot scene with the contract bounds.
+    #[test]
+    fn pq_session_steps_level_by_level() {
+        let mut s = pq_session("conical-station");
+        assert_eq!(s.metrics_struct().phase, "ready");
+        s.advance().unwrap();
+        let first = s.metrics_struct();
+        assert_eq!(
+            (first.phase, first.level, first.faces),
+            ("control", Some(0), 24)
+        );
+        let key = |m: &Metrics| (m.phase, m.level, m.iteration, m.faces, m.max_planarity);
+        let mut prev = key(&first);
+        let mut levels_seen = vec![0];
+        let mut steps = 1;
+        while !s.done() {
+            s.advance().unwrap();
+            steps += 1;
+            let m = s.metrics_struct();
+            assert_ne!(key(&m), prev, "step {steps} left the metrics unchanged");
+            assert_eq!(m.max_planarity, max_planarity(&s.current_mesh().unwrap()));
+            if levels_seen.last() != m.level.as_ref() {
+                levels_seen.push(m.level.unwrap());
+            }
+            prev = key(&m);
+        }
+        assert_eq!(levels_seen, vec![0, 1, 2]);
+        let m = s.metrics_struct();
+        assert_eq!(m.phase, "done");
+        assert!(m.max_planarity <= 1e-10 && m.conical_residual.unwrap() <= 1e-10);
+        let one_shot = dupin_core::pq_scene("conical-station").unwrap();
+        assert_eq!(s.current_mesh().unwrap(), one_shot.mesh);
+        assert_eq!(m.iteration, one_shot.iterations);
+    }
+
+    /// Offset and support layers of the finished conical station: the offset has the mesh's
+    /// faces and is planar, there is one beam per edge and the beams are planar (conical
+    /// paper, Sec. 4); the drawn mesh gains both layers and a segment per vertex.
+    #[test]
+    fn conical_layers_are_planar_and_drawn() {
+        let mut s = pq_session("conical-station");
+        while !s.done() {
+            s.advance().unwrap();
+        }
+        let plain = s.mesh(None).unwrap();
+        let mesh = s.current_mesh().unwrap();
+        assert!(s.offset_reason().is_none());
+        assert!(pq_session("developable-strips").offset_reason().is_some());
+        s.layers = LayerConfig {
+            offset: true,
+            support: true,
+            distance: Some(0.2),
+        };
+        let (offset, beams, segments) = s.layer_meshes(&mesh).unwrap().unwrap();
+        let (offset, beams) = (offset.unwrap(), beams.unwrap());
+        let edges = dupin_core::MeshTopology::new(&mesh).unwrap().edges().len();
+        assert_eq!(offset.num_faces(), mesh.num_faces());
+        assert_eq!(beams.num_faces(), edges);
+        assert!(max_planarity(&offset) <= 1e-9, "{}", max_planarity(&offset));
+        assert!(max_planarity(&beams) <= 1e-9, "{}", max_planarity(&beams));
+        assert_eq!(segments.len(), 6 * mesh.num_vertices());
+        let layered = s.mesh(None).unwrap();
+        let tris = |m: &MeshData| m.buffers.triangle_count();
+        let offset_tris = dupin_core::polymesh_buffers(&offset, None)
+            .0
+            .triangle_count();
+        let beam_tris = dupin_core::polymesh_buffers(&beams, None)
+            .0
+            .triangle_count();
+        assert_eq!(tris(&layered), tris(&plain) + offset_tris + beam_tris);
+        assert_eq!(layered.colors.len(), layered.buffers.positions.len());
+        assert!(layered.edges.len() > plain.edges.len() + segments.len());
+        // Only the support layer: no offset panels.
+        s.layers.offset = false;
+        assert_eq!(tris(&s.mesh(None).unwrap()), tris(&plain) + beam_tris);
     }
 
     #[test]
