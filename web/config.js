@@ -1,7 +1,7 @@
 // The page's whole configuration and its URL-hash form. One object describes what is on
 // screen: `scene` ('torus' preview, a contract scene, or 'free'), the torus or free-surface
 // parameters, the free mode's run settings, the step count, colour mode, panel edge for mm
-// figures, camera and backend.
+// figures, the offset and support layers (conical scenes), camera and backend.
 export const FREE = 'free';
 
 export function defaults() {
@@ -12,6 +12,7 @@ export function defaults() {
     steps: 1,
     color: 'planarity',
     panelEdge: 1.5,
+    layers: { offset: false, support: false, distance: 0.15 },
     camera: null,
     backend: 'auto',
   };
@@ -41,6 +42,10 @@ export function readHash(hash, { scenes, catalog, torusParams }) {
   if (['planarity', 'convexity', 'regularity'].includes(h.get('color'))) c.color = h.get('color');
   const edge = Number(h.get('edge'));
   if (h.has('edge') && Number.isFinite(edge) && edge > 0) c.panelEdge = edge;
+  c.layers.offset = h.get('offset') === '1';
+  c.layers.support = h.get('support') === '1';
+  const dist = Number(h.get('dist'));
+  if (h.has('dist') && Number.isFinite(dist) && dist !== 0) c.layers.distance = dist;
   const cam = (h.get('cam') ?? '').split(',').map(Number);
   if (cam.length === 6 && cam.every(Number.isFinite)) c.camera = cam;
   if (h.get('backend') === 'webgl2') c.backend = 'webgl2';
@@ -60,6 +65,9 @@ export function writeHash(c) {
   if (c.scene !== 'torus') h.set('steps', String(c.steps));
   if (c.color !== 'planarity') h.set('color', c.color);
   if (c.panelEdge !== 1.5) h.set('edge', String(c.panelEdge));
+  if (c.layers.offset) h.set('offset', '1');
+  if (c.layers.support) h.set('support', '1');
+  if (c.layers.distance !== 0.15) h.set('dist', String(c.layers.distance));
   if (c.camera) h.set('cam', c.camera.map(String).join(','));
   if (c.backend !== 'auto') h.set('backend', c.backend);
   return '#' + h.toString();

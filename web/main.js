@@ -82,6 +82,7 @@ function load(next, { reframe = true, field = null } = {}) {
       lastMetrics = { phase: 'done', iteration: 0, faces: m.triangleCount, vertices: m.vertexCount, maxPlanarity: 0 };
       showMetrics(metricsEl, lastMetrics, config);
       drawHistogram($('histogram'), {});
+      showLayers({ unavailable: 'the torus preview is a smooth surface: offset and support beams need a conical scene (conical-station)', info: null });
       if (field) showFieldError(fieldsBox, field, '');
       showStatus(viewer.backend);
       syncHash();
@@ -95,7 +96,7 @@ function load(next, { reframe = true, field = null } = {}) {
   lastPhase = '';
   userMoved = !!pendingCamera;
   candidate = { config: next, field, reframe };
-  solver.load(sessionConfig(next), { steps: next.steps, mode: next.color, field });
+  solver.load(sessionConfig(next), { steps: next.steps, mode: next.color, field, layers: next.layers });
 }
 let candidate = null; // configuration sent to the worker, not yet confirmed
 
@@ -135,6 +136,7 @@ function applyState(s) {
   } catch (e) {
     showStatus(`${viewer.backend} · ${e.message ?? e}`, true);
   }
+  if (s.layers) showLayers(s.layers);
   lastFaces = m.faces;
   lastPhase = m.phase;
   lastMetrics = m;
@@ -153,8 +155,35 @@ function applyState(s) {
   if (playing) requestAnimationFrame(() => solver.post('ack'));
 }
 
+// ---- offset and support layers (conical scenes): computed in Rust, toggled here -----------------
+/** Enables the layer toggles where the run has an offset, else shows why not; `info` is
+ * Session.layerInfo (measures of the layers on show). */
+function showLayers({ unavailable, info }) {
+  for (const id of ['toggle-offset', 'toggle-support', 'offset-distance']) $(id).disabled = !!unavailable;
+  $('offset-reason').textContent = unavailable ?? '';
+  const li = $('layer-info');
+  li.textContent = info
+    ? `offset: ${info.offsetFaces} faces, planarity ${info.offsetPlanarity.toExponential(1)} · ${info.beams} beams, planarity ${info.beamPlanarity.toExponential(1)}`
+    : '';
+  if (info) Object.assign(li.dataset, { beams: String(info.beams), beamPlanarity: String(info.beamPlanarity), offsetPlanarity: String(info.offsetPlanarity) });
+  else for (const k of ['beams', 'beamPlanarity', 'offsetPlanarity']) delete li.dataset[k];
+}
+
+function showLayerError(message) {
+  $('offset-distance-error').textContent = message;
+  $('offset-distance').classList.toggle('invalid', message !== '');
+}
+
+function setLayers(patch) {
+  config.layers = { ...config.layers, ...patch };
+  showLayerError('');
+  if (running) solver.post('layers', { layers: config.layers });
+  syncHash();
+}
+
 function reportError(message, field) {
   settled = true;
+  if (field === 'offset-distance') { showLayerError(message); return; }
   if (!(field && showFieldError(fieldsBox, field, message))) showStatus(`${viewer.backend} · ${message}`, true);
 }
 
@@ -345,6 +374,10 @@ function restore(hash) {
   $('panel-edge').classList.remove('invalid');
   $('panel-edge-error').textContent = '';
   $('panel-edge').value = String(next.panelEdge);
+  $('toggle-offset').checked = next.layers.offset;
+  $('toggle-support').checked = next.layers.support;
+  $('offset-distance').value = String(next.layers.distance);
+  showLayerError('');
   drawLegend($('legend'), colorLegend(next.color));
   clearFieldErrors(fieldsBox);
   rebuildFields();
@@ -374,7 +407,7 @@ async function main() {
   initPresent(() => mesh);
   $('scene-select').addEventListener('change', (e) => {
     const next = defaults();
-    Object.assign(next, { scene: e.target.value, color: config.color, panelEdge: config.panelEdge, backend: config.backend });
+    Object.assign(next, { scene: e.target.value, color: config.color, panelEdge: config.panelEdge, layers: config.layers, backend: config.backend });
     if (next.scene === 'torus') for (const [k, s] of Object.entries(TORUS)) next.params[k] = s.value;
     if (next.scene === FREE) {
       const s = ctx.catalog.find((x) => x.name === next.free.surface) ?? ctx.catalog[0];
@@ -400,6 +433,16 @@ async function main() {
     config.panelEdge = v;
     if (lastMetrics) showMetrics(metricsEl, lastMetrics, config);
     syncHash();
+  });
+  $('toggle-offset').addEventListener('change', (e) => setLayers({ offset: e.target.checked }));
+  $('toggle-support').addEventListener('change', (e) => setLayers({ support: e.target.checked }));
+  $('offset-distance').addEventListener('change', (e) => {
+    const v = Number(e.target.value);
+    if (e.target.value.trim() === '' || !Number.isFinite(v) || v === 0) {
+      showLayerError('face distance must be a number other than 0');
+      return;
+    }
+    setLayers({ distance: v });
   });
   $('export-obj').addEventListener('click', () => {
     if (running) solver.post('export', { kind: 'obj' });

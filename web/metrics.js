@@ -22,6 +22,12 @@ export function showMetrics(dl, m, { panelEdge }) {
     invalidFaces: String(m.invalidFaces ?? 0),
     steps: String(m.steps ?? 0),
   });
+  // PQ scenes: level and the scene's residuals (absent attributes for other runs).
+  const extra = { level: m.level, levels: m.levels, conicalResidual: m.conicalResidual, circularResidual: m.circularResidual, maxDeterminant: m.maxDeterminant, singularPointsInside: m.singularPointsInside };
+  for (const [k, v] of Object.entries(extra)) {
+    if (v === undefined || v === null) delete dl.dataset[k];
+    else dl.dataset[k] = String(v);
+  }
   const rows = [
     ['phase', m.phase], ['layer', m.layer ?? 0], ['iteration', m.iteration], ['faces', m.faces],
     ['vertices', m.vertices],
@@ -30,10 +36,15 @@ export function showMetrics(dl, m, { panelEdge }) {
     ['invalid faces', m.invalidFaces ?? 0],
     ['step time', m.ms === undefined ? '–' : `${m.ms.toFixed(1)} ms`],
   ];
+  if (m.level !== undefined) rows.splice(1, 1, ['level', `${m.level} of ${m.levels}`]);
+  if (m.conicalResidual !== undefined) rows.push(['conical residual', `${exp(m.conicalResidual)} rad`]);
+  if (m.circularResidual !== undefined) rows.push(['circular residual', exp(m.circularResidual)]);
+  if (m.maxDeterminant !== undefined) rows.push(['max determinant', exp(m.maxDeterminant)]);
+  if (m.singularPointsInside !== undefined) rows.push(['singular points on strip', m.singularPointsInside]);
   dl.replaceChildren(...rows.flatMap(([k, v]) => {
     const dt = document.createElement('dt'); dt.textContent = k;
     const dd = document.createElement('dd'); dd.textContent = String(v);
-    dd.dataset.metric = k.replace(' ', '-');
+    dd.dataset.metric = k.replaceAll(' ', '-');
     return [dt, dd];
   }));
 }

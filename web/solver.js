@@ -24,10 +24,11 @@ export class Solver {
   }
 
   /** Starts `config` (a Session config) and replays `steps` steps; `field` names the input
-   * that caused the load (bad configurations report back to it). */
-  load(config, { steps = 1, mode, field = null } = {}) {
+   * that caused the load (bad configurations report back to it); `layers` are the offset and
+   * support layers to draw where the run has them. */
+  load(config, { steps = 1, mode, field = null, layers = null } = {}) {
     this.gen += 1;
-    this.worker.postMessage({ type: 'load', gen: this.gen, config, steps, mode, field });
+    this.worker.postMessage({ type: 'load', gen: this.gen, config, steps, mode, field, layers });
     return this.gen;
   }
 

@@ -1,9 +1,11 @@
 // The solver thread: a module worker that owns the `Session` (state and geometry in Rust) so
 // the page's thread only draws. Protocol (all messages carry the load generation `gen`; stale
 // ones are dropped on both sides):
-//   in:  load {config, steps, mode} | step | play | pause | ack | mode {mode} | export {kind, panelEdge}
+//   in:  load {config, steps, mode, layers} | step | play | pause | ack | mode {mode}
+//        | layers {layers} (offset/support, Session.setLayers) | export {kind, panelEdge}
 //        | pick {origin, direction} (a view ray)
-//   out: ready | state {metrics, steps, done, mesh: typed arrays (transferred)} | error {message, field}
+//   out: ready | state {metrics, steps, done, mesh: typed arrays (transferred), layers:
+//        {unavailable, info}} | error {message, field}
 //        | export {kind, text} | pick {pick | error} (Session.pickVertex's answer)
 import init, { Session } from './pkg/dupin_web.js';
 
@@ -13,6 +15,13 @@ let steps = 0;
 let mode = 'planarity';
 let playing = false;
 let lastMetrics = null;
+let layers = null; // the page's offset/support settings, applied where the run has an offset
+
+// Sets the layers on the session where it has an offset layer (else they stay off and the
+// page shows Session.offsetUnavailable's reason).
+function applyLayers() {
+  if (session && !session.offsetUnavailable()) session.setLayers(layers);
+}
 
 function meshMessage() {
   const m = session.mesh(mode);
@@ -27,7 +36,8 @@ function send() {
   const t1 = performance.now();
   const done = session.done();
   if (lastMetrics?.timing) lastMetrics.timing.mesh = t1 - t0;
-  postMessage({ type: 'state', gen, metrics: lastMetrics, steps, done, playing: playing && !done, mesh },
+  const layerState = { unavailable: session.offsetUnavailable() ?? null, info: session.layerInfo() };
+  postMessage({ type: 'state', gen, metrics: lastMetrics, steps, done, playing: playing && !done, mesh, layers: layerState },
     [mesh.positions.buffer, mesh.normals.buffer, mesh.indices.buffer, mesh.colors.buffer, mesh.edges.buffer]);
   // Posting (structured clone of the metrics; the typed arrays are transferred) is timed for
   // the step log of the next state.
@@ -69,8 +79,10 @@ const handlers = {
     session = next;
     gen = msg.gen;
     mode = msg.mode ?? mode;
+    layers = msg.layers ?? null;
     playing = false;
     steps = 0;
+    try { applyLayers(); } catch (e) { layers = null; fail(e, 'offset-distance'); }
     try {
       // Replays `steps` steps (a restored URL); the first step is always taken.
       const target = Math.max(1, msg.steps ?? 1);
@@ -97,6 +109,12 @@ const handlers = {
       if (!playing || !session || session.done()) return;
       try { stepOnce(); send(); } catch (e) { fail(e); }
     }, 0);
+  },
+  layers(msg) {
+    const old = layers;
+    layers = msg.layers;
+    try { applyLayers(); } catch (e) { layers = old; fail(e, 'offset-distance'); return; }
+    if (session) { try { send(); } catch (e) { fail(e, 'offset-distance'); } }
   },
   mode(msg) {
     mode = msg.mode;
