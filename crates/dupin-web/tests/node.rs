@@ -144,3 +144,48 @@ fn surface_catalog_lists_every_library_surface_with_ranges() {
 
 #[path = "web_api/teach.rs"]
 mod teach_node;
+
+#[wasm_bindgen_test]
+fn pq_session_steps_levels_and_draws_conical_layers() {
+    use dupin_web::Session;
+    let parse = |s: &str| js_sys::JSON::parse(s).unwrap();
+    let get = |m: &wasm_bindgen::JsValue, k: &str| js_sys::Reflect::get(m, &k.into()).unwrap();
+    let message = |e: wasm_bindgen::JsError| -> String {
+        let v = wasm_bindgen::JsValue::from(e);
+        get(&v, "message").as_string().unwrap()
+    };
+    let mut s = Session::new(parse(r#"{"scene":"conical-station"}"#)).unwrap();
+    let first = s.step().unwrap();
+    assert_eq!(get(&first, "phase").as_string().as_deref(), Some("control"));
+    assert_eq!(get(&first, "level").as_f64(), Some(0.0));
+    assert!(s.offset_unavailable().is_none());
+    for (json, needle) in [
+        (r#"{"offset":true,"distance":0}"#, "distance"),
+        (r#"{"offsets":true}"#, "bad layers"),
+    ] {
+        let msg = message(s.set_layers(parse(json)).unwrap_err());
+        assert!(msg.contains(needle), "{json}: {msg}");
+    }
+    let plain = s.mesh(None).unwrap().triangle_count();
+    s.set_layers(parse(r#"{"offset":true,"support":true,"distance":0.2}"#))
+        .unwrap();
+    assert!(s.mesh(None).unwrap().triangle_count() > 2 * plain);
+    let mut levels = std::collections::BTreeSet::new();
+    while !s.done() {
+        let m = s.step().unwrap();
+        levels.insert(get(&m, "level").as_f64().unwrap() as usize);
+    }
+    assert_eq!(levels.into_iter().collect::<Vec<_>>(), vec![0, 1, 2]);
+    let m = s.metrics().unwrap();
+    assert!(get(&m, "maxPlanarity").as_f64().unwrap() <= 1e-10);
+    assert!(get(&m, "conicalResidual").as_f64().unwrap() <= 1e-10);
+    let info = s.layer_info().unwrap();
+    assert!(get(&info, "beams").as_f64().unwrap() > 0.0);
+    assert!(get(&info, "beamPlanarity").as_f64().unwrap() <= 1e-9);
+    // A non-conical scene has no offset layer and says why.
+    let mut t = Session::new(parse(r#"{"scene":"developable-strips"}"#)).unwrap();
+    assert!(t.offset_unavailable().unwrap().contains("conical"));
+    assert!(message(t.set_layers(parse(r#"{"support":true}"#)).unwrap_err()).contains("conical"));
+    t.set_layers(wasm_bindgen::JsValue::NULL).unwrap();
+    assert!(t.layer_info().unwrap().is_null());
+}
