@@ -565,6 +565,18 @@ impl Session {
         let l: LayerConfig = if layers.is_null() || layers.is_undefined() {
             LayerConfig::default()
         } else {
+            // serde_wasm_bindgen looks up the known fields only, so a misspelt key would be
+            // silently ignored: refuse unknown keys here.
+            let keys = js_sys::Object::keys(&js_sys::Object::from(layers.clone()));
+            if let Some(k) = keys
+                .iter()
+                .filter_map(|k| k.as_string())
+                .find(|k| !["offset", "support", "distance"].contains(&k.as_str()))
+            {
+                return Err(JsError::new(&format!(
+                    "bad layers: unknown field `{k}`, expected `offset`, `support` or `distance`"
+                )));
+            }
             serde_wasm_bindgen::from_value(layers)
                 .map_err(|e| JsError::new(&format!("bad layers: {e}")))?
         };
