@@ -9,12 +9,10 @@ const median = (a) => { const s = [...a].sort((x, y) => x - y); return s.length 
 const r1 = (x) => Math.round(10 * x) / 10;
 const PQ = ['pq-catmull-clark', 'conical-station', 'developable-trefoil', 'developable-strips', 'circular-principal'];
 const out = {};
-const { browser, page } = await openPage();
 for (const scene of PQ) {
+  // A fresh page per scene, opened at the scene's first step (with both layers for the station).
   const layers = scene === 'conical-station' ? '&offset=1&support=1' : '';
-  await page.evaluate(() => window.dupin.stepLog.splice(0));
-  await page.evaluate((h) => { location.hash = h; }, `#scene=${scene}&steps=1${layers}`);
-  await page.waitForFunction((s) => new URLSearchParams(location.hash.slice(1)).get('scene') === s, scene);
+  const { browser, page } = await openPage({ hash: `#scene=${scene}&steps=1${layers}` });
   await waitSteps(page, 1);
   await byId(page, 'play').click();
   await waitDone(page);
@@ -29,6 +27,6 @@ for (const scene of PQ) {
     meshMs: r1(median(log.map((s) => s.timing.mesh))),
     mainMs: r1(median(log.map((s) => s.mainMs))),
   };
+  await browser.close();
 }
-await browser.close();
 console.log(JSON.stringify(out));
