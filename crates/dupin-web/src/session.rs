@@ -33,6 +33,31 @@ struct SessionConfig {
     init: Option<String>,
 }
 
+/// The fields of [`SessionConfig`], for [`refuse_unknown_keys`].
+const SESSION_CONFIG_KEYS: &[&str] = &[
+    "scene", "surface", "params", "method", "size", "bound", "lambda", "mu", "init",
+];
+
+/// serde_wasm_bindgen reads a JS object's known fields only (`deny_unknown_fields` never
+/// fires), so a misspelt key would be silently ignored: refuse it with a readable message.
+fn refuse_unknown_keys(value: &JsValue, what: &str, allowed: &[&str]) -> Result<(), JsError> {
+    if !value.is_object() {
+        return Ok(()); // serde reports the wrong type itself.
+    }
+    let keys = js_sys::Object::keys(&js_sys::Object::from(value.clone()));
+    match keys
+        .iter()
+        .filter_map(|k| k.as_string())
+        .find(|k| !allowed.contains(&k.as_str()))
+    {
+        Some(k) => Err(JsError::new(&format!(
+            "bad {what}: unknown field `{k}`, expected one of `{}`",
+            allowed.join("`, `")
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// Histogram bins of log10(face planarity): `HIST_BINS` bins over [HIST_LO, HIST_HI]; values
 /// below and above land in the first and last bin.
 const HIST_BINS: usize = 14;
@@ -286,6 +311,7 @@ impl Session {
     /// Starts a session. Throws an `Error` naming what to change for a bad configuration.
     #[wasm_bindgen(constructor)]
     pub fn new(config: JsValue) -> Result<Session, JsError> {
+        refuse_unknown_keys(&config, "session config", SESSION_CONFIG_KEYS)?;
         let cfg: SessionConfig = serde_wasm_bindgen::from_value(config)
             .map_err(|e| JsError::new(&format!("bad session config: {e}")))?;
         let run = match (&cfg.scene, &cfg.surface) {
@@ -565,18 +591,7 @@ impl Session {
         let l: LayerConfig = if layers.is_null() || layers.is_undefined() {
             LayerConfig::default()
         } else {
-            // serde_wasm_bindgen looks up the known fields only, so a misspelt key would be
-            // silently ignored: refuse unknown keys here.
-            let keys = js_sys::Object::keys(&js_sys::Object::from(layers.clone()));
-            if let Some(k) = keys
-                .iter()
-                .filter_map(|k| k.as_string())
-                .find(|k| !["offset", "support", "distance"].contains(&k.as_str()))
-            {
-                return Err(JsError::new(&format!(
-                    "bad layers: unknown field `{k}`, expected `offset`, `support` or `distance`"
-                )));
-            }
+            refuse_unknown_keys(&layers, "layers", &["offset", "support", "distance"])?;
             serde_wasm_bindgen::from_value(layers)
                 .map_err(|e| JsError::new(&format!("bad layers: {e}")))?
         };

@@ -92,6 +92,11 @@ fn bad_session_configs_throw_readable_errors() {
         (r#"{"surface":"torus","params":{"r":-1}}"#, "r"),
         (r#"{"surface":"torus","size":1000}"#, "size"),
         (r#"{"surface":"torus","init":"magic"}"#, "init"),
+        (r#"{"surface":"torus","sise":0.2}"#, "unknown field `sise`"),
+        (
+            r#"{"scene":"sphere-radial","iterations":3}"#,
+            "unknown field `iterations`",
+        ),
     ] {
         let err = match Session::new(js_sys::JSON::parse(json).unwrap()) {
             Err(e) => wasm_bindgen::JsValue::from(e),
