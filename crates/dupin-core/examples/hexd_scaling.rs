@@ -57,6 +57,26 @@ fn spade_refine(points: &[Vec2]) -> (usize, f64) {
     (cdt.num_inner_faces(), start.elapsed().as_secs_f64())
 }
 
+/// FNV-1a over the triangles (in order) and the vertex coordinates' bits: equal fingerprints
+/// mean the same triangulation, so a data-layout change can be checked to change nothing.
+fn fingerprint(t: &dupin_core::HexTriangulation) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    let mut eat = |x: u64| {
+        h ^= x;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    };
+    for tri in &t.triangles {
+        for &v in tri {
+            eat(u64::from(v));
+        }
+    }
+    for p in &t.vertices {
+        eat(p.x.to_bits());
+        eat(p.y.to_bits());
+    }
+    h
+}
+
 fn main() {
     let mode = if std::env::args().any(|a| a == "--extended") {
         HexDelaunayMode::Extended
@@ -69,9 +89,14 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(64000);
+    // HEXD_MIN=N skips the sizes below N.
+    let min: usize = std::env::var("HEXD_MIN")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0);
     let sizes: Vec<usize> = [1000usize, 2000, 4000, 8000, 16000, 32000, 64000]
         .into_iter()
-        .filter(|&n| n <= max)
+        .filter(|&n| n <= max && n >= min)
         .collect();
     let mut xs = Vec::new();
     let mut ys = Vec::new();
@@ -97,6 +122,7 @@ fn main() {
                 .collect();
             std::fs::write(format!("{dir}/uniform_{n}.txt"), text).expect("writable dump dir");
         }
+        let mut hash = 0u64;
         let mut best = f64::INFINITY;
         let mut best_cpu = f64::INFINITY;
         let mut tris = 0;
@@ -119,6 +145,25 @@ fn main() {
             peak = PEAK.load(Ordering::Relaxed) - base;
             best = best.min(s);
             tris = t.triangles.len();
+            hash = fingerprint(&t);
+        }
+        if std::env::var("HEXD_HASH").is_ok() {
+            println!("{n}: output fingerprint {hash:016x}");
+        }
+        if std::env::var("HEXD_NO_SPADE").is_ok() {
+            xs.push((tris as f64).ln());
+            ys.push((if best_cpu.is_finite() { best_cpu } else { best }).ln());
+            println!(
+                "{:>7} {:>10} {:>9.4} {:>9.4} {:>10.1} {:>12.1} {:>9.1}",
+                n,
+                tris,
+                best,
+                best_cpu,
+                best_cpu.min(best) * 1e9 / tris as f64,
+                peak as f64 / 1e6,
+                peak as f64 / tris as f64
+            );
+            continue;
         }
         let (st, ss) = spade_refine(&pts);
         // Thread CPU time where available (the machine may be shared), else wall time.

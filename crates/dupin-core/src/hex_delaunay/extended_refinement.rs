@@ -47,7 +47,7 @@ fn for_each_leaf(h: &Hierarchy, mut f: impl FnMut(u32, Axial)) {
         return;
     }
     for k in 0..h.depth() {
-        for &x in h.split_at(k) {
+        for x in h.split_at(k) {
             let c = (2 * x.0, 2 * x.1);
             if !h.is_split(k + 1, c) {
                 f(k + 1, c);

@@ -270,7 +270,7 @@ mod tests {
             // Balancing: every split hexagon has its six neighbours (inside Ω) present, i.e.
             // adjacent cells differ by at most one paper level.
             for k in 0..h.depth() {
-                for &x in h.split_at(k) {
+                for x in h.split_at(k) {
                     assert!(h.is_present(k, x), "case {case}: split but absent");
                     for d in DIRS {
                         let y = add(x, d);
