@@ -25,6 +25,7 @@ use super::lattice::{
 };
 use crate::math::Vec2;
 use rustc_hash::FxHashMap;
+use std::cell::Cell as Memo;
 
 /// A leaf cell of the hexagon mesh.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -228,9 +229,26 @@ const TILE_MASK: i64 = (1 << TILE) - 1;
 /// bitset over unbounded signed coordinates; a hash set of points costs one scattered probe
 /// per query into a table that outgrows the caches (1.4 million splits at 16k points in the
 /// extended mode), while neighbouring queries here land in the same, already cached, entry.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 struct TileSet {
     tiles: FxHashMap<Axial, [u64; 4]>,
+    /// The tile of the last query (its key, or `NO_TILE`, and a copy of its words): the rules
+    /// ask about a hexagon and its neighbours in a row, so most queries skip the hash probe.
+    last_key: Memo<Axial>,
+    last: [Memo<u64>; 4],
+}
+
+/// No tile has this key (keys are coordinates shifted right by `TILE`).
+const NO_TILE: Axial = (i64::MIN, i64::MIN);
+
+impl Default for TileSet {
+    fn default() -> Self {
+        TileSet {
+            tiles: FxHashMap::default(),
+            last_key: Memo::new(NO_TILE),
+            last: Default::default(),
+        }
+    }
 }
 
 impl TileSet {
@@ -244,9 +262,14 @@ impl TileSet {
     #[inline]
     fn contains(&self, v: Axial) -> bool {
         let (key, bit) = Self::slot(v);
-        self.tiles
-            .get(&key)
-            .is_some_and(|t| (t[bit >> 6] >> (bit & 63)) & 1 != 0)
+        if self.last_key.get() != key {
+            let words = self.tiles.get(&key).copied().unwrap_or_default();
+            for (c, w) in self.last.iter().zip(words) {
+                c.set(w);
+            }
+            self.last_key.set(key);
+        }
+        (self.last[bit >> 6].get() >> (bit & 63)) & 1 != 0
     }
 
     /// Inserts `v`; returns whether it was new.
@@ -257,6 +280,9 @@ impl TileSet {
         let m = 1u64 << (bit & 63);
         let new = *w & m == 0;
         *w |= m;
+        if self.last_key.get() == key {
+            self.last[bit >> 6].set(*w);
+        }
         new
     }
 
