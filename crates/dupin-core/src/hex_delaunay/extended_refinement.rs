@@ -32,7 +32,7 @@
 
 use super::dual::{Key, pack};
 use super::error::HexDelaunayError;
-use super::hierarchy::{Cell, Hierarchy};
+use super::hierarchy::{Cell, HexSet, Hierarchy};
 use super::lattice::{Axial, DIRS, add, hex_norm, in_domain, on_boundary, parents_of_midpoint};
 use super::simple_refinement::Refinement;
 use crate::math::Vec2;
@@ -580,8 +580,7 @@ impl OccupiedIndex {
 /// hexagons one level finer); the leaves read their rings. Those within eight steps at levels
 /// `k` and `k + 1` (from `2x`) and six at level `k - 1` are re-run and give the ring roles.
 fn affected(r: &Refinement, index: &mut OccupiedIndex, changes: &[(u32, Axial)]) -> (Hexes, Hexes) {
-    let mut leaves: FxHashSet<(u32, Axial)> = FxHashSet::default();
-    leaves.reserve(changes.len() * 24);
+    let mut leaves = HexSet::default();
     let mut occupied: FxHashSet<(u32, Axial)> = FxHashSet::default();
     for &(k, x) in changes {
         index.after_split(r, k, x);
@@ -605,7 +604,7 @@ fn affected(r: &Refinement, index: &mut OccupiedIndex, changes: &[(u32, Axial)])
         });
     }
     // The order of the visits does not matter (the rules read the state, not the marks).
-    (leaves.into_iter().collect(), occupied.into_iter().collect())
+    (leaves.iter().collect(), occupied.into_iter().collect())
 }
 
 /// An incremental pass over the given leaves and occupied hexagons.

@@ -220,6 +220,48 @@ impl Hierarchy {
     }
 }
 
+/// A set of hexagons `(level, centre)` stored like the split sets (16×16 tiles of bits per
+/// level): a work queue of hexagons near a change (discs of neighbours, mostly overlapping) is
+/// deduplicated in a few cached tiles instead of one hash entry per hexagon.
+#[derive(Debug, Clone, Default)]
+pub struct HexSet {
+    levels: Vec<TileSet>,
+}
+
+impl HexSet {
+    /// Inserts `v` at `level`; returns whether it was new.
+    pub fn insert(&mut self, level: u32, v: Axial) -> bool {
+        if self.levels.len() <= level as usize {
+            self.levels.resize_with(level as usize + 1, TileSet::default);
+        }
+        self.levels[level as usize].insert(v)
+    }
+
+    /// Whether `v` at `level` is in the set.
+    #[cfg(test)]
+    pub fn contains(&self, level: u32, v: Axial) -> bool {
+        self.levels
+            .get(level as usize)
+            .is_some_and(|s| s.contains(v))
+    }
+
+    /// The hexagons, level by level, tile by tile (deterministic order).
+    pub fn iter(&self) -> impl Iterator<Item = (u32, Axial)> + '_ {
+        self.levels
+            .iter()
+            .enumerate()
+            .flat_map(|(k, s)| s.iter().map(move |v| (k as u32, v)))
+    }
+}
+
+impl Extend<(u32, Axial)> for HexSet {
+    fn extend<I: IntoIterator<Item = (u32, Axial)>>(&mut self, iter: I) {
+        for (k, v) in iter {
+            self.insert(k, v);
+        }
+    }
+}
+
 /// Side of a tile, as a shift: tiles of 16×16 lattice coordinates.
 const TILE: u32 = 4;
 const TILE_MASK: i64 = (1 << TILE) - 1;
@@ -339,6 +381,33 @@ mod tests {
         got.dedup();
         assert_eq!(n, got.len(), "a point iterated twice");
         let mut want: Vec<Axial> = s.into_iter().collect();
+        want.sort_unstable();
+        assert_eq!(got, want);
+    }
+
+    /// The levelled set keeps levels apart and lists each member once.
+    #[test]
+    fn hex_set_keeps_levels_apart() {
+        let mut rng = ChaCha8Rng::seed_from_u64(6);
+        let mut t = HexSet::default();
+        let mut s: FxHashSet<(u32, Axial)> = FxHashSet::default();
+        for _ in 0..3000 {
+            let h = (
+                rng.random_range(0u32..4),
+                (rng.random_range(-20i64..20), rng.random_range(-20i64..20)),
+            );
+            assert_eq!(t.insert(h.0, h.1), s.insert(h));
+        }
+        for k in 0..5 {
+            for a in -22..22 {
+                for b in -22..22 {
+                    assert_eq!(t.contains(k, (a, b)), s.contains(&(k, (a, b))));
+                }
+            }
+        }
+        let mut got: Vec<_> = t.iter().collect();
+        got.sort_unstable();
+        let mut want: Vec<_> = s.into_iter().collect();
         want.sort_unstable();
         assert_eq!(got, want);
     }
