@@ -232,7 +232,8 @@ impl HexSet {
     /// Inserts `v` at `level`; returns whether it was new.
     pub fn insert(&mut self, level: u32, v: Axial) -> bool {
         if self.levels.len() <= level as usize {
-            self.levels.resize_with(level as usize + 1, TileSet::default);
+            self.levels
+                .resize_with(level as usize + 1, TileSet::default);
         }
         self.levels[level as usize].insert(v)
     }
