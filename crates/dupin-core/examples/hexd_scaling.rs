@@ -191,21 +191,23 @@ fn main() {
         .map(|(x, y)| (x - sx) * (y - sy))
         .sum::<f64>()
         / xs.iter().map(|x| (x - sx).powi(2)).sum::<f64>();
-    if std::env::var("HEXD_PHASES").is_ok() {
-        for &n in &[16000usize, 64000] {
+    // HEXD_PHASES=n1,n2,..: thread CPU time of refinement and of the dual (with the extended
+    // relocations) at those sizes.
+    if let Ok(list) = std::env::var("HEXD_PHASES") {
+        for n in list.split(',').filter_map(|s| s.parse::<usize>().ok()) {
             let pts = uniform(n, n as u64);
-            let t0 = Instant::now();
+            let t0 = thread_cpu().unwrap_or(0.0);
             let mut s = dupin_core::HexDelaunayStepper::new(&pts, &[], mode).unwrap();
-            let t1 = Instant::now();
+            let t1 = thread_cpu().unwrap_or(0.0);
             s.run().unwrap();
-            let t2 = Instant::now();
+            let t2 = thread_cpu().unwrap_or(0.0);
             let tri = s.triangulation();
-            let t3 = Instant::now();
+            let t3 = thread_cpu().unwrap_or(0.0);
             println!(
-                "{n}: setup {:.4} refine {:.4} dual {:.4} splits {} tris {}",
-                (t1 - t0).as_secs_f64(),
-                (t2 - t1).as_secs_f64(),
-                (t3 - t2).as_secs_f64(),
+                "{n}: CPU s: setup {:.4} refine {:.4} dual {:.4}; splits {} tris {}",
+                t1 - t0,
+                t2 - t1,
+                t3 - t2,
                 s.split_count(),
                 tri.triangles.len()
             );

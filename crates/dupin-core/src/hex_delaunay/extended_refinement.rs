@@ -68,13 +68,7 @@ fn for_each_leaf(h: &Hierarchy, mut f: impl FnMut(u32, Axial)) {
 
 /// Bit `j` set when the neighbour in direction `DIRS[j]` is split (a fin lies between).
 fn fin_mask(h: &Hierarchy, k: u32, v: Axial) -> u8 {
-    let mut m = 0u8;
-    for (j, d) in DIRS.iter().enumerate() {
-        if h.is_split(k, add(v, *d)) {
-            m |= 1 << j;
-        }
-    }
-    m
+    h.split_neighbours(k, v)
 }
 
 /// For one or two consecutive fins, the index of the first fin direction and the count.
