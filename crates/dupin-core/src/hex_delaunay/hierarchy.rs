@@ -285,28 +285,35 @@ const TILE: u32 = 4;
 const TILE_MASK: i64 = (1 << TILE) - 1;
 
 /// A set of lattice points stored as 16×16 tiles, each a 256-bit set (4 words, half a cache
-/// line) inline in one hash-map entry. Written by hand because no crate offers a sparse 2D
-/// bitset over unbounded signed coordinates; a hash set of points costs one scattered probe
-/// per query into a table that outgrows the caches (1.4 million splits at 16k points in the
-/// extended mode), while neighbouring queries here land in the same, already cached, entry.
+/// line). Written by hand because no crate offers a sparse 2D bitset over unbounded signed
+/// coordinates; a hash set of points costs one scattered probe per query into a table that
+/// outgrows the caches (1.4 million splits at 16k points in the extended mode), while
+/// neighbouring queries here land in the same, already cached, tile.
 #[derive(Debug, Clone)]
 struct TileSet {
-    tiles: FxHashMap<Axial, [u64; 4]>,
-    /// The tile of the last query (its key, or `NO_TILE`, and a copy of its words): the rules
-    /// ask about a hexagon and its neighbours in a row, so most queries skip the hash probe.
-    last_key: Memo<Axial>,
-    last: [Memo<u64>; 4],
+    /// Tile key → index into `words` and `keys`.
+    index: FxHashMap<Axial, u32>,
+    /// The tiles' bits, in order of creation.
+    words: Vec<[u64; 4]>,
+    /// The tiles' keys, in order of creation.
+    keys: Vec<Axial>,
+    /// The tile of the last query and its index (`NONE` if absent): the rules ask about a
+    /// hexagon and its neighbours in a row, so most queries and inserts skip the hash probe.
+    last: Memo<(Axial, u32)>,
 }
 
 /// No tile has this key (keys are coordinates shifted right by `TILE`).
 const NO_TILE: Axial = (i64::MIN, i64::MIN);
+/// Index of an absent tile.
+const NONE: u32 = u32::MAX;
 
 impl Default for TileSet {
     fn default() -> Self {
         TileSet {
-            tiles: FxHashMap::default(),
-            last_key: Memo::new(NO_TILE),
-            last: Default::default(),
+            index: FxHashMap::default(),
+            words: Vec::new(),
+            keys: Vec::new(),
+            last: Memo::new((NO_TILE, NONE)),
         }
     }
 }
@@ -319,21 +326,27 @@ impl TileSet {
         ((v.0 >> TILE, v.1 >> TILE), bit)
     }
 
-    #[inline]
+    /// Index of the tile `key` (`NONE` if absent), remembered for the next query.
+    #[inline(always)]
+    fn tile(&self, key: Axial) -> u32 {
+        let (k, i) = self.last.get();
+        if k == key {
+            return i;
+        }
+        let i = self.index.get(&key).copied().unwrap_or(NONE);
+        self.last.set((key, i));
+        i
+    }
+
+    #[inline(always)]
     fn contains(&self, v: Axial) -> bool {
         let (key, bit) = Self::slot(v);
-        if self.last_key.get() != key {
-            let words = self.tiles.get(&key).copied().unwrap_or_default();
-            for (c, w) in self.last.iter().zip(words) {
-                c.set(w);
-            }
-            self.last_key.set(key);
-        }
-        (self.last[bit >> 6].get() >> (bit & 63)) & 1 != 0
+        let i = self.tile(key);
+        i != NONE && (self.words[i as usize][bit >> 6] >> (bit & 63)) & 1 != 0
     }
 
     /// Bit `j` set when `v + DIRS[j]` is in the set.
-    #[inline]
+    #[inline(always)]
     fn neighbours(&self, v: Axial) -> u8 {
         let (row, col) = (v.0 & TILE_MASK, v.1 & TILE_MASK);
         if row == 0 || col == 0 || row == TILE_MASK || col == TILE_MASK {
@@ -343,10 +356,14 @@ impl TileSet {
             }
             return m;
         }
-        self.contains(v); // loads the tile into `last`
+        let i = self.tile((v.0 >> TILE, v.1 >> TILE));
+        if i == NONE {
+            return 0;
+        }
+        let w = &self.words[i as usize];
         let bit = |a: i64, b: i64| -> u8 {
             let i = (((row + a) << TILE) | (col + b)) as usize;
-            ((self.last[i >> 6].get() >> (i & 63)) & 1) as u8
+            ((w[i >> 6] >> (i & 63)) & 1) as u8
         };
         // DIRS: (1, 0), (0, 1), (-1, 1), (-1, 0), (0, -1), (1, -1).
         bit(1, 0)
@@ -358,46 +375,70 @@ impl TileSet {
     }
 
     /// Inserts `v`; returns whether it was new.
-    #[inline]
+    #[inline(always)]
     fn insert(&mut self, v: Axial) -> bool {
         let (key, bit) = Self::slot(v);
-        let w = &mut self.tiles.entry(key).or_default()[bit >> 6];
+        let mut i = self.tile(key);
+        if i == NONE {
+            i = self.words.len() as u32;
+            self.index.insert(key, i);
+            self.words.push([0; 4]);
+            self.keys.push(key);
+            self.last.set((key, i));
+        }
+        let w = &mut self.words[i as usize][bit >> 6];
         let m = 1u64 << (bit & 63);
         let new = *w & m == 0;
         *w |= m;
-        if self.last_key.get() == key {
-            self.last[bit >> 6].set(*w);
-        }
         new
     }
 
     /// Removes `v` (an emptied tile stays, as an all-zero entry).
     fn remove(&mut self, v: Axial) {
         let (key, bit) = Self::slot(v);
-        if let Some(t) = self.tiles.get_mut(&key) {
-            t[bit >> 6] &= !(1u64 << (bit & 63));
-            if self.last_key.get() == key {
-                self.last[bit >> 6].set(t[bit >> 6]);
-            }
+        let i = self.tile(key);
+        if i != NONE {
+            self.words[i as usize][bit >> 6] &= !(1u64 << (bit & 63));
         }
     }
 
-    /// The points, tile by tile, row-major within a tile.
-    fn iter(&self) -> impl Iterator<Item = Axial> + '_ {
-        self.tiles.iter().flat_map(|(&(ta, tb), words)| {
-            words.iter().enumerate().flat_map(move |(i, &w0)| {
-                let mut w = w0;
-                std::iter::from_fn(move || {
-                    if w == 0 {
-                        return None;
-                    }
-                    let bit = (i << 6) | w.trailing_zeros() as usize;
-                    w &= w - 1;
-                    let (row, col) = ((bit >> TILE) as i64, (bit as i64) & TILE_MASK);
-                    Some(((ta << TILE) | row, (tb << TILE) | col))
-                })
-            })
-        })
+    /// The points, tile by tile (in order of creation), row-major within a tile.
+    fn iter(&self) -> TileIter<'_> {
+        TileIter {
+            set: self,
+            tile: 0,
+            word: 0,
+            bits: self.words.first().map_or(0, |w| w[0]),
+        }
+    }
+}
+
+/// Iterator over a [`TileSet`]: the set bits of each word in turn.
+struct TileIter<'a> {
+    set: &'a TileSet,
+    tile: usize,
+    word: usize,
+    bits: u64,
+}
+
+impl Iterator for TileIter<'_> {
+    type Item = Axial;
+
+    #[inline]
+    fn next(&mut self) -> Option<Axial> {
+        while self.bits == 0 {
+            self.word += 1;
+            if self.word == 4 {
+                self.word = 0;
+                self.tile += 1;
+            }
+            self.bits = *self.set.words.get(self.tile)?.get(self.word)?;
+        }
+        let bit = (self.word << 6) | self.bits.trailing_zeros() as usize;
+        self.bits &= self.bits - 1;
+        let (ta, tb) = self.set.keys[self.tile];
+        let (row, col) = ((bit >> TILE) as i64, (bit as i64) & TILE_MASK);
+        Some(((ta << TILE) | row, (tb << TILE) | col))
     }
 }
 
