@@ -236,6 +236,7 @@ impl Hierarchy {
 #[derive(Debug, Clone, Default)]
 pub struct HexSet {
     levels: Vec<TileSet>,
+    len: usize,
 }
 
 impl HexSet {
@@ -245,13 +246,17 @@ impl HexSet {
             self.levels
                 .resize_with(level as usize + 1, TileSet::default);
         }
-        self.levels[level as usize].insert(v)
+        let new = self.levels[level as usize].insert(v);
+        self.len += usize::from(new);
+        new
     }
 
     /// Removes `v` at `level`.
     pub fn remove(&mut self, level: u32, v: Axial) {
-        if let Some(s) = self.levels.get_mut(level as usize) {
-            s.remove(v);
+        if let Some(s) = self.levels.get_mut(level as usize)
+            && s.remove(v)
+        {
+            self.len -= 1;
         }
     }
 
@@ -263,14 +268,42 @@ impl HexSet {
             .is_some_and(|s| s.contains(v))
     }
 
-    /// The hexagons, level by level, tile by tile (deterministic order).
-    pub fn iter(&self) -> impl Iterator<Item = (u32, Axial)> + '_ {
-        self.levels
-            .iter()
-            .enumerate()
-            .flat_map(|(k, s)| s.iter().map(move |v| (k as u32, v)))
+    /// The hexagons, level by level, tile by tile (deterministic order). The exact length is
+    /// known, so collecting allocates once.
+    pub fn iter(&self) -> impl ExactSizeIterator<Item = (u32, Axial)> + '_ {
+        Counted {
+            inner: self
+                .levels
+                .iter()
+                .enumerate()
+                .flat_map(|(k, s)| s.iter().map(move |v| (k as u32, v))),
+            left: self.len,
+        }
     }
 }
+
+/// An iterator with a known number of items left.
+struct Counted<I> {
+    inner: I,
+    left: usize,
+}
+
+impl<I: Iterator> Iterator for Counted<I> {
+    type Item = I::Item;
+
+    #[inline]
+    fn next(&mut self) -> Option<I::Item> {
+        let x = self.inner.next()?;
+        self.left -= 1;
+        Some(x)
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        (self.left, Some(self.left))
+    }
+}
+
+impl<I: Iterator> ExactSizeIterator for Counted<I> {}
 
 impl Extend<(u32, Axial)> for HexSet {
     fn extend<I: IntoIterator<Item = (u32, Axial)>>(&mut self, iter: I) {
@@ -393,13 +426,18 @@ impl TileSet {
         new
     }
 
-    /// Removes `v` (an emptied tile stays, as an all-zero entry).
-    fn remove(&mut self, v: Axial) {
+    /// Removes `v` (an emptied tile stays, as an all-zero entry); returns whether it was in.
+    fn remove(&mut self, v: Axial) -> bool {
         let (key, bit) = Self::slot(v);
         let i = self.tile(key);
-        if i != NONE {
-            self.words[i as usize][bit >> 6] &= !(1u64 << (bit & 63));
+        if i == NONE {
+            return false;
         }
+        let w = &mut self.words[i as usize][bit >> 6];
+        let m = 1u64 << (bit & 63);
+        let was = *w & m != 0;
+        *w &= !m;
+        was
     }
 
     /// The points, tile by tile (in order of creation), row-major within a tile.
@@ -510,7 +548,9 @@ mod tests {
                 }
             }
         }
+        assert_eq!(t.iter().len(), s.len());
         let mut got: Vec<_> = t.iter().collect();
+        assert_eq!(got.len(), s.len());
         got.sort_unstable();
         let mut want: Vec<_> = s.into_iter().collect();
         want.sort_unstable();
