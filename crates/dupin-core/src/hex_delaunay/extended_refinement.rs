@@ -581,11 +581,11 @@ fn affected(r: &Refinement, index: &mut OccupiedIndex, changes: &[(u32, Axial)])
     }
     for &(k, x) in changes {
         let c = (2 * x.0, 2 * x.1);
-        leaves.extend(disc(x, 2).map(|z| (k, z)));
-        leaves.extend(disc(c, 3).map(|z| (k + 1, z)));
+        leaves.insert_disc(k, x, 2);
+        leaves.insert_disc(k + 1, c, 3);
         if k >= 1 {
             let half = (x.0.div_euclid(2), x.1.div_euclid(2));
-            leaves.extend(disc(half, 2).map(|z| (k - 1, z)));
+            leaves.insert_disc(k - 1, half, 2);
             index.near(r, k - 1, half, 6, |o| {
                 occupied.insert((k - 1, o));
             });

@@ -251,6 +251,26 @@ impl HexSet {
         new
     }
 
+    /// Inserts every lattice point within hexagonal distance `r` of `c` at `level` (the
+    /// neighbourhood of a change), a row of bits at a time.
+    pub fn insert_disc(&mut self, level: u32, c: Axial, r: i64) {
+        if self.levels.len() <= level as usize {
+            self.levels
+                .resize_with(level as usize + 1, TileSet::default);
+        }
+        let set = &mut self.levels[level as usize];
+        for i in -r..=r {
+            let a = c.0 + i;
+            let (mut b0, b1) = (c.1 + (-r).max(-i - r), c.1 + r.min(-i + r));
+            while b0 <= b1 {
+                // The part of the row inside one tile.
+                let end = b1.min(b0 | TILE_MASK);
+                self.len += set.insert_run(a, b0, end);
+                b0 = end + 1;
+            }
+        }
+    }
+
     /// Removes `v` at `level`.
     pub fn remove(&mut self, level: u32, v: Axial) {
         if let Some(s) = self.levels.get_mut(level as usize)
@@ -426,6 +446,25 @@ impl TileSet {
         new
     }
 
+    /// Inserts `(a, b)` for `b0 <= b <= b1`, all in one tile; returns how many were new.
+    fn insert_run(&mut self, a: i64, b0: i64, b1: i64) -> usize {
+        let (key, bit) = Self::slot((a, b0));
+        let mut i = self.tile(key);
+        if i == NONE {
+            i = self.words.len() as u32;
+            self.index.insert(key, i);
+            self.words.push([0; 4]);
+            self.keys.push(key);
+            self.last.set((key, i));
+        }
+        let len = (b1 - b0 + 1) as u32;
+        let m = ((1u64 << len) - 1) << (bit & 63);
+        let w = &mut self.words[i as usize][bit >> 6];
+        let new = (m & !*w).count_ones() as usize;
+        *w |= m;
+        new
+    }
+
     /// Removes `v` (an emptied tile stays, as an all-zero entry); returns whether it was in.
     fn remove(&mut self, v: Axial) -> bool {
         let (key, bit) = Self::slot(v);
@@ -544,6 +583,29 @@ mod tests {
         for k in 0..5 {
             for a in -22..22 {
                 for b in -22..22 {
+                    assert_eq!(t.contains(k, (a, b)), s.contains(&(k, (a, b))));
+                }
+            }
+        }
+        // Discs, as the extended passes insert them, across tile borders.
+        for _ in 0..300 {
+            let (k, c, r) = (
+                rng.random_range(0u32..4),
+                (rng.random_range(-40i64..40), rng.random_range(-40i64..40)),
+                rng.random_range(0i64..4),
+            );
+            t.insert_disc(k, c, r);
+            for a in -r..=r {
+                for b in -r..=r {
+                    if (a + b).abs() <= r {
+                        s.insert((k, (c.0 + a, c.1 + b)));
+                    }
+                }
+            }
+        }
+        for k in 0..5 {
+            for a in -45..45 {
+                for b in -45..45 {
                     assert_eq!(t.contains(k, (a, b)), s.contains(&(k, (a, b))));
                 }
             }
