@@ -1,9 +1,10 @@
 //! Criterion benchmarks of the hexagonal Delaunay triangulation (simple and extended
 //! refinement) on seeded uniform points, with spade's constrained Delaunay refinement at its default 30° bound on the
-//! same points as the peer. Run: `cargo bench -p dupin-core --bench hex_delaunay -- --quick`.
+//! same points as the peer, and the paper's PSLG data set (the IMR letters fixture, both modes).
+//! Run: `cargo bench -p dupin-core --bench hex_delaunay -- --quick`.
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use dupin_core::{HexDelaunayMode, Vec2, hex_delaunay};
+use dupin_core::{HexDelaunayMode, Vec2, hex_delaunay, parse_points, parse_segments};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use spade::{ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation};
@@ -55,6 +56,22 @@ fn bench(c: &mut Criterion) {
         });
         g.bench_with_input(BenchmarkId::new("spade_refine_30deg", n), &pts, |b, p| {
             b.iter(|| spade_refine(black_box(p)))
+        });
+    }
+    // The paper's data set 4: the letters IMR as a PSLG (75 points, 75 segments).
+    let pts = parse_points(include_str!("../tests/data/imr_points.txt")).expect("fixture");
+    let segs = parse_segments(include_str!("../tests/data/imr_segments.txt")).expect("fixture");
+    for (name, mode) in [
+        ("imr_pslg_simple", HexDelaunayMode::Simple),
+        ("imr_pslg_extended", HexDelaunayMode::Extended),
+    ] {
+        let n = hex_delaunay(&pts, &segs, mode)
+            .expect("valid PSLG")
+            .triangles
+            .len();
+        eprintln!("IMR letters, {mode:?}: {n} triangles");
+        g.bench_function(name, |b| {
+            b.iter(|| hex_delaunay(black_box(&pts), &segs, mode).map(|t| t.triangles.len()))
         });
     }
     g.finish();

@@ -2,6 +2,12 @@
 //! output triangles for 1k..64k uniform points, the fitted exponent, and spade's 30° refinement
 //! on the same points. Run: `cargo run --release -p dupin-core --example hexd_scaling`
 //! (simple mode) or `... --example hexd_scaling -- --extended` (extended mode).
+//!
+//! Environment: `HEXD_MIN` / `HEXD_MAX` bound the sizes; `HEXD_NO_SPADE` skips the peer;
+//! `HEXD_HASH` prints a fingerprint of each output (triangles in order and vertex bits, to check
+//! that a data-layout change changes nothing); `HEXD_DUMP=dir` writes the points for an outside
+//! peer (e.g. Triangle); `HEXD_PHASES=n1,n2` prints the thread CPU time of refinement and dual
+//! extraction at those sizes.
 
 use dupin_core::{HexDelaunayMode, Vec2, hex_delaunay};
 use rand::{RngExt, SeedableRng};
@@ -57,6 +63,26 @@ fn spade_refine(points: &[Vec2]) -> (usize, f64) {
     (cdt.num_inner_faces(), start.elapsed().as_secs_f64())
 }
 
+/// FNV-1a over the triangles (in order) and the vertex coordinates' bits: equal fingerprints
+/// mean the same triangulation, so a data-layout change can be checked to change nothing.
+fn fingerprint(t: &dupin_core::HexTriangulation) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    let mut eat = |x: u64| {
+        h ^= x;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    };
+    for tri in &t.triangles {
+        for &v in tri {
+            eat(u64::from(v));
+        }
+    }
+    for p in &t.vertices {
+        eat(p.x.to_bits());
+        eat(p.y.to_bits());
+    }
+    h
+}
+
 fn main() {
     let mode = if std::env::args().any(|a| a == "--extended") {
         HexDelaunayMode::Extended
@@ -69,9 +95,14 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(64000);
+    // HEXD_MIN=N skips the sizes below N.
+    let min: usize = std::env::var("HEXD_MIN")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0);
     let sizes: Vec<usize> = [1000usize, 2000, 4000, 8000, 16000, 32000, 64000]
         .into_iter()
-        .filter(|&n| n <= max)
+        .filter(|&n| n <= max && n >= min)
         .collect();
     let mut xs = Vec::new();
     let mut ys = Vec::new();
@@ -97,6 +128,7 @@ fn main() {
                 .collect();
             std::fs::write(format!("{dir}/uniform_{n}.txt"), text).expect("writable dump dir");
         }
+        let mut hash = 0u64;
         let mut best = f64::INFINITY;
         let mut best_cpu = f64::INFINITY;
         let mut tris = 0;
@@ -119,6 +151,25 @@ fn main() {
             peak = PEAK.load(Ordering::Relaxed) - base;
             best = best.min(s);
             tris = t.triangles.len();
+            hash = fingerprint(&t);
+        }
+        if std::env::var("HEXD_HASH").is_ok() {
+            println!("{n}: output fingerprint {hash:016x}");
+        }
+        if std::env::var("HEXD_NO_SPADE").is_ok() {
+            xs.push((tris as f64).ln());
+            ys.push((if best_cpu.is_finite() { best_cpu } else { best }).ln());
+            println!(
+                "{:>7} {:>10} {:>9.4} {:>9.4} {:>10.1} {:>12.1} {:>9.1}",
+                n,
+                tris,
+                best,
+                best_cpu,
+                best_cpu.min(best) * 1e9 / tris as f64,
+                peak as f64 / 1e6,
+                peak as f64 / tris as f64
+            );
+            continue;
         }
         let (st, ss) = spade_refine(&pts);
         // Thread CPU time where available (the machine may be shared), else wall time.
@@ -146,29 +197,33 @@ fn main() {
         .map(|(x, y)| (x - sx) * (y - sy))
         .sum::<f64>()
         / xs.iter().map(|x| (x - sx).powi(2)).sum::<f64>();
-    if std::env::var("HEXD_PHASES").is_ok() {
-        for &n in &[16000usize, 64000] {
+    // HEXD_PHASES=n1,n2,..: thread CPU time of refinement and of the dual (with the extended
+    // relocations) at those sizes.
+    if let Ok(list) = std::env::var("HEXD_PHASES") {
+        for n in list.split(',').filter_map(|s| s.parse::<usize>().ok()) {
             let pts = uniform(n, n as u64);
-            let t0 = Instant::now();
+            let t0 = thread_cpu().unwrap_or(0.0);
             let mut s = dupin_core::HexDelaunayStepper::new(&pts, &[], mode).unwrap();
-            let t1 = Instant::now();
+            let t1 = thread_cpu().unwrap_or(0.0);
             s.run().unwrap();
-            let t2 = Instant::now();
+            let t2 = thread_cpu().unwrap_or(0.0);
             let tri = s.triangulation();
-            let t3 = Instant::now();
+            let t3 = thread_cpu().unwrap_or(0.0);
             println!(
-                "{n}: setup {:.4} refine {:.4} dual {:.4} splits {} tris {}",
-                (t1 - t0).as_secs_f64(),
-                (t2 - t1).as_secs_f64(),
-                (t3 - t2).as_secs_f64(),
+                "{n}: CPU s: setup {:.4} refine {:.4} dual {:.4}; splits {} tris {}",
+                t1 - t0,
+                t2 - t1,
+                t3 - t2,
                 s.split_count(),
                 tri.triangles.len()
             );
         }
     }
-    println!(
-        "fitted exponent of (CPU) time against triangles ({}..{} points): {slope:.3}",
-        sizes[0],
-        sizes[sizes.len() - 1]
-    );
+    if sizes.len() >= 2 {
+        println!(
+            "fitted exponent of (CPU) time against triangles ({}..{} points): {slope:.3}",
+            sizes[0],
+            sizes[sizes.len() - 1]
+        );
+    }
 }

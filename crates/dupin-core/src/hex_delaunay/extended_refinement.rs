@@ -32,7 +32,7 @@
 
 use super::dual::{Key, pack};
 use super::error::HexDelaunayError;
-use super::hierarchy::{Cell, Hierarchy};
+use super::hierarchy::{Cell, HexSet, Hierarchy};
 use super::lattice::{Axial, DIRS, add, hex_norm, in_domain, on_boundary, parents_of_midpoint};
 use super::simple_refinement::Refinement;
 use crate::math::Vec2;
@@ -47,7 +47,7 @@ fn for_each_leaf(h: &Hierarchy, mut f: impl FnMut(u32, Axial)) {
         return;
     }
     for k in 0..h.depth() {
-        for &x in h.split_at(k) {
+        for x in h.split_at(k) {
             let c = (2 * x.0, 2 * x.1);
             if !h.is_split(k + 1, c) {
                 f(k + 1, c);
@@ -68,13 +68,7 @@ fn for_each_leaf(h: &Hierarchy, mut f: impl FnMut(u32, Axial)) {
 
 /// Bit `j` set when the neighbour in direction `DIRS[j]` is split (a fin lies between).
 fn fin_mask(h: &Hierarchy, k: u32, v: Axial) -> u8 {
-    let mut m = 0u8;
-    for (j, d) in DIRS.iter().enumerate() {
-        if h.is_split(k, add(v, *d)) {
-            m |= 1 << j;
-        }
-    }
-    m
+    h.split_neighbours(k, v)
 }
 
 /// For one or two consecutive fins, the index of the first fin direction and the count.
@@ -580,19 +574,18 @@ impl OccupiedIndex {
 /// hexagons one level finer); the leaves read their rings. Those within eight steps at levels
 /// `k` and `k + 1` (from `2x`) and six at level `k - 1` are re-run and give the ring roles.
 fn affected(r: &Refinement, index: &mut OccupiedIndex, changes: &[(u32, Axial)]) -> (Hexes, Hexes) {
-    let mut leaves: FxHashSet<(u32, Axial)> = FxHashSet::default();
-    leaves.reserve(changes.len() * 24);
+    let mut leaves = HexSet::default();
     let mut occupied: FxHashSet<(u32, Axial)> = FxHashSet::default();
     for &(k, x) in changes {
         index.after_split(r, k, x);
     }
     for &(k, x) in changes {
         let c = (2 * x.0, 2 * x.1);
-        leaves.extend(disc(x, 2).map(|z| (k, z)));
-        leaves.extend(disc(c, 3).map(|z| (k + 1, z)));
+        leaves.insert_disc(k, x, 2);
+        leaves.insert_disc(k + 1, c, 3);
         if k >= 1 {
             let half = (x.0.div_euclid(2), x.1.div_euclid(2));
-            leaves.extend(disc(half, 2).map(|z| (k - 1, z)));
+            leaves.insert_disc(k - 1, half, 2);
             index.near(r, k - 1, half, 6, |o| {
                 occupied.insert((k - 1, o));
             });
@@ -605,7 +598,7 @@ fn affected(r: &Refinement, index: &mut OccupiedIndex, changes: &[(u32, Axial)])
         });
     }
     // The order of the visits does not matter (the rules read the state, not the marks).
-    (leaves.into_iter().collect(), occupied.into_iter().collect())
+    (leaves.iter().collect(), occupied.into_iter().collect())
 }
 
 /// An incremental pass over the given leaves and occupied hexagons.

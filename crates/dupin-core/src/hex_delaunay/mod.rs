@@ -14,10 +14,10 @@
 //! full hexagons, whose centres stay on Ω's edges) never need refining below the size the
 //! points' spacing requires.
 //!
-//! Data structure (the O(n log n) requirement): split hexagons are kept in one hash set
-//! per level keyed by lattice coordinates, points are re-checked from a work queue only when a
-//! nearby hexagon changes, and the dual is extracted by a recursion over the lattice triangles
-//! that costs O(1) per output triangle. See `hierarchy.rs`, `simple_refinement.rs`, `dual.rs`.
+//! Data structure (the O(n log n) requirement): split hexagons are kept per level in
+//! 16×16 tiles of lattice coordinates (a hash map of 256-bit sets), points are re-checked from
+//! a work queue only when a nearby hexagon changes, and the dual is extracted by a recursion
+//! over the lattice triangles that costs O(1) per output triangle. See `hierarchy.rs`, `simple_refinement.rs`, `dual.rs`.
 //!
 //! PSLG input (section 7, `pslg.rs`): segments refine the hexagons they meet, the centres of
 //! met hexagons move onto them, and each segment becomes a chain of output edges

@@ -25,7 +25,7 @@
 //! triangles, n points.
 
 use super::error::HexDelaunayError;
-use super::hierarchy::{Cell, Hierarchy};
+use super::hierarchy::{Cell, HexSet, Hierarchy};
 use super::lattice::{Axial, DIRS, add};
 use crate::math::Vec2;
 use rustc_hash::FxHashMap;
@@ -41,6 +41,9 @@ pub struct Refinement {
     /// Leaf cell of every point.
     pub cell_of: Vec<Cell>,
     occupants: FxHashMap<Cell, Vec<u32>>,
+    /// The occupied full cells, tiled like the split sets: most occupancy queries (rings
+    /// around occupied hexagons) find an empty cell here without probing `occupants`.
+    occupied_full: HexSet,
     queue: VecDeque<u32>,
     queued: Vec<bool>,
     scratch: Vec<(u32, Axial)>,
@@ -59,8 +62,12 @@ impl Refinement {
     pub fn new(hierarchy: Hierarchy, points: Vec<Vec2>) -> Self {
         let mut occupants: FxHashMap<Cell, Vec<u32>> = FxHashMap::default();
         let cell_of: Vec<Cell> = points.iter().map(|p| hierarchy.locate(*p)).collect();
+        let mut occupied_full = HexSet::default();
         for (i, c) in cell_of.iter().enumerate() {
             occupants.entry(*c).or_default().push(i as u32);
+            if let Cell::Full(k, x) = *c {
+                occupied_full.insert(k, x);
+            }
         }
         let n = points.len();
         Refinement {
@@ -68,6 +75,7 @@ impl Refinement {
             points,
             cell_of,
             occupants,
+            occupied_full,
             queue: (0..n as u32).collect(),
             queued: vec![true; n],
             scratch: Vec::new(),
@@ -83,6 +91,9 @@ impl Refinement {
         let c = self.hierarchy.locate(p);
         self.cell_of.push(c);
         self.occupants.entry(c).or_default().push(i);
+        if let Cell::Full(k, x) = c {
+            self.occupied_full.insert(k, x);
+        }
         self.queued.push(false);
         self.push(i);
         i
@@ -102,10 +113,20 @@ impl Refinement {
 
     /// The points (distinct-point indices) in the leaf cell `c`.
     pub fn occupants_of(&self, c: &Cell) -> &[u32] {
+        if let Cell::Full(k, x) = *c
+            && !self.occupied_full.contains(k, x)
+        {
+            return &[];
+        }
         self.occupants.get(c).map_or(&[], Vec::as_slice)
     }
 
     fn occupied(&self, c: &Cell) -> usize {
+        if let Cell::Full(k, x) = *c
+            && !self.occupied_full.contains(k, x)
+        {
+            return 0;
+        }
         self.occupants.get(c).map_or(0, Vec::len)
     }
 
@@ -113,6 +134,9 @@ impl Refinement {
     /// once the simple rules are done every occupied cell holds exactly one point).
     #[inline]
     pub fn point_in(&self, k: u32, x: Axial) -> Option<Vec2> {
+        if !self.occupied_full.contains(k, x) {
+            return None;
+        }
         let i = *self.occupants.get(&Cell::Full(k, x))?.last()?;
         Some(self.points[i as usize])
     }
@@ -216,6 +240,9 @@ impl Refinement {
     fn relocate(&mut self, i: u32, c: Cell) {
         self.cell_of[i as usize] = c;
         self.occupants.entry(c).or_default().push(i);
+        if let Cell::Full(k, x) = c {
+            self.occupied_full.insert(k, x);
+        }
         self.push(i);
     }
 
@@ -223,6 +250,7 @@ impl Refinement {
     /// rules may now fire.
     fn after_split(&mut self, k: u32, x: Axial) {
         let moved = self.occupants.remove(&Cell::Full(k, x)).unwrap_or_default();
+        self.occupied_full.remove(k, x);
         for i in moved {
             let c = self.hierarchy.locate_from(self.points[i as usize], k, x);
             self.relocate(i, c);
@@ -238,6 +266,9 @@ impl Refinement {
         }
         for d in DIRS {
             let y = add(x, d);
+            if !self.occupied_full.contains(k, y) {
+                continue;
+            }
             if let Some(v) = self.occupants.get(&Cell::Full(k, y)) {
                 let v = v.clone();
                 for i in v {
@@ -270,7 +301,7 @@ mod tests {
             // Balancing: every split hexagon has its six neighbours (inside Ω) present, i.e.
             // adjacent cells differ by at most one paper level.
             for k in 0..h.depth() {
-                for &x in h.split_at(k) {
+                for x in h.split_at(k) {
                     assert!(h.is_present(k, x), "case {case}: split but absent");
                     for d in DIRS {
                         let y = add(x, d);

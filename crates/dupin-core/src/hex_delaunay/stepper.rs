@@ -283,7 +283,7 @@ impl HexDelaunayStepper {
             self.refinement.cell_of.iter().copied().collect();
         let mut out = Vec::new();
         for k in 0..h.depth() {
-            for &x in h.split_at(k) {
+            for x in h.split_at(k) {
                 let c = (2 * x.0, 2 * x.1);
                 if !h.is_split(k + 1, c) {
                     out.push(HexCell {
