@@ -16,6 +16,7 @@
 //! as long as the problem emits the same (row, column) pattern, so iterating on a fixed mesh
 //! costs one numeric factorisation per step.
 
+mod cholesky;
 mod gauss_newton;
 mod pattern;
 mod schur;
