@@ -22,6 +22,7 @@ mod pattern;
 mod schur;
 mod sqp;
 
+pub(crate) use cholesky::{Ordering, SparseCholesky};
 pub use gauss_newton::{LevenbergMarquardt, LmOptions, LmStep, NonlinearLeastSquares};
 pub use sqp::{ConstrainedLeastSquares, Sqp, SqpOptions, SqpStep};
 
