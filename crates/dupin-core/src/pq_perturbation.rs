@@ -203,7 +203,7 @@ pub struct PqStepInfo {
 pub struct PqResult {
     /// The perturbed mesh (the best one reached when not converged).
     pub mesh: PolyMesh,
-    /// Iterations used.
+    /// Iterations used (penalty, Newton and chord steps; see [`PqResult::factorizations`]).
     pub iterations: usize,
     /// Whether the tolerance was reached.
     pub converged: bool,
@@ -217,7 +217,8 @@ pub struct PqResult {
     pub circular_residual: Option<f64>,
     /// Largest vertex displacement from the input.
     pub max_move: f64,
-    /// Sparse factorisations used (one per tried Gauss-Newton step).
+    /// Sparse factorisations used (one per tried Gauss-Newton step; the chord steps of the
+    /// exact phase reuse the last one).
     pub factorizations: usize,
 }
 
@@ -559,7 +560,8 @@ fn is_convex(pts: &[Vec3]) -> bool {
 }
 
 /// A PQ / conical / circular perturbation that can be stepped and watched (one step is one
-/// penalty or SQP iteration). [`pq_perturb`] runs it to the end.
+/// penalty or SQP iteration, or in the exact phase a chord step reusing the last
+/// factorisation). [`pq_perturb`] runs it to the end.
 pub struct PqPerturbation {
     mesh: PolyMesh,
     topo: MeshTopology,
