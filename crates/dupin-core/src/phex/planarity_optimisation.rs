@@ -51,18 +51,11 @@
 //! (element -> variable list) instead of triplets.
 
 use super::PhexError;
+use crate::solver::{Ordering, SparseCholesky};
 use crate::{PolyMesh, SolverError, Surface, Vec2, Vec3, max_planarity};
-use faer::Side;
 use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::cholesky::llt::factor::LltRegularization;
-use faer::perm::PermRef;
-use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::amd;
-use faer::sparse::linalg::cholesky::{
-    CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
-};
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
-use faer::{Conj, Par};
+use faer::sparse::{SymbolicSparseColMat, SymbolicSparseColMatRef};
 use nalgebra::Matrix3;
 
 /// Settings of the planarity optimisation.
@@ -228,8 +221,8 @@ impl BlockPattern {
 
 /// Elimination order of the normal matrix for the fallback Cholesky factorisation: AMD on the
 /// vertex graph (V nodes, 9x fewer entries than the scalar pattern, same fill once expanded to
-/// 3 x 3 blocks), as `(fwd, inv)` scalar permutations (`fwd[new] = old`).
-fn vertex_amd_ordering(pattern: &BlockPattern) -> (Vec<u32>, Vec<u32>) {
+/// 3 x 3 blocks), as the scalar permutation `fwd[new] = old`.
+fn vertex_amd_ordering(pattern: &BlockPattern) -> Vec<u32> {
     let nv = pattern.block_ptr.len() - 1;
     let col_ptr: Vec<u32> = pattern.block_ptr.iter().map(|&c| c as u32).collect();
     let graph = SymbolicSparseColMatRef::new_checked(nv, nv, &col_ptr, None, &pattern.blocks);
@@ -254,11 +247,7 @@ fn vertex_amd_ordering(pattern: &BlockPattern) -> (Vec<u32>, Vec<u32>) {
     for &v in &perm {
         fwd.extend([3 * v, 3 * v + 1, 3 * v + 2]);
     }
-    let mut inv = vec![0u32; 3 * nv];
-    for (new, &old) in fwd.iter().enumerate() {
-        inv[old as usize] = new as u32;
-    }
-    (fwd, inv)
+    fwd
 }
 
 /// Tetrahedron volume of four points and its gradients with respect to each of them.
@@ -278,18 +267,15 @@ fn quads(n: usize) -> usize {
     if n == 4 { 1 } else { n }
 }
 
-/// Symbolic sparse Cholesky analysis with its numeric storage and workspace (the fallback
-/// solver, created on first use).
+/// Sparse Cholesky analysis of the normal matrix (the fallback solver, created on first
+/// use), ordered by [`vertex_amd_ordering`], with the buffer of values in its layout.
 struct Factor {
-    matrix: SymbolicSparseColMat<u32>,
-    symbolic: SymbolicCholesky<u32>,
-    values: Vec<f64>,
-    scratch: MemBuffer,
+    chol: SparseCholesky,
+    permuted: Vec<f64>,
 }
 
 impl Factor {
     fn new(pattern: &BlockPattern) -> Result<Self, SolverError> {
-        let fe = |e: &dyn std::fmt::Debug| SolverError::Factorization(format!("{e:?}"));
         let n = pattern.col_ptr.len() - 1;
         let matrix = SymbolicSparseColMat::<u32>::new_checked(
             n,
@@ -298,28 +284,11 @@ impl Factor {
             None,
             pattern.row_indices(),
         );
-        let (fwd, inv) = vertex_amd_ordering(pattern);
-        let symbolic = factorize_symbolic_cholesky(
-            matrix.as_ref(),
-            Side::Upper,
-            SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n)),
-            CholeskySymbolicParams {
-                // faer's automatic choice picks the simplicial kernel for mesh matrices, several
-                // times slower here.
-                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-                ..Default::default()
-            },
-        )
-        .map_err(|e| fe(&e))?;
-        let req = symbolic
-            .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
-            .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
-        let scratch = MemBuffer::try_new(req).map_err(|e| fe(&e))?;
+        let fwd = vertex_amd_ordering(pattern);
+        let chol = SparseCholesky::analyse(matrix.as_ref(), Ordering::Custom(&fwd))?;
         Ok(Factor {
-            matrix,
-            values: vec![0.0; symbolic.len_val()],
-            symbolic,
-            scratch,
+            permuted: vec![0.0; chol.nnz()],
+            chol,
         })
     }
 }
@@ -442,7 +411,7 @@ impl PlanarityOptimiser {
     /// Stored entries of the Cholesky factor (nnz(L), supernodal blocks included); 0 until the
     /// Cholesky fallback is first used.
     pub fn factor_len(&self) -> usize {
-        self.factor.as_ref().map_or(0, |f| f.symbolic.len_val())
+        self.factor.as_ref().map_or(0, |f| f.chol.factor_len())
     }
 
     /// Conjugate-gradient iterations done so far.
@@ -609,34 +578,18 @@ impl PlanarityOptimiser {
             self.factor = Some(Factor::new(&self.pattern)?);
         }
         let factor = self.factor.as_mut().expect("created above");
-        let mut damped = self.values.clone();
+        let positions = factor.chol.positions();
+        for (&at, &v) in positions.iter().zip(&self.values) {
+            factor.permuted[at as usize] = v;
+        }
         for c in 0..g.len() {
-            damped[self.pattern.diagonal(c)] += delta;
+            factor.permuted[positions[self.pattern.diagonal(c)] as usize] += delta;
         }
-        let mat = SparseColMatRef::new(factor.matrix.as_ref(), &damped);
         self.factorizations += 1;
-        let f = factor
-            .symbolic
-            .factorize_numeric_llt(
-                &mut factor.values,
-                mat,
-                Side::Upper,
-                LltRegularization::default(),
-                Par::Seq,
-                MemStack::new(&mut factor.scratch),
-                Default::default(),
-            )
-            .map_err(|e| SolverError::Factorization(format!("{e:?}")))?;
+        factor.chol.factorize(&factor.permuted)?;
         let mut h: Vec<f64> = g.iter().map(|v| -v).collect();
-        let rhs = faer::MatMut::from_column_major_slice_mut(&mut h, g.len(), 1);
-        f.solve_in_place_with_conj(Conj::No, rhs, Par::Seq, MemStack::new(&mut factor.scratch));
-        if h.iter().all(|v| v.is_finite()) {
-            Ok(h)
-        } else {
-            Err(SolverError::Factorization(
-                "the solve produced non-finite values".into(),
-            ))
-        }
+        factor.chol.solve_in_place(&mut h)?;
+        Ok(h)
     }
 
     /// y = (A + delta I) x for the symmetric matrix stored as its upper triangle in `values`,

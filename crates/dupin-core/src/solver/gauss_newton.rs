@@ -93,6 +93,13 @@ pub struct LevenbergMarquardt {
     /// Damping the first rejected try jumps to (0: plain growth), see
     /// [`Self::set_damping_with_fallback`].
     fallback: f64,
+    /// Whether the last step was accepted with the factorisation still held, `sys` keeping
+    /// the Jacobian it was made from: a [`Self::chord_step`] may reuse it.
+    chord_ready: bool,
+    /// The damping of that factorisation.
+    chord_damping: f64,
+    /// Evaluation at a chord step's trial point.
+    chord_sys: SparseSystem,
 }
 
 impl LevenbergMarquardt {
@@ -112,6 +119,9 @@ impl LevenbergMarquardt {
             schur: BlockSchur::default(),
             schur_active: false,
             fallback: 0.0,
+            chord_ready: false,
+            chord_damping: 0.0,
+            chord_sys: SparseSystem::new(),
         }
     }
 
@@ -119,6 +129,7 @@ impl LevenbergMarquardt {
     /// from the last accepted step must not be reused.
     pub fn invalidate(&mut self) {
         self.cached_x = None;
+        self.chord_ready = false;
     }
 
     /// Number of sparse factorisations done so far (one per tried step).
@@ -239,6 +250,7 @@ impl LevenbergMarquardt {
         x: &mut [f64],
     ) -> Result<LmStep, SolverError> {
         let n = problem.num_variables();
+        self.chord_ready = false;
         if self.cached_x.as_deref() == Some(&*x) {
             std::mem::swap(&mut self.sys, &mut self.trial_sys);
         } else {
@@ -294,6 +306,8 @@ impl LevenbergMarquardt {
                 x.copy_from_slice(&trial);
                 self.cached_x = Some(trial);
                 let used = self.damping;
+                self.chord_ready = true;
+                self.chord_damping = used;
                 self.damping = (self.damping * 2.0).max(1e-12);
                 return Ok(LmStep {
                     cost_before,
@@ -316,6 +330,8 @@ impl LevenbergMarquardt {
                 x.copy_from_slice(&trial);
                 self.cached_x = Some(trial);
                 let used = self.damping;
+                self.chord_ready = true;
+                self.chord_damping = used;
                 // Nielsen's update (1999), floored at 1/decrease: shrink fully only when the
                 // model is nearly exact, barely on a fair one (ρ ≈ 0.7), grow on a poor one.
                 // A fixed shrink on every ρ > 0.5 made the next try fail (a wasted
@@ -342,6 +358,91 @@ impl LevenbergMarquardt {
         Err(SolverError::NoDescent {
             damping: self.damping,
         })
+    }
+
+    /// A chord (simplified Newton) step from `x`, the point the last accepted
+    /// [`Self::step`] or chord step reached: `(J₀ᵀJ₀ + μD) h = -J₀ᵀ r(x)` with the Jacobian
+    /// `J₀` and the factorisation of the last factored step and a fresh residual, so it costs
+    /// one evaluation and two triangular solves instead of an assembly and a factorisation.
+    /// The gradient must use `J₀` too: with `J(x)ᵀr` its part outside the row space of `J₀`
+    /// would be amplified by `1/μ` on an underdetermined system. Converges linearly, at a
+    /// rate proportional to the distance from the factored point, so it pays off in the
+    /// quadratic phase of Newton's method (Kelley, Iterative Methods for Linear and Nonlinear
+    /// Equations, 1995, Sec. 5.4).
+    ///
+    /// Returns `None` when no factorisation can be reused (nothing accepted since the last
+    /// factorisation, [`Self::invalidate`] called, a different Jacobian pattern); then `x` is
+    /// unchanged and [`Self::step`] is the way on. A step that does not lower the cost is
+    /// not taken (`cost_after == cost_before`, `step_norm == 0`).
+    pub fn chord_step<P: NonlinearLeastSquares + ?Sized>(
+        &mut self,
+        problem: &P,
+        x: &mut [f64],
+    ) -> Result<Option<LmStep>, SolverError> {
+        let n = problem.num_variables();
+        if !self.chord_ready || self.cached_x.as_deref() != Some(&*x) {
+            return Ok(None);
+        }
+        // `sys`: the evaluation the factor was made from; `trial_sys`: the one at `x`.
+        let (j0, now) = (&self.sys, &self.trial_sys);
+        let same = j0.residuals.len() == now.residuals.len()
+            && j0.entries.len() == now.entries.len()
+            && j0
+                .entries
+                .iter()
+                .zip(&now.entries)
+                .all(|(a, b)| a.row == b.row && a.col == b.col);
+        if !same || j0.entries.iter().any(|e| e.col as usize >= n) {
+            return Ok(None);
+        }
+        let cost_before = now.cost();
+        let unchanged = LmStep {
+            cost_before,
+            cost_after: cost_before,
+            step_norm: 0.0,
+            damping: self.chord_damping,
+        };
+        if cost_before == 0.0 {
+            return Ok(Some(unchanged));
+        }
+        let mut g = vec![0.0; n];
+        for e in &j0.entries {
+            g[e.col as usize] += e.value * now.residuals[e.row as usize];
+        }
+        let mut rhs: Vec<f64> = if self.schur_active {
+            self.schur.reduced_rhs(&g)
+        } else {
+            g.iter().map(|v| -v).collect()
+        };
+        if self.normal.solve_factored(&mut rhs).is_err() {
+            self.chord_ready = false;
+            return Ok(None);
+        }
+        let h = if self.schur_active {
+            self.schur.back_substitute(rhs, &g)
+        } else {
+            rhs
+        };
+        let trial: Vec<f64> = x.iter().zip(&h).map(|(a, b)| a + b).collect();
+        self.chord_sys.clear();
+        problem.evaluate(&trial, &mut self.chord_sys);
+        let cost_after = if self.chord_sys.validate(n).is_ok() {
+            self.chord_sys.cost()
+        } else {
+            f64::INFINITY
+        };
+        if cost_after >= cost_before {
+            return Ok(Some(unchanged));
+        }
+        x.copy_from_slice(&trial);
+        self.cached_x = Some(trial);
+        std::mem::swap(&mut self.trial_sys, &mut self.chord_sys);
+        Ok(Some(LmStep {
+            cost_before,
+            cost_after,
+            step_norm: h.iter().map(|v| v * v).sum::<f64>().sqrt(),
+            damping: self.chord_damping,
+        }))
     }
 }
 
@@ -503,6 +604,77 @@ mod tests {
                 - nalgebra::DVector::from_column_slice(&x0))
             + &c;
         assert!(c1.amax() <= 1e-5 * c.amax(), "{}", c1.amax());
+    }
+
+    /// An underdetermined nonlinear system `r_i = (A x)_i + x_i² x_{i+1} - b_i`.
+    struct Bent {
+        a: nalgebra::DMatrix<f64>,
+        b: Vec<f64>,
+    }
+    impl Bent {
+        fn jacobian(&self, x: &[f64]) -> nalgebra::DMatrix<f64> {
+            let mut j = self.a.clone();
+            for i in 0..self.a.nrows() {
+                j[(i, i)] += 2.0 * x[i] * x[i + 1];
+                j[(i, i + 1)] += x[i] * x[i];
+            }
+            j
+        }
+        fn residual(&self, x: &[f64]) -> nalgebra::DVector<f64> {
+            let ax = &self.a * nalgebra::DVector::from_column_slice(x);
+            nalgebra::DVector::from_fn(self.a.nrows(), |i, _| {
+                ax[i] + x[i] * x[i] * x[i + 1] - self.b[i]
+            })
+        }
+    }
+    impl NonlinearLeastSquares for Bent {
+        fn num_variables(&self) -> usize {
+            self.a.ncols()
+        }
+        fn evaluate(&self, x: &[f64], out: &mut SparseSystem) {
+            let (r, j) = (self.residual(x), self.jacobian(x));
+            for i in 0..j.nrows() {
+                let row = out.push_residual(r[i]);
+                for k in 0..j.ncols() {
+                    out.push_entry(row, k as u32, j[(i, k)]);
+                }
+            }
+        }
+    }
+
+    /// A chord step after a near-Newton step is the minimum-norm simplified Newton step
+    /// `-J₀ᵀ(J₀J₀ᵀ)⁻¹ r(x₁)` with the Jacobian of the factored point (no new factorisation),
+    /// and it shrinks the residual; without an accepted factored step there is none.
+    #[test]
+    fn chord_step_reuses_the_factorisation_with_the_old_jacobian() {
+        let mut rng = ChaCha8Rng::seed_from_u64(17);
+        let (m, n) = (6, 10);
+        let a = nalgebra::DMatrix::from_fn(m, n, |_, _| rng.random::<f64>() * 2.0 - 1.0);
+        let b: Vec<f64> = (0..m).map(|_| rng.random::<f64>()).collect();
+        let p = Bent { a, b };
+        let mut lm = LevenbergMarquardt::new(LmOptions::default());
+        let mut x: Vec<f64> = (0..n).map(|_| rng.random::<f64>() * 0.2).collect();
+        assert_eq!(lm.chord_step(&p, &mut x), Ok(None));
+        lm.set_damping(1e-9);
+        let x0 = x.clone();
+        lm.step(&p, &mut x).unwrap();
+        assert_eq!(lm.factorizations(), 1);
+        let x1 = x.clone();
+        let s = lm.chord_step(&p, &mut x).unwrap().expect("a chord step");
+        assert_eq!(lm.factorizations(), 1, "a chord step must not factor");
+        let j0 = p.jacobian(&x0);
+        let r1 = p.residual(&x1);
+        let want = -j0.transpose() * (&j0 * j0.transpose()).lu().solve(&r1).unwrap();
+        let h = nalgebra::DVector::from_fn(n, |i, _| x[i] - x1[i]);
+        assert!((&h - &want).amax() <= 1e-6 * want.amax(), "{h} vs {want}");
+        // With the Jacobian of x₁ instead, the step is a different one.
+        let j1 = p.jacobian(&x1);
+        let newton = -j1.transpose() * (&j1 * j1.transpose()).lu().solve(&r1).unwrap();
+        assert!((&newton - &want).amax() > 1e-3 * want.amax());
+        assert!(s.cost_after < 0.1 * s.cost_before, "{s:?}");
+        assert!((p.residual(&x).norm_squared() * 0.5 - s.cost_after).abs() <= 1e-15);
+        lm.invalidate();
+        assert_eq!(lm.chord_step(&p, &mut x), Ok(None));
     }
 
     /// A linear problem whose last variables form blocks of 3 seen by one residual group each.

@@ -16,11 +16,13 @@
 //! as long as the problem emits the same (row, column) pattern, so iterating on a fixed mesh
 //! costs one numeric factorisation per step.
 
+mod cholesky;
 mod gauss_newton;
 mod pattern;
 mod schur;
 mod sqp;
 
+pub(crate) use cholesky::{Ordering, SparseCholesky};
 pub use gauss_newton::{LevenbergMarquardt, LmOptions, LmStep, NonlinearLeastSquares};
 pub use sqp::{ConstrainedLeastSquares, Sqp, SqpOptions, SqpStep};
 

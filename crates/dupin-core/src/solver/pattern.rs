@@ -2,17 +2,10 @@
 //! the symbolic analysis (triplet order and symbolic factorisation) cached across calls.
 
 use super::SolverError;
-use faer::Side;
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::cholesky::llt::factor::LltRegularization;
+use super::cholesky::{Ordering, SparseCholesky};
 use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::linalg::cholesky::{
-    CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
-};
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
-use faer::{Conj, Par};
 
 /// Which factorisation a cached pattern feeds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -24,13 +17,9 @@ pub(crate) enum Factor {
 }
 
 enum Symbolic {
-    /// Supernodal Cholesky (forced: faer's automatic choice picks the simplicial kernel for
-    /// our mesh matrices, several times slower here) with its value and scratch buffers.
-    Llt {
-        symbolic: Box<SymbolicCholesky<u32>>,
-        values: Vec<f64>,
-        scratch: MemBuffer,
-    },
+    /// Supernodal Cholesky on the AMD-permuted matrix: the cached slots point into its
+    /// permuted layout.
+    Llt(Box<SparseCholesky>),
     Lu(SymbolicLu<u32>),
 }
 
@@ -46,8 +35,9 @@ pub(crate) struct PatternMatrix {
     n: usize,
     /// The pattern the cache was built for.
     pairs: Vec<(u32, u32)>,
-    /// Cached analysis: the CSC pattern, the CSC slot of every assembled entry (so assembly
-    /// is a scatter-add without re-sorting or allocating) and the symbolic factorisation.
+    /// Cached analysis: the CSC pattern, the slot of every assembled entry in the factored
+    /// layout (the CSC one for LU, the permuted one of the Cholesky), so assembly is a
+    /// scatter-add without re-sorting or allocating, and the symbolic factorisation.
     cached: Option<(SymbolicSparseColMat<u32>, Vec<u32>, Symbolic)>,
     /// CSC values of the matrix being factored (filled directly in values-only mode).
     csc_values: Vec<f64>,
@@ -68,6 +58,9 @@ pub(crate) struct PatternMatrix {
     /// The cached slots follow the entry order of the last build-mode assembly (false while
     /// a new one has not been analysed, e.g. after a failed analysis).
     fresh: bool,
+    /// The Cholesky values hold the factor of the last successful [`Self::solve`] (reused by
+    /// [`Self::solve_factored`]).
+    factored: bool,
 }
 
 impl PatternMatrix {
@@ -86,6 +79,7 @@ impl PatternMatrix {
             values: Vec::new(),
             same_pattern: false,
             fresh: false,
+            factored: false,
         }
     }
 
@@ -104,6 +98,7 @@ impl PatternMatrix {
         self.cursor = 0;
         self.base_valid = false;
         self.same_pattern = true;
+        self.factored = false;
     }
 
     /// Number of entries assembled so far.
@@ -194,6 +189,7 @@ impl PatternMatrix {
         self.base_len = 0;
         self.same_pattern = false;
         self.fresh = false;
+        self.factored = false;
     }
 
     /// Adds `value` at (row, col); repeated positions are summed.
@@ -207,6 +203,7 @@ impl PatternMatrix {
     pub(crate) fn solve(&mut self, rhs: &mut [f64]) -> Result<(), SolverError> {
         let n = self.n;
         let fe = |e: &dyn std::fmt::Debug| SolverError::Factorization(format!("{e:?}"));
+        self.factored = false;
         if self.same_pattern {
             // Values-only assembly: the values are in place if exactly the cached entries came.
             let expected = self.cached.as_ref().map_or(usize::MAX, |c| c.1.len());
@@ -223,7 +220,7 @@ impl PatternMatrix {
         if !reuse
             && !self.same_pattern
             && self.kind == Factor::CholeskyUpper
-            && let Some((sym, slots, _)) = self.cached.as_mut()
+            && let Some((sym, slots, Symbolic::Llt(chol))) = self.cached.as_mut()
         {
             let (col_ptr, row_idx) = (sym.col_ptr(), sym.row_idx());
             let mut new_slots = Vec::with_capacity(self.new_pairs.len());
@@ -247,6 +244,10 @@ impl PatternMatrix {
                 0
             };
             if 10 * filled >= 9 * row_idx.len() {
+                let positions = chol.positions();
+                new_slots
+                    .iter_mut()
+                    .for_each(|k| *k = positions[*k as usize]);
                 *slots = new_slots;
                 std::mem::swap(&mut self.pairs, &mut self.new_pairs);
                 self.new_pairs.clear();
@@ -254,27 +255,13 @@ impl PatternMatrix {
             }
         }
         if !reuse {
-            let (sym, slots) = csc_pattern(n, &self.new_pairs)?;
+            let (sym, mut slots) = csc_pattern(n, &self.new_pairs)?;
             let symbolic = match self.kind {
                 Factor::CholeskyUpper => {
-                    let symbolic = factorize_symbolic_cholesky(
-                        sym.as_ref(),
-                        Side::Upper,
-                        SymmetricOrdering::Amd,
-                        CholeskySymbolicParams {
-                            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-                            ..Default::default()
-                        },
-                    )
-                    .map_err(|e| fe(&e))?;
-                    let req = symbolic
-                        .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
-                        .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
-                    Symbolic::Llt {
-                        values: vec![0.0; symbolic.len_val()],
-                        scratch: MemBuffer::try_new(req).map_err(|e| fe(&e))?,
-                        symbolic: Box::new(symbolic),
-                    }
+                    let chol = SparseCholesky::analyse(sym.as_ref(), Ordering::Amd)?;
+                    let positions = chol.positions();
+                    slots.iter_mut().for_each(|k| *k = positions[*k as usize]);
+                    Symbolic::Llt(Box::new(chol))
                 }
                 Factor::Lu => Symbolic::Lu(SymbolicLu::try_new(sym.as_ref()).map_err(|e| fe(&e))?),
             };
@@ -301,38 +288,38 @@ impl PatternMatrix {
             self.cursor = self.values.len();
             self.same_pattern = true;
         }
-        let mat = SparseColMatRef::<u32, f64>::new(sym.as_ref(), &self.csc_values);
-        let rhs_mat = faer::MatMut::from_column_major_slice_mut(rhs, n, 1);
         match symbolic {
-            Symbolic::Llt {
-                symbolic,
-                values,
-                scratch,
-            } => {
-                let f = symbolic
-                    .factorize_numeric_llt(
-                        values,
-                        mat.as_ref(),
-                        Side::Upper,
-                        LltRegularization::default(),
-                        Par::Seq,
-                        MemStack::new(scratch),
-                        Default::default(),
-                    )
-                    .map_err(|e| fe(&e))?;
-                f.solve_in_place_with_conj(Conj::No, rhs_mat, Par::Seq, MemStack::new(scratch));
+            Symbolic::Llt(chol) => {
+                chol.factorize(&self.csc_values)?;
+                self.factored = true;
+                chol.solve_in_place(rhs)
             }
             Symbolic::Lu(s) => {
+                let mat = SparseColMatRef::<u32, f64>::new(sym.as_ref(), &self.csc_values);
                 let f = Lu::try_new_with_symbolic(s.clone(), mat.as_ref()).map_err(|e| fe(&e))?;
-                f.solve_in_place(rhs_mat);
+                f.solve_in_place(faer::MatMut::from_column_major_slice_mut(rhs, n, 1));
+                if rhs.iter().all(|v| v.is_finite()) {
+                    Ok(())
+                } else {
+                    Err(SolverError::Factorization(
+                        "the solve produced non-finite values (singular matrix)".into(),
+                    ))
+                }
             }
         }
-        if rhs.iter().all(|v| v.is_finite()) {
-            Ok(())
-        } else {
-            Err(SolverError::Factorization(
-                "the solve produced non-finite values (singular matrix)".into(),
-            ))
+    }
+}
+
+impl PatternMatrix {
+    /// Solves `A x = rhs` in place with the Cholesky factor of the last successful
+    /// [`Self::solve`], without a new factorisation (chord steps). Fails when there is no such
+    /// factor (an LU matrix, a failed factorisation, or a new assembly begun since).
+    pub(crate) fn solve_factored(&mut self, rhs: &mut [f64]) -> Result<(), SolverError> {
+        match self.cached.as_mut() {
+            Some((_, _, Symbolic::Llt(chol))) if self.factored => chol.solve_in_place(rhs),
+            _ => Err(SolverError::Factorization(
+                "no factorisation to reuse".into(),
+            )),
         }
     }
 }
