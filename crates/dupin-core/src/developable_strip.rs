@@ -10,7 +10,7 @@
 use crate::discrete_terms::quad_det_grad;
 use crate::math::Vec3;
 use crate::mesh::PolyMesh;
-use crate::pq_perturbation::{PqError, PqOptions, PqResult, pq_perturb};
+use crate::pq_perturbation::{PqError, PqOptions, PqPerturbation, PqResult};
 use crate::subdivision::{chaikin, lane_riesenfeld_cubic};
 
 /// A strip of quads (a_i, a_{i+1}, b_{i+1}, b_i) between two polylines.
@@ -107,7 +107,7 @@ impl PqStrip {
     }
 
     /// Rebuilds a strip of the same closure from the positions of its cut mesh.
-    fn rebuild_from_cut(&self, positions: &[Vec3]) -> PqStrip {
+    pub(crate) fn rebuild_from_cut(&self, positions: &[Vec3]) -> PqStrip {
         let n = self.a.len();
         let m = if self.closure == StripClosure::Open {
             n
@@ -197,6 +197,13 @@ impl PqStrip {
     /// PQ perturbation of the strip with the determinant terms on (µ = 1), glued across the
     /// end joint for closed and Möbius strips.
     pub fn perturb(&self, options: PqOptions) -> Result<(PqStrip, PqResult), PqError> {
+        let r = self.perturbation(&options)?.finish();
+        Ok((self.rebuild_from_cut(&r.mesh.positions), r))
+    }
+
+    /// The stateful perturbation [`PqStrip::perturb`] runs, on the cut-open mesh: step it and
+    /// read the strip back with [`PqStrip::rebuild_from_cut`].
+    pub(crate) fn perturbation(&self, options: &PqOptions) -> Result<PqPerturbation, PqError> {
         let (mesh, glue) = self.cut_mesh();
         // Thin quads: the unit-edge determinants exceed the planarity measure by the aspect
         // ratio, so aim the planarity a little lower.
@@ -204,10 +211,9 @@ impl PqStrip {
             determinant_terms: true,
             identify: glue,
             tolerance: options.tolerance * 1e-2,
-            ..options
+            ..options.clone()
         };
-        let r = pq_perturb(&mesh, options)?;
-        Ok((self.rebuild_from_cut(&r.mesh.positions), r))
+        PqPerturbation::new(&mesh, options)
     }
 }
 

@@ -11,8 +11,7 @@
 
 use crate::circular::circular_residual;
 use crate::conical::conical_residual;
-use crate::developable_strip::{PqStrip, StripClosure, StripRule};
-use crate::math::Vec3;
+use crate::developable_strip::{PqStrip, StripRule};
 use crate::mesh::PolyMesh;
 use crate::mesh_topology::MeshTopology;
 use crate::planarity::max_planarity;
@@ -161,7 +160,7 @@ impl PqSceneStepper {
         rounds: usize,
         options: PqOptions,
     ) -> Result<Self, PqSceneError> {
-        let perturbation = strip_perturbation(strip, &options)?;
+        let perturbation = strip.perturbation(&options)?;
         Ok(PqSceneStepper {
             target: Target::Strip {
                 rule,
@@ -248,7 +247,7 @@ impl PqSceneStepper {
                 Target::Strip { rule, strip } => {
                     *strip = strip.subdivide(*rule);
                     self.mesh = strip.to_mesh();
-                    self.perturbation = Some(strip_perturbation(strip, &self.options)?);
+                    self.perturbation = Some(strip.perturbation(&self.options)?);
                 }
             }
         }
@@ -280,7 +279,7 @@ impl PqSceneStepper {
         match &mut self.target {
             Target::Mesh(_) => self.mesh = perturbed,
             Target::Strip { strip, .. } => {
-                *strip = rebuild_from_cut(strip, &perturbed.positions);
+                *strip = strip.rebuild_from_cut(&perturbed.positions);
                 self.mesh = strip.to_mesh();
             }
         }
@@ -326,67 +325,6 @@ impl PqSceneStepper {
             max_determinant: i.max_determinant,
             singular_points_inside: i.singular_points_inside,
         })
-    }
-}
-
-/// The perturbation of one strip level, set up as [`PqStrip::perturb`] sets it up: determinant
-/// terms on, the cut joint glued, the planarity aimed 100x lower (thin quads).
-fn strip_perturbation(
-    strip: &PqStrip,
-    options: &PqOptions,
-) -> Result<PqPerturbation, PqSceneError> {
-    let (mesh, glue) = cut_mesh(strip);
-    let options = PqOptions {
-        determinant_terms: true,
-        identify: glue,
-        tolerance: options.tolerance * 1e-2,
-        ..options.clone()
-    };
-    Ok(PqPerturbation::new(&mesh, options)?)
-}
-
-// The cut-open strip and its rebuild repeat `PqStrip`'s private helpers of the same names
-// (developable_strip.rs belongs to another part of the workspace); the test
-// `stepper_ends_at_the_one_shot_result` compares the two paths bit for bit.
-
-/// The strip cut open at the end joint (the last quad uses copies of a_0 and b_0) and the
-/// vertex pairs to glue back.
-fn cut_mesh(s: &PqStrip) -> (PolyMesh, Vec<(usize, usize)>) {
-    let n = s.a.len();
-    if s.closure == StripClosure::Open {
-        return (s.to_mesh(), Vec::new());
-    }
-    let (end_a, end_b) = match s.closure {
-        StripClosure::Closed => (s.a[0], s.b[0]),
-        _ => (s.b[0], s.a[0]),
-    };
-    let mut p: Vec<Vec3> = s.a.clone();
-    p.push(end_a);
-    p.extend_from_slice(&s.b);
-    p.push(end_b);
-    let m = n + 1;
-    let faces: Vec<[u32; 4]> = (0..n as u32)
-        .map(|i| [i, i + 1, m as u32 + i + 1, m as u32 + i])
-        .collect();
-    let glue = match s.closure {
-        StripClosure::Closed => vec![(0, n), (m, m + n)],
-        _ => vec![(m, n), (0, m + n)],
-    };
-    (PolyMesh::new(p, faces).unwrap_or_default(), glue)
-}
-
-/// A strip of the same closure from the positions of its cut mesh.
-fn rebuild_from_cut(s: &PqStrip, positions: &[Vec3]) -> PqStrip {
-    let n = s.a.len();
-    let m = if s.closure == StripClosure::Open {
-        n
-    } else {
-        n + 1
-    };
-    PqStrip {
-        a: positions[..n].to_vec(),
-        b: positions[m..m + n].to_vec(),
-        closure: s.closure,
     }
 }
 
