@@ -2,6 +2,7 @@
 //! depth buffer, the offscreen target of a snapshot, pipeline and pass boilerplate.
 
 use crate::mesh_renderer::RenderError;
+use crate::readback::{PendingSnapshot, read_back};
 use dupin_core::TriangleBuffers;
 
 pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -155,13 +156,16 @@ pub(crate) fn texture(
     })
 }
 
-/// The colour texture a snapshot renders into and copies back from (size clamped to 8192).
-pub(crate) fn snapshot_target(
+/// Renders one frame offscreen with `draw` (given the target view and its size, clamped to
+/// 8192) into a texture of `format`, and starts copying it back: the body of both renderers'
+/// `begin_snapshot`.
+pub(crate) fn snapshot(
     device: &wgpu::Device,
+    queue: &wgpu::Queue,
     format: wgpu::TextureFormat,
-    width: u32,
-    height: u32,
-) -> (wgpu::Texture, wgpu::TextureView, u32, u32) {
+    (width, height): (u32, u32),
+    draw: impl FnOnce(&wgpu::TextureView, u32, u32),
+) -> PendingSnapshot {
     let (width, height) = (width.clamp(1, 8192), height.clamp(1, 8192));
     let tex = texture(
         device,
@@ -170,8 +174,8 @@ pub(crate) fn snapshot_target(
         format,
         wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
     );
-    let view = tex.create_view(&Default::default());
-    (tex, view, width, height)
+    draw(&tex.create_view(&Default::default()), width, height);
+    read_back(device, queue, &tex, width, height, format)
 }
 
 /// A depth attachment cleared to the far plane.
