@@ -7,7 +7,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use dupin_core::{PolyMesh, Vec3, polymesh_buffers, polymesh_edges};
-use dupin_render::{OrbitCamera, PresentationOffscreen, frame_buffers};
+use dupin_render::{FrameInstances, OrbitCamera, PresentationOffscreen, frame_instances};
 use std::time::{Duration, Instant};
 
 const SIZE: (u32, u32) = (960, 640);
@@ -45,14 +45,15 @@ fn bench(c: &mut Criterion) {
         .map(|s| ((s[3] - s[0]).powi(2) + (s[4] - s[1]).powi(2) + (s[5] - s[2]).powi(2)).sqrt())
         .sum::<f32>()
         / (edges.len() / 6) as f32;
-    let frames = frame_buffers(&edges, 0.06 * mean, 0.11 * mean);
+    let frames = frame_instances(&edges, 0.06 * mean, 0.11 * mean);
     println!(
-        "{} panels: {} glass + {} frame triangles, {} + {} vertices",
+        "{} panels: {} glass triangles ({} vertices), {} beams + {} nodes = {} frame triangles",
         m.num_faces(),
         glass.triangle_count(),
-        frames.triangle_count(),
         glass.vertex_count(),
-        frames.vertex_count()
+        frames.beam_count(),
+        frames.node_count(),
+        frames.triangle_count()
     );
     let mut p = match PresentationOffscreen::new(&glass, &frames) {
         Ok(p) => p,
@@ -92,15 +93,14 @@ fn bench(c: &mut Criterion) {
         })
     });
     // Where the orbit frame's time goes: the same frame without the frames, without the glass.
-    let none = dupin_core::TriangleBuffers::default();
-    p.set_scene(&glass, &none).unwrap();
+    p.set_scene(&glass, &FrameInstances::default()).unwrap();
     g.bench_function("orbit frame, glass and ground only", |b| {
         b.iter(|| {
             cam.orbit(0.01, 0.0);
             p.frame(&cam, SIZE).unwrap()
         })
     });
-    p.set_scene(&none, &frames).unwrap();
+    p.set_scene(&Default::default(), &frames).unwrap();
     g.bench_function("orbit frame, frames and ground only", |b| {
         b.iter(|| {
             cam.orbit(0.01, 0.0);

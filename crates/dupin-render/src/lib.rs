@@ -19,6 +19,8 @@ pub use mesh_renderer::{BACKGROUND, MeshRenderer, RenderError};
 pub use offscreen::{
     OffscreenImage, PresentationOffscreen, render_offscreen, render_presentation_offscreen,
 };
-pub use presentation::{GLASS_TINT, METAL_COLOR, PresentationRenderer, frame_buffers};
+pub use presentation::{
+    FrameInstances, GLASS_TINT, METAL_COLOR, PresentationRenderer, frame_instances,
+};
 pub use readback::PendingSnapshot;
 pub use wgpu;

@@ -98,6 +98,7 @@ impl MeshRenderer {
                 topology,
                 depth_write: true,
                 bias,
+                instanced: false,
             };
             gpu_mesh::pipeline(device, &layout, &shader, spec)
         };

@@ -2,7 +2,7 @@
 
 use crate::camera::OrbitCamera;
 use crate::mesh_renderer::{MeshRenderer, RenderError};
-use crate::presentation::PresentationRenderer;
+use crate::presentation::{FrameInstances, PresentationRenderer};
 use crate::readback::PendingSnapshot;
 use dupin_core::TriangleBuffers;
 
@@ -126,7 +126,7 @@ async fn gpu() -> Result<(wgpu::Adapter, wgpu::Device, wgpu::Queue), RenderError
 /// the sun's `shadows`. Blocks.
 pub fn render_presentation_offscreen(
     panels: &TriangleBuffers,
-    frames: &TriangleBuffers,
+    frames: &FrameInstances,
     camera: &OrbitCamera,
     size: (u32, u32),
     shadows: bool,
@@ -150,7 +150,7 @@ pub struct PresentationOffscreen {
 impl PresentationOffscreen {
     /// Opens a device (as [`render_offscreen`]) and uploads the scene: glass `panels` and metal
     /// `frames`.
-    pub fn new(panels: &TriangleBuffers, frames: &TriangleBuffers) -> Result<Self, RenderError> {
+    pub fn new(panels: &TriangleBuffers, frames: &FrameInstances) -> Result<Self, RenderError> {
         let (adapter, device, queue) = pollster::block_on(gpu())?;
         let mut renderer = PresentationRenderer::new(&device, wgpu::TextureFormat::Rgba8UnormSrgb);
         renderer.set_scene(&device, &queue, panels, None, frames)?;
@@ -172,7 +172,7 @@ impl PresentationOffscreen {
     pub fn set_scene(
         &mut self,
         panels: &TriangleBuffers,
-        frames: &TriangleBuffers,
+        frames: &FrameInstances,
     ) -> Result<(), RenderError> {
         self.renderer
             .set_scene(&self.device, &self.queue, panels, None, frames)

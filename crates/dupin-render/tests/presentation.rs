@@ -8,7 +8,7 @@
 
 use dupin_core::{PolyMesh, TriangleBuffers, Vec3, polymesh_buffers, polymesh_edges};
 use dupin_render::{
-    OffscreenImage, OrbitCamera, PresentationOffscreen, frame_buffers,
+    FrameInstances, OffscreenImage, OrbitCamera, PresentationOffscreen, frame_instances,
     render_presentation_offscreen,
 };
 
@@ -41,7 +41,7 @@ fn panels() -> PolyMesh {
 
 /// Glass and frame buffers of the test scene (without frames: only the four legs, so the ground
 /// sits at the same height in every variant; without glass: no panels) and its camera.
-fn scene(with_frames: bool, with_glass: bool) -> (TriangleBuffers, TriangleBuffers, OrbitCamera) {
+fn scene(with_frames: bool, with_glass: bool) -> (TriangleBuffers, FrameInstances, OrbitCamera) {
     let m = panels();
     let (glass, _) = polymesh_buffers(&m, None);
     let mut edges = polymesh_edges(&m);
@@ -50,9 +50,9 @@ fn scene(with_frames: bool, with_glass: bool) -> (TriangleBuffers, TriangleBuffe
         edges.extend([c[0], c[1], z, c[0], c[1], 0.0]);
     }
     let frames = if with_frames {
-        frame_buffers(&edges, 0.05, 0.09)
+        frame_instances(&edges, 0.05, 0.09)
     } else {
-        frame_buffers(&edges[edges.len() - 24..], 0.05, 0.09)
+        frame_instances(&edges[edges.len() - 24..], 0.05, 0.09)
     };
     let glass = if with_glass {
         glass
