@@ -269,6 +269,8 @@ pub(crate) struct PipelineSpec<'a> {
     pub bias: wgpu::DepthBiasState,
     /// Also reads an [`Instance`] buffer at slot 1.
     pub instanced: bool,
+    /// Faces not drawn (closed meshes wound counter-clockwise seen from outside).
+    pub cull: Option<wgpu::Face>,
 }
 
 /// A render pipeline over [`Vertex`] buffers with a `LessEqual` depth test.
@@ -301,6 +303,7 @@ pub(crate) fn pipeline(
         },
         primitive: wgpu::PrimitiveState {
             topology: spec.topology,
+            cull_mode: spec.cull,
             ..Default::default()
         },
         depth_stencil: Some(wgpu::DepthStencilState {

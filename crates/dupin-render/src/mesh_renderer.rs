@@ -99,6 +99,7 @@ impl MeshRenderer {
                 depth_write: true,
                 bias,
                 instanced: false,
+                cull: None,
             };
             gpu_mesh::pipeline(device, &layout, &shader, spec)
         };

@@ -48,8 +48,9 @@ const UNIT_BOX: [[f32; 3]; 8] = [
     [1., 1., -1.],
     [1., 1., 1.],
 ];
-/// Its faces as quads: the four sides along x first (all a beam draws: nodes cover its ends),
-/// then the two ends (a node draws all six).
+/// Its faces as quads, counter-clockwise seen from outside (back faces are culled): the four
+/// sides along x first (all a beam draws: nodes cover its ends), then the two ends (a node draws
+/// all six).
 const UNIT_BOX_QUADS: [[u32; 4]; 6] = [
     [0, 4, 5, 1],
     [2, 3, 7, 6],
@@ -71,9 +72,9 @@ fn unit_box_indices() -> Vec<u32> {
 
 /// Metal frames as instances of one unit box: a beam per edge (a square prism) and a node per
 /// distinct endpoint (a cube). Drawn instanced, so a 10k-panel frame costs 1.5 MB of instance
-/// data and two draw calls instead of 20 MB of baked triangles; the GPU still draws 8 triangles
-/// a beam and 12 a node, from 8 shared corner vertices per box (flat normals come from
-/// screen-space derivatives in the fragment shader).
+/// data and two draw calls instead of 20 MB of baked triangles; the GPU shades 8 shared corner
+/// vertices per box (flat normals come from screen-space derivatives in the fragment shader)
+/// and draws 8 triangles a beam and 12 a node, half of them culled as back faces.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FrameInstances {
     beams: Vec<Instance>,
@@ -338,6 +339,7 @@ impl PresentationRenderer {
                     clamp: 0.0,
                 },
                 instanced: true,
+                cull: Some(wgpu::Face::Back),
             },
         );
         let pipeline = |vertex, fs, blend, depth_write| {
@@ -348,6 +350,9 @@ impl PresentationRenderer {
                 depth_write,
                 bias: Default::default(),
                 instanced: vertex == "vs_frame",
+                // Boxes are closed (a beam's open ends lie inside its nodes): their back faces
+                // are hidden, so culling them halves the frame triangles rasterised.
+                cull: (vertex == "vs_frame").then_some(wgpu::Face::Back),
             };
             gpu_mesh::pipeline(device, &main_pl, &shader, spec)
         };
@@ -627,6 +632,10 @@ mod tests {
                 corners[(t - beam_tris) / 12]
             };
             assert!(n.dot(mid - centre) > 0.0, "inward normal {n} at {mid}");
+            // Wound counter-clockwise seen from outside: back-face culling keeps the outside.
+            let p = |k: usize| Vec3::new(tri[3 * k], tri[3 * k + 1], tri[3 * k + 2]);
+            let wound = (p(1) - p(0)).cross(p(2) - p(0));
+            assert!(wound.dot(n) > 0.0, "clockwise triangle at {mid}");
         }
     }
 }

@@ -64,6 +64,11 @@ fn sunlight(world: vec3<f32>, n: vec3<f32>) -> f32 {
     let ndc = lp.xyz / lp.w;
     let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
     let depth = ndc.z - 0.002;
+    // Outside the map (most of the ground) is sunlit: skip the nine taps there.
+    let inside = all(uv >= vec2<f32>(0.0)) && all(uv <= vec2<f32>(1.0)) && depth <= 1.0;
+    if !inside {
+        return 1.0;
+    }
     var lit = 0.0;
     for (var dx = -1; dx <= 1; dx++) {
         for (var dy = -1; dy <= 1; dy++) {
@@ -71,8 +76,7 @@ fn sunlight(world: vec3<f32>, n: vec3<f32>) -> f32 {
             lit += textureSampleCompareLevel(shadow_map, shadow_sampler, uv + o, depth);
         }
     }
-    let inside = all(uv >= vec2<f32>(0.0)) && all(uv <= vec2<f32>(1.0)) && depth <= 1.0;
-    return select(1.0, lit / 9.0, inside);
+    return lit / 9.0;
 }
 
 fn hemisphere(n: vec3<f32>) -> vec3<f32> {
