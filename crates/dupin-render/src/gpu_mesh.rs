@@ -26,28 +26,6 @@ pub(crate) const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::Vertex
     attributes: &ATTRIBUTES,
 };
 
-/// One instance of a unit mesh: its vertex `p` lands at `origin + p.x ax + p.y ay + p.z az`
-/// (`InstIn` in `presentation.wgsl`).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub(crate) struct Instance {
-    pub origin: [f32; 3],
-    pub ax: [f32; 3],
-    pub ay: [f32; 3],
-    pub az: [f32; 3],
-}
-
-const INSTANCE_ATTRIBUTES: [wgpu::VertexAttribute; 4] = wgpu::vertex_attr_array![
-    3 => Float32x3, 4 => Float32x3, 5 => Float32x3, 6 => Float32x3
-];
-
-/// The per-instance buffer layout of [`Instance`] (slot 1 of instanced pipelines).
-pub(crate) const INSTANCE_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
-    array_stride: std::mem::size_of::<Instance>() as u64,
-    step_mode: wgpu::VertexStepMode::Instance,
-    attributes: &INSTANCE_ATTRIBUTES,
-};
-
 /// An indexed triangle or line list on the GPU.
 pub(crate) struct GpuMesh {
     vertices: wgpu::Buffer,
@@ -77,20 +55,9 @@ impl GpuMesh {
 
     /// Draws all of it with the pass's current pipeline and bind groups.
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
-        self.draw_instanced(pass, 0..self.count, 0..1);
-    }
-
-    /// Draws `indices` of it once per instance in `instances` (the pipeline's instance buffer
-    /// bound at slot 1 by the caller).
-    pub fn draw_instanced(
-        &self,
-        pass: &mut wgpu::RenderPass<'_>,
-        indices: std::ops::Range<u32>,
-        instances: std::ops::Range<u32>,
-    ) {
         pass.set_vertex_buffer(0, self.vertices.slice(..));
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
-        pass.draw_indexed(indices, 0, instances);
+        pass.draw_indexed(0..self.count, 0, 0..1);
     }
 }
 
@@ -267,8 +234,6 @@ pub(crate) struct PipelineSpec<'a> {
     pub topology: wgpu::PrimitiveTopology,
     pub depth_write: bool,
     pub bias: wgpu::DepthBiasState,
-    /// Also reads an [`Instance`] buffer at slot 1.
-    pub instanced: bool,
     /// Faces not drawn (closed meshes wound counter-clockwise seen from outside).
     pub cull: Option<wgpu::Face>,
 }
@@ -287,11 +252,6 @@ pub(crate) fn pipeline(
             write_mask: wgpu::ColorWrites::ALL,
         })]
     });
-    let layouts: &[Option<wgpu::VertexBufferLayout<'static>>] = if spec.instanced {
-        &[Some(VERTEX_LAYOUT), Some(INSTANCE_LAYOUT)]
-    } else {
-        &[Some(VERTEX_LAYOUT)]
-    };
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(spec.fragment.map_or(spec.vertex, |f| f.0)),
         layout: Some(layout),
@@ -299,7 +259,7 @@ pub(crate) fn pipeline(
             module: shader,
             entry_point: Some(spec.vertex),
             compilation_options: Default::default(),
-            buffers: layouts,
+            buffers: &[Some(VERTEX_LAYOUT)],
         },
         primitive: wgpu::PrimitiveState {
             topology: spec.topology,

@@ -98,7 +98,6 @@ impl MeshRenderer {
                 topology,
                 depth_write: true,
                 bias,
-                instanced: false,
                 cull: None,
             };
             gpu_mesh::pipeline(device, &layout, &shader, spec)

@@ -10,7 +10,7 @@
 //! [`PresentationRenderer::set_shadows`] changed something and reused by every orbit frame.
 
 use crate::camera::OrbitCamera;
-use crate::gpu_mesh::{self, DEPTH_FORMAT, DepthBuffer, GpuMesh, Instance, PipelineSpec, Vertex};
+use crate::gpu_mesh::{self, DEPTH_FORMAT, DepthBuffer, GpuMesh, PipelineSpec, Vertex};
 use crate::mesh_renderer::{RenderError, background_for};
 use crate::readback::PendingSnapshot;
 use dupin_core::TriangleBuffers;
@@ -70,11 +70,12 @@ fn unit_box_indices() -> Vec<u32> {
         .collect()
 }
 
-/// Metal frames as instances of one unit box: a beam per edge (a square prism) and a node per
-/// distinct endpoint (a cube). Drawn instanced, so a 10k-panel frame costs 1.5 MB of instance
-/// data and two draw calls instead of 20 MB of baked triangles; the GPU shades 8 shared corner
-/// vertices per box (flat normals come from screen-space derivatives in the fragment shader)
-/// and draws 8 triangles a beam and 12 a node, half of them culled as back faces.
+/// Metal frames as placed copies of one unit box: a beam per edge (a square prism) and a node
+/// per distinct endpoint (a cube), 48 bytes each. Uploaded as 8 shared corner vertices a box
+/// (flat normals come from screen-space derivatives in the fragment shader) and drawn in one
+/// call: 8 triangles a beam and 12 a node, half of them culled as back faces. Not GPU
+/// instancing: software rasterisers (SwiftShader) set up each instance as its own small draw,
+/// which doubled the 10k-panel frame time there.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FrameInstances {
     beams: Vec<Instance>,
@@ -126,6 +127,15 @@ impl FrameInstances {
     }
 }
 
+/// One placed unit box: its point `p` lands at `origin + p.x ax + p.y ay + p.z az`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Instance {
+    origin: [f32; 3],
+    ax: [f32; 3],
+    ay: [f32; 3],
+    az: [f32; 3],
+}
+
 impl Instance {
     /// Where the unit-box point `p` lands.
     fn place(&self, p: [f32; 3]) -> Vec3 {
@@ -171,24 +181,26 @@ pub fn frame_instances(edges: &[f32], beam: f32, node: f32) -> FrameInstances {
     out
 }
 
-/// The frames on the GPU: the unit box and the instance buffer (beams, then nodes).
-struct FramesGpu {
-    unit: GpuMesh,
-    instances: wgpu::Buffer,
-    beams: u32,
-    nodes: u32,
-}
-
-impl FramesGpu {
-    fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
-        pass.set_vertex_buffer(1, self.instances.slice(..));
-        if self.beams > 0 {
-            self.unit.draw_instanced(pass, 0..BEAM_INDICES, 0..self.beams);
+impl FrameInstances {
+    /// The boxes as one indexed mesh: 8 corners a box, its beam sides or node faces.
+    fn mesh(&self) -> (Vec<Vertex>, Vec<u32>) {
+        let idx = unit_box_indices();
+        let boxes = self.beams.len() + self.nodes.len();
+        let (mut vertices, mut indices) = (Vec::with_capacity(8 * boxes), Vec::new());
+        let parts = [(&self.beams, BEAM_INDICES), (&self.nodes, NODE_INDICES)];
+        for (list, count) in parts {
+            for inst in list.iter() {
+                let base = vertices.len() as u32;
+                vertices.extend(UNIT_BOX.map(|c| Vertex {
+                    pos: inst.place(c).to_array(),
+                    // Unused: the metal shader takes flat normals from derivatives.
+                    normal: [0.0; 3],
+                    color: METAL_COLOR,
+                }));
+                indices.extend(idx[..count as usize].iter().map(|i| base + i));
+            }
         }
-        if self.nodes > 0 {
-            let all = self.beams..self.beams + self.nodes;
-            self.unit.draw_instanced(pass, 0..NODE_INDICES, all);
-        }
+        (vertices, indices)
     }
 }
 
@@ -204,7 +216,7 @@ pub struct PresentationRenderer {
     main_group: wgpu::BindGroup,
     shadow_view: wgpu::TextureView,
     glass: Option<GpuMesh>,
-    frames: Option<FramesGpu>,
+    frames: Option<GpuMesh>,
     ground: Option<GpuMesh>,
     /// Bounding sphere of the scene (centre, radius).
     bounds: (Vec3, f32),
@@ -329,7 +341,7 @@ impl PresentationRenderer {
             &shadow_pl,
             &shader,
             PipelineSpec {
-                vertex: "vs_frame_shadow",
+                vertex: "vs_shadow",
                 fragment: None,
                 topology: wgpu::PrimitiveTopology::TriangleList,
                 depth_write: true,
@@ -338,36 +350,29 @@ impl PresentationRenderer {
                     slope_scale: 2.0,
                     clamp: 0.0,
                 },
-                instanced: true,
                 cull: Some(wgpu::Face::Back),
             },
         );
-        let pipeline = |vertex, fs, blend, depth_write| {
+        let pipeline = |fs, blend, depth_write, cull| {
             let spec = PipelineSpec {
-                vertex,
+                vertex: "vs_main",
                 fragment: Some((fs, format, blend)),
                 topology: wgpu::PrimitiveTopology::TriangleList,
                 depth_write,
                 bias: Default::default(),
-                instanced: vertex == "vs_frame",
-                // Boxes are closed (a beam's open ends lie inside its nodes): their back faces
-                // are hidden, so culling them halves the frame triangles rasterised.
-                cull: (vertex == "vs_frame").then_some(wgpu::Face::Back),
+                cull,
             };
             gpu_mesh::pipeline(device, &main_pl, &shader, spec)
         };
         PresentationRenderer {
             format,
             shadow_pipeline,
-            metal_pipeline: pipeline("vs_frame", "fs_metal", None, true),
+            // Boxes are closed (a beam's open ends lie inside its nodes): their back faces are
+            // hidden, so culling them halves the frame triangles rasterised.
+            metal_pipeline: pipeline("fs_metal", None, true, Some(wgpu::Face::Back)),
             // Glass is blended over everything opaque and does not hide what is behind it.
-            glass_pipeline: pipeline(
-                "vs_main",
-                "fs_glass",
-                Some(wgpu::BlendState::ALPHA_BLENDING),
-                false,
-            ),
-            ground_pipeline: pipeline("vs_main", "fs_ground", None, true),
+            glass_pipeline: pipeline("fs_glass", Some(wgpu::BlendState::ALPHA_BLENDING), false, None),
+            ground_pipeline: pipeline("fs_ground", None, true, None),
             uniforms,
             shadow_group,
             main_group,
@@ -427,31 +432,8 @@ impl PresentationRenderer {
             .collect();
         self.glass = GpuMesh::upload(device, queue, &glass, &panels.indices, "glass");
         self.ground = GpuMesh::upload(device, queue, &ground, &[0, 1, 2, 0, 2, 3], "ground");
-        let unit = UNIT_BOX.map(|pos| Vertex {
-            pos,
-            // Unused: the metal shader takes flat normals from derivatives.
-            normal: [0.0; 3],
-            color: METAL_COLOR,
-        });
-        let instances: Vec<Instance> = frames.beams.iter().chain(&frames.nodes).copied().collect();
-        self.frames = if instances.is_empty() {
-            None
-        } else {
-            GpuMesh::upload(device, queue, &unit, &unit_box_indices(), "unit box").map(|unit| {
-                FramesGpu {
-                    unit,
-                    instances: gpu_mesh::buffer(
-                        device,
-                        queue,
-                        bytemuck::cast_slice(&instances),
-                        wgpu::BufferUsages::VERTEX,
-                        "frame instances",
-                    ),
-                    beams: frames.beams.len() as u32,
-                    nodes: frames.nodes.len() as u32,
-                }
-            })
-        };
+        let (metal, metal_indices) = frames.mesh();
+        self.frames = GpuMesh::upload(device, queue, &metal, &metal_indices, "frames");
         Ok(())
     }
 
@@ -474,8 +456,8 @@ impl PresentationRenderer {
 
     /// Draws the scene seen by `camera` into `target` (`width` x `height`, this renderer's
     /// format): the sun's shadow pass when the scene or the shadow setting changed since the
-    /// last frame, then frames, ground, and glass blended on top: 5 draw calls (4 with a
-    /// shadow pass: 2 more).
+    /// last frame, then frames, ground, and glass blended on top: 3 draw calls (with a shadow
+    /// pass: 4).
     pub fn render(
         &mut self,
         device: &wgpu::Device,
@@ -532,11 +514,8 @@ impl PresentationRenderer {
             pass.set_bind_group(0, &self.main_group, &[]);
             // Opaque frames first: they hide part of the ground, whose fragments then fail the
             // depth test before shading.
-            if let Some(f) = &self.frames {
-                pass.set_pipeline(&self.metal_pipeline);
-                f.draw(&mut pass);
-            }
             for (pipeline, mesh) in [
+                (&self.metal_pipeline, &self.frames),
                 (&self.ground_pipeline, &self.ground),
                 (&self.glass_pipeline, &self.glass),
             ] {

@@ -1,4 +1,4 @@
-// Presentation mode (after vertex_io.wgsl): metal frames (instanced boxes) and a ground that receive a shadow map of the frames, and glass
+// Presentation mode (after vertex_io.wgsl): metal frames (boxes with shared corners) and a ground that receive a shadow map of the frames, and glass
 // panels blended over them with a Fresnel-like rim. Soft light: a sky/ground hemisphere ambient
 // plus one sun whose shadow is filtered with a 3x3 percentage-closer kernel.
 
@@ -27,31 +27,9 @@ fn vs_main(v: VsIn) -> VsOut {
     return o;
 }
 
-// One beam or node: an instance of the unit box (`FrameInstances` in presentation.rs).
-struct InstIn {
-    @location(3) origin: vec3<f32>,
-    @location(4) ax: vec3<f32>,
-    @location(5) ay: vec3<f32>,
-    @location(6) az: vec3<f32>,
-};
-
-fn placed(p: vec3<f32>, i: InstIn) -> vec3<f32> {
-    return i.origin + i.ax * p.x + i.ay * p.y + i.az * p.z;
-}
-
 @vertex
-fn vs_frame(v: VsIn, inst: InstIn) -> VsOut {
-    var o: VsOut;
-    o.world = placed(v.pos, inst);
-    o.clip = u.view_proj * vec4<f32>(o.world, 1.0);
-    o.normal = vec3<f32>(0.0);
-    o.color = v.color;
-    return o;
-}
-
-@vertex
-fn vs_frame_shadow(v: VsIn, inst: InstIn) -> @builtin(position) vec4<f32> {
-    return u.light_view_proj * vec4<f32>(placed(v.pos, inst), 1.0);
+fn vs_shadow(v: VsIn) -> @builtin(position) vec4<f32> {
+    return u.light_view_proj * vec4<f32>(v.pos, 1.0);
 }
 
 fn encode(c: vec3<f32>, a: f32) -> vec4<f32> {
