@@ -90,7 +90,13 @@ fn bench(c: &mut Criterion) {
             })
         });
     };
-    frame(&mut g, "orbit frame (shadow map cached)", &mut p, &mut cam, false);
+    frame(
+        &mut g,
+        "orbit frame (shadow map cached)",
+        &mut p,
+        &mut cam,
+        false,
+    );
     frame(&mut g, "frame with shadow pass", &mut p, &mut cam, true);
     g.bench_function("render() call only (CPU encode + submit, wall)", |b| {
         b.iter_custom(|iters| {
@@ -108,10 +114,23 @@ fn bench(c: &mut Criterion) {
     // Where the orbit frame's time goes: the same frame without the frames, without the glass,
     // with neither (ground and clear only).
     p.set_scene(&glass, &FrameInstances::default()).unwrap();
-    frame(&mut g, "orbit frame, glass and ground only", &mut p, &mut cam, false);
+    frame(
+        &mut g,
+        "orbit frame, glass and ground only",
+        &mut p,
+        &mut cam,
+        false,
+    );
     p.set_scene(&Default::default(), &frames).unwrap();
-    frame(&mut g, "orbit frame, frames and ground only", &mut p, &mut cam, false);
-    p.set_scene(&Default::default(), &FrameInstances::default()).unwrap();
+    frame(
+        &mut g,
+        "orbit frame, frames and ground only",
+        &mut p,
+        &mut cam,
+        false,
+    );
+    p.set_scene(&Default::default(), &FrameInstances::default())
+        .unwrap();
     frame(&mut g, "orbit frame, ground only", &mut p, &mut cam, false);
     g.finish();
 }
@@ -123,7 +142,11 @@ fn process_cpu() -> Duration {
     if let Ok(dir) = std::fs::read_dir("/proc/self/task") {
         for t in dir.flatten() {
             if let Ok(s) = std::fs::read_to_string(t.path().join("schedstat")) {
-                ns += s.split_whitespace().next().and_then(|x| x.parse().ok()).unwrap_or(0);
+                ns += s
+                    .split_whitespace()
+                    .next()
+                    .and_then(|x| x.parse().ok())
+                    .unwrap_or(0);
             }
         }
     }

@@ -371,7 +371,12 @@ impl PresentationRenderer {
             // hidden, so culling them halves the frame triangles rasterised.
             metal_pipeline: pipeline("fs_metal", None, true, Some(wgpu::Face::Back)),
             // Glass is blended over everything opaque and does not hide what is behind it.
-            glass_pipeline: pipeline("fs_glass", Some(wgpu::BlendState::ALPHA_BLENDING), false, None),
+            glass_pipeline: pipeline(
+                "fs_glass",
+                Some(wgpu::BlendState::ALPHA_BLENDING),
+                false,
+                None,
+            ),
             ground_pipeline: pipeline("fs_ground", None, true, None),
             uniforms,
             shadow_group,
@@ -552,12 +557,42 @@ mod tests {
     fn frames_have_a_prism_per_edge_and_one_node_per_vertex() {
         // A unit square: 4 edges, 4 corners.
         let e = [
-            0., 0., 0., 1., 0., 0., //
-            1., 0., 0., 1., 1., 0., //
-            1., 1., 0., 0., 1., 0., //
-            0., 1., 0., 0., 0., 0., //
-            2., 2., 2., 2., 2., 2., // degenerate: skipped
-            f32::NAN, 0., 0., 1., 1., 1., // not finite: skipped
+            0.,
+            0.,
+            0.,
+            1.,
+            0.,
+            0., //
+            1.,
+            0.,
+            0.,
+            1.,
+            1.,
+            0., //
+            1.,
+            1.,
+            0.,
+            0.,
+            1.,
+            0., //
+            0.,
+            1.,
+            0.,
+            0.,
+            0.,
+            0., //
+            2.,
+            2.,
+            2.,
+            2.,
+            2.,
+            2., // degenerate: skipped
+            f32::NAN,
+            0.,
+            0.,
+            1.,
+            1.,
+            1., // not finite: skipped
         ];
         let f = frame_instances(&e, 0.1, 0.2);
         assert_eq!((f.beam_count(), f.node_count()), (4, 4));
@@ -581,12 +616,21 @@ mod tests {
                 if t < beam_tris {
                     let (a, c) = axes[t / 8];
                     let s = (p - a).dot(c - a);
-                    assert!((-1e-6..=1.0 + 1e-6).contains(&s), "{p} beyond its beam's ends");
-                    assert!(((p - (a + (c - a) * s)).length() - on_beam).abs() < 1e-6, "{p}");
+                    assert!(
+                        (-1e-6..=1.0 + 1e-6).contains(&s),
+                        "{p} beyond its beam's ends"
+                    );
+                    assert!(
+                        ((p - (a + (c - a) * s)).length() - on_beam).abs() < 1e-6,
+                        "{p}"
+                    );
                 } else {
                     let c = corners[(t - beam_tris) / 12];
                     let d = (p - c).abs();
-                    assert!((d - Vec3::splat(0.1)).abs().max_element() < 1e-6, "{p} off node {c}");
+                    assert!(
+                        (d - Vec3::splat(0.1)).abs().max_element() < 1e-6,
+                        "{p} off node {c}"
+                    );
                 }
             }
         }

@@ -165,13 +165,20 @@ fn shadow_map_is_cached_across_orbit_frames_and_redrawn_on_change() {
         orbit.orbit(0.3, 0.05);
         p.frame(&orbit, (W, H)).unwrap();
     }
-    assert_eq!(p.renderer().shadow_passes(), 1, "one shadow pass for five orbit frames");
+    assert_eq!(
+        p.renderer().shadow_passes(),
+        1,
+        "one shadow pass for five orbit frames"
+    );
     // After five frames from elsewhere, the cached map draws this view exactly as a fresh
     // renderer (which draws its shadow map for this very frame) does.
     let cached = p.snapshot(&cam, (W, H)).unwrap();
     let fresh = render(true, true, true);
     assert_eq!(p.renderer().shadow_passes(), 1);
-    assert!(cached.rgba == fresh.rgba, "cached shadows differ from fresh ones");
+    assert!(
+        cached.rgba == fresh.rgba,
+        "cached shadows differ from fresh ones"
+    );
 
     // Setting the same value keeps the map; a change redraws it, once.
     p.renderer().set_shadows(true);
@@ -181,7 +188,10 @@ fn shadow_map_is_cached_across_orbit_frames_and_redrawn_on_change() {
     let unlit = p.snapshot(&cam, (W, H)).unwrap();
     p.frame(&orbit, (W, H)).unwrap();
     assert_eq!(p.renderer().shadow_passes(), 2);
-    assert!(unlit.rgba == render(true, true, false).rgba, "stale shadows after turning them off");
+    assert!(
+        unlit.rgba == render(true, true, false).rgba,
+        "stale shadows after turning them off"
+    );
     p.renderer().set_shadows(true);
     assert!(p.snapshot(&cam, (W, H)).unwrap().rgba == fresh.rgba);
     assert_eq!(p.renderer().shadow_passes(), 3);
@@ -191,7 +201,10 @@ fn shadow_map_is_cached_across_orbit_frames_and_redrawn_on_change() {
     p.set_scene(&glass2, &frames2).unwrap();
     let legs = p.snapshot(&cam, (W, H)).unwrap();
     assert_eq!(p.renderer().shadow_passes(), 4);
-    assert!(legs.rgba == render(false, true, true).rgba, "stale shadows after a new scene");
+    assert!(
+        legs.rgba == render(false, true, true).rgba,
+        "stale shadows after a new scene"
+    );
     assert!(legs.rgba != fresh.rgba);
 }
 
