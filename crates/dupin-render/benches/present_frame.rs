@@ -84,7 +84,7 @@ fn bench(c: &mut Criterion) {
                         p.renderer().set_shadows(false);
                         p.renderer().set_shadows(true);
                     }
-                    p.frame(&cam, SIZE).unwrap();
+                    p.frame(cam, SIZE).unwrap();
                 }
                 process_cpu() - c0
             })
