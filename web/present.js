@@ -33,7 +33,7 @@ function show(mesh) {
 }
 
 // Drawing-buffer size: CSS size x devicePixelRatio, with the ratio capped at 2 and the buffer
-// at about 4 megapixels (a 4K full screen at dpr 2 would be 33 MP: 8x the fragment work for
+// at about 4 megapixels (a 3840 x 2160 CSS full screen at dpr 2 would be 33 MP: 8x the work for
 // no visible gain), so the fill rate per frame stays bounded whatever the display.
 const MAX_DPR = 2;
 const MAX_PIXELS = 2560 * 1600;
