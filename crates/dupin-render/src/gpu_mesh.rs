@@ -2,6 +2,7 @@
 //! depth buffer, the offscreen target of a snapshot, pipeline and pass boilerplate.
 
 use crate::mesh_renderer::RenderError;
+use crate::readback::{PendingSnapshot, read_back};
 use dupin_core::TriangleBuffers;
 
 pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -44,20 +45,7 @@ impl GpuMesh {
         if indices.is_empty() {
             return None;
         }
-        // Plain buffers filled through the queue: some WebGPU implementations (SwiftShader)
-        // refuse `mappedAtCreation` for buffers of a few hundred kilobytes.
-        let make = |bytes: &[u8], usage: wgpu::BufferUsages| {
-            let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: (bytes.len() as u64)
-                    .max(4)
-                    .next_multiple_of(wgpu::COPY_BUFFER_ALIGNMENT),
-                usage: usage | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            queue.write_buffer(&buffer, 0, bytes);
-            buffer
-        };
+        let make = |bytes: &[u8], usage| buffer(device, queue, bytes, usage, label);
         Some(GpuMesh {
             vertices: make(bytemuck::cast_slice(vertices), wgpu::BufferUsages::VERTEX),
             indices: make(bytemuck::cast_slice(indices), wgpu::BufferUsages::INDEX),
@@ -71,6 +59,27 @@ impl GpuMesh {
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..self.count, 0, 0..1);
     }
+}
+
+/// A buffer of `bytes` for `usage`, filled through the queue: some WebGPU implementations
+/// (SwiftShader) refuse `mappedAtCreation` for buffers of a few hundred kilobytes.
+pub(crate) fn buffer(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    bytes: &[u8],
+    usage: wgpu::BufferUsages,
+    label: &str,
+) -> wgpu::Buffer {
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: (bytes.len() as u64)
+            .max(4)
+            .next_multiple_of(wgpu::COPY_BUFFER_ALIGNMENT),
+        usage: usage | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    queue.write_buffer(&buffer, 0, bytes);
+    buffer
 }
 
 /// The vertices of `mesh`, coloured by `colors` (3 linear floats a vertex) or `default`, after
@@ -155,13 +164,16 @@ pub(crate) fn texture(
     })
 }
 
-/// The colour texture a snapshot renders into and copies back from (size clamped to 8192).
-pub(crate) fn snapshot_target(
+/// Renders one frame offscreen with `draw` (given the target view and its size, clamped to
+/// 8192) into a texture of `format`, and starts copying it back: the body of both renderers'
+/// `begin_snapshot`.
+pub(crate) fn snapshot(
     device: &wgpu::Device,
+    queue: &wgpu::Queue,
     format: wgpu::TextureFormat,
-    width: u32,
-    height: u32,
-) -> (wgpu::Texture, wgpu::TextureView, u32, u32) {
+    (width, height): (u32, u32),
+    draw: impl FnOnce(&wgpu::TextureView, u32, u32),
+) -> PendingSnapshot {
     let (width, height) = (width.clamp(1, 8192), height.clamp(1, 8192));
     let tex = texture(
         device,
@@ -170,8 +182,8 @@ pub(crate) fn snapshot_target(
         format,
         wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
     );
-    let view = tex.create_view(&Default::default());
-    (tex, view, width, height)
+    draw(&tex.create_view(&Default::default()), width, height);
+    read_back(device, queue, &tex, width, height, format)
 }
 
 /// A depth attachment cleared to the far plane.
@@ -222,6 +234,8 @@ pub(crate) struct PipelineSpec<'a> {
     pub topology: wgpu::PrimitiveTopology,
     pub depth_write: bool,
     pub bias: wgpu::DepthBiasState,
+    /// Faces not drawn (closed meshes wound counter-clockwise seen from outside).
+    pub cull: Option<wgpu::Face>,
 }
 
 /// A render pipeline over [`Vertex`] buffers with a `LessEqual` depth test.
@@ -249,6 +263,7 @@ pub(crate) fn pipeline(
         },
         primitive: wgpu::PrimitiveState {
             topology: spec.topology,
+            cull_mode: spec.cull,
             ..Default::default()
         },
         depth_stencil: Some(wgpu::DepthStencilState {

@@ -16,7 +16,11 @@ mod readback;
 pub use camera::OrbitCamera;
 pub use mesh_renderer::{BACKGROUND, MeshRenderer, RenderError};
 #[cfg(not(target_arch = "wasm32"))]
-pub use offscreen::{OffscreenImage, render_offscreen, render_presentation_offscreen};
-pub use presentation::{GLASS_TINT, METAL_COLOR, PresentationRenderer, frame_buffers};
+pub use offscreen::{
+    OffscreenImage, PresentationOffscreen, render_offscreen, render_presentation_offscreen,
+};
+pub use presentation::{
+    FrameInstances, GLASS_TINT, METAL_COLOR, PresentationRenderer, frame_instances,
+};
 pub use readback::PendingSnapshot;
 pub use wgpu;

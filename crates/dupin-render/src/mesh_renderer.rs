@@ -2,7 +2,7 @@
 
 use crate::camera::OrbitCamera;
 use crate::gpu_mesh::{self, DepthBuffer, GpuMesh, PipelineSpec, Vertex};
-use crate::readback::{PendingSnapshot, read_back};
+use crate::readback::PendingSnapshot;
 use dupin_core::TriangleBuffers;
 use thiserror::Error;
 
@@ -98,6 +98,7 @@ impl MeshRenderer {
                 topology,
                 depth_write: true,
                 bias,
+                cull: None,
             };
             gpu_mesh::pipeline(device, &layout, &shader, spec)
         };
@@ -170,10 +171,9 @@ impl MeshRenderer {
         height: u32,
         camera: &OrbitCamera,
     ) -> PendingSnapshot {
-        let (texture, view, width, height) =
-            gpu_mesh::snapshot_target(device, self.format, width, height);
-        self.render(device, queue, &view, width, height, camera);
-        read_back(device, queue, &texture, width, height, self.format)
+        gpu_mesh::snapshot(device, queue, self.format, (width, height), |view, w, h| {
+            self.render(device, queue, view, w, h, camera)
+        })
     }
 
     /// Draws the current mesh and lines seen by `camera` into `target` (of this renderer's

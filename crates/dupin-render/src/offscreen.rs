@@ -2,7 +2,7 @@
 
 use crate::camera::OrbitCamera;
 use crate::mesh_renderer::{MeshRenderer, RenderError};
-use crate::presentation::PresentationRenderer;
+use crate::presentation::{FrameInstances, PresentationRenderer};
 use crate::readback::PendingSnapshot;
 use dupin_core::TriangleBuffers;
 
@@ -126,17 +126,112 @@ async fn gpu() -> Result<(wgpu::Adapter, wgpu::Device, wgpu::Queue), RenderError
 /// the sun's `shadows`. Blocks.
 pub fn render_presentation_offscreen(
     panels: &TriangleBuffers,
-    frames: &TriangleBuffers,
+    frames: &FrameInstances,
     camera: &OrbitCamera,
-    (width, height): (u32, u32),
+    size: (u32, u32),
     shadows: bool,
 ) -> Result<OffscreenImage, RenderError> {
-    pollster::block_on(async {
-        let (adapter, device, queue) = gpu().await?;
-        let mut r = PresentationRenderer::new(&device, wgpu::TextureFormat::Rgba8UnormSrgb);
-        r.set_scene(&device, &queue, panels, None, frames)?;
-        r.set_shadows(shadows);
-        let pending = r.begin_snapshot(&device, &queue, width.max(1), height.max(1), camera);
-        finish(&adapter, &device, pending)
-    })
+    let mut p = PresentationOffscreen::new(panels, frames)?;
+    p.renderer().set_shadows(shadows);
+    p.snapshot(camera, size)
+}
+
+/// A presentation view kept alive offscreen, frame after frame, as the page's canvas is: for
+/// tests of what carries over between frames (the cached shadow map) and for frame benchmarks.
+pub struct PresentationOffscreen {
+    adapter: wgpu::Adapter,
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    renderer: PresentationRenderer,
+    /// The colour target of [`Self::frame`], re-created only when the size changes.
+    target: Option<(wgpu::TextureView, u32, u32)>,
+}
+
+impl PresentationOffscreen {
+    /// Opens a device (as [`render_offscreen`]) and uploads the scene: glass `panels` and metal
+    /// `frames`.
+    pub fn new(panels: &TriangleBuffers, frames: &FrameInstances) -> Result<Self, RenderError> {
+        let (adapter, device, queue) = pollster::block_on(gpu())?;
+        let mut renderer = PresentationRenderer::new(&device, wgpu::TextureFormat::Rgba8UnormSrgb);
+        renderer.set_scene(&device, &queue, panels, None, frames)?;
+        Ok(PresentationOffscreen {
+            adapter,
+            device,
+            queue,
+            renderer,
+            target: None,
+        })
+    }
+
+    /// The renderer, for settings ([`PresentationRenderer::set_shadows`]) and counters.
+    pub fn renderer(&mut self) -> &mut PresentationRenderer {
+        &mut self.renderer
+    }
+
+    /// Replaces the scene, as [`PresentationRenderer::set_scene`].
+    pub fn set_scene(
+        &mut self,
+        panels: &TriangleBuffers,
+        frames: &FrameInstances,
+    ) -> Result<(), RenderError> {
+        self.renderer
+            .set_scene(&self.device, &self.queue, panels, None, frames)
+    }
+
+    /// Draws one frame seen by `camera` into a `width` x `height` target and waits until the
+    /// GPU has finished it (no read-back): what one orbit frame of the page costs.
+    pub fn frame(&mut self, camera: &OrbitCamera, size: (u32, u32)) -> Result<(), RenderError> {
+        self.submit_frame(camera, size);
+        self.wait()
+    }
+
+    /// Encodes and submits one frame as [`Self::frame`] does, without waiting for the GPU: the
+    /// CPU cost of the page's `render()` call.
+    pub fn submit_frame(&mut self, camera: &OrbitCamera, (width, height): (u32, u32)) {
+        let (width, height) = (width.clamp(1, 8192), height.clamp(1, 8192));
+        if self
+            .target
+            .as_ref()
+            .is_none_or(|t| (t.1, t.2) != (width, height))
+        {
+            let tex = crate::gpu_mesh::texture(
+                &self.device,
+                "dupin offscreen frame",
+                (width, height),
+                wgpu::TextureFormat::Rgba8UnormSrgb,
+                wgpu::TextureUsages::RENDER_ATTACHMENT,
+            );
+            self.target = Some((tex.create_view(&Default::default()), width, height));
+        }
+        let view = &self.target.as_ref().expect("created above").0;
+        self.renderer
+            .render(&self.device, &self.queue, view, width, height, camera);
+    }
+
+    /// Blocks until the GPU has finished everything submitted.
+    pub fn wait(&self) -> Result<(), RenderError> {
+        self.device
+            .poll(wgpu::PollType::Wait {
+                submission_index: None,
+                timeout: None,
+            })
+            .map(|_| ())
+            .map_err(|e| RenderError::Readback(e.to_string()))
+    }
+
+    /// Renders the view seen by `camera` at `width` x `height` and reads it back. Blocks.
+    pub fn snapshot(
+        &mut self,
+        camera: &OrbitCamera,
+        (width, height): (u32, u32),
+    ) -> Result<OffscreenImage, RenderError> {
+        let pending = self.renderer.begin_snapshot(
+            &self.device,
+            &self.queue,
+            width.max(1),
+            height.max(1),
+            camera,
+        );
+        finish(&self.adapter, &self.device, pending)
+    }
 }

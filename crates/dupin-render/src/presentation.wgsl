@@ -1,4 +1,4 @@
-// Presentation mode (after vertex_io.wgsl): metal frames and a ground that receive a shadow map of the frames, and glass
+// Presentation mode (after vertex_io.wgsl): metal frames (boxes with shared corners) and a ground that receive a shadow map of the frames, and glass
 // panels blended over them with a Fresnel-like rim. Soft light: a sky/ground hemisphere ambient
 // plus one sun whose shadow is filtered with a 3x3 percentage-closer kernel.
 
@@ -42,6 +42,11 @@ fn sunlight(world: vec3<f32>, n: vec3<f32>) -> f32 {
     let ndc = lp.xyz / lp.w;
     let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
     let depth = ndc.z - 0.002;
+    // Outside the map (most of the ground) is sunlit: skip the nine taps there.
+    let inside = all(uv >= vec2<f32>(0.0)) && all(uv <= vec2<f32>(1.0)) && depth <= 1.0;
+    if !inside {
+        return 1.0;
+    }
     var lit = 0.0;
     for (var dx = -1; dx <= 1; dx++) {
         for (var dy = -1; dy <= 1; dy++) {
@@ -49,8 +54,7 @@ fn sunlight(world: vec3<f32>, n: vec3<f32>) -> f32 {
             lit += textureSampleCompareLevel(shadow_map, shadow_sampler, uv + o, depth);
         }
     }
-    let inside = all(uv >= vec2<f32>(0.0)) && all(uv <= vec2<f32>(1.0)) && depth <= 1.0;
-    return select(1.0, lit / 9.0, inside);
+    return lit / 9.0;
 }
 
 fn hemisphere(n: vec3<f32>) -> vec3<f32> {
@@ -62,7 +66,12 @@ fn hemisphere(n: vec3<f32>) -> vec3<f32> {
 @fragment
 fn fs_metal(i: VsOut) -> @location(0) vec4<f32> {
     let view = normalize(u.eye.xyz - i.world);
-    let n = facing_normal(i, u.eye.xyz);
+    // The flat normal of the triangle from screen-space derivatives of the world position (both
+    // lie in its plane): the boxes share 8 corner vertices and carry no face normals.
+    let d = cross(dpdx(i.world), dpdy(i.world));
+    let len = length(d);
+    var n = select(view, d / len, len > 0.0);
+    n = select(n, -n, dot(n, view) < 0.0);
     let sun = normalize(u.sun.xyz);
     let lit = sunlight(i.world, n);
     let h = normalize(sun + view);

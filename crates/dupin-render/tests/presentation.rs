@@ -7,7 +7,10 @@
 //! `DUPIN_BLESS=1 cargo test -p dupin-render --test presentation` rewrites the reference.
 
 use dupin_core::{PolyMesh, TriangleBuffers, Vec3, polymesh_buffers, polymesh_edges};
-use dupin_render::{OffscreenImage, OrbitCamera, frame_buffers, render_presentation_offscreen};
+use dupin_render::{
+    FrameInstances, OffscreenImage, OrbitCamera, PresentationOffscreen, frame_instances,
+    render_presentation_offscreen,
+};
 
 mod common;
 use common::{H, W, expect_image, reference_image, save};
@@ -36,7 +39,9 @@ fn panels() -> PolyMesh {
     PolyMesh::new(pos, &faces).unwrap()
 }
 
-fn render(with_frames: bool, with_glass: bool, shadows: bool) -> OffscreenImage {
+/// Glass and frame buffers of the test scene (without frames: only the four legs, so the ground
+/// sits at the same height in every variant; without glass: no panels) and its camera.
+fn scene(with_frames: bool, with_glass: bool) -> (TriangleBuffers, FrameInstances, OrbitCamera) {
     let m = panels();
     let (glass, _) = polymesh_buffers(&m, None);
     let mut edges = polymesh_edges(&m);
@@ -45,10 +50,9 @@ fn render(with_frames: bool, with_glass: bool, shadows: bool) -> OffscreenImage 
         edges.extend([c[0], c[1], z, c[0], c[1], 0.0]);
     }
     let frames = if with_frames {
-        frame_buffers(&edges, 0.05, 0.09)
+        frame_instances(&edges, 0.05, 0.09)
     } else {
-        // Only the legs, so the ground sits at the same height in every variant.
-        frame_buffers(&edges[edges.len() - 24..], 0.05, 0.09)
+        frame_instances(&edges[edges.len() - 24..], 0.05, 0.09)
     };
     let glass = if with_glass {
         glass
@@ -62,6 +66,11 @@ fn render(with_frames: bool, with_glass: bool, shadows: bool) -> OffscreenImage 
             .collect::<Vec<_>>(),
     );
     cam.distance *= 1.15;
+    (glass, frames, cam)
+}
+
+fn render(with_frames: bool, with_glass: bool, shadows: bool) -> OffscreenImage {
+    let (glass, frames, cam) = scene(with_frames, with_glass);
     expect_image(render_presentation_offscreen(
         &glass,
         &frames,
@@ -142,4 +151,63 @@ fn presentation_matches_reference_and_shows_frames_glass_and_shadows() {
         full.adapter,
         actual.display()
     );
+}
+
+/// The shadow map is drawn once per scene or shadow setting, not once per frame, and the cached
+/// map gives exactly the picture a fresh renderer draws: orbiting does not need the sun's pass.
+#[test]
+fn shadow_map_is_cached_across_orbit_frames_and_redrawn_on_change() {
+    let (glass, frames, cam) = scene(true, true);
+    let mut p = expect_image_ok(PresentationOffscreen::new(&glass, &frames));
+    assert_eq!(p.renderer().shadow_passes(), 0);
+    let mut orbit = cam;
+    for _ in 0..5 {
+        orbit.orbit(0.3, 0.05);
+        p.frame(&orbit, (W, H)).unwrap();
+    }
+    assert_eq!(
+        p.renderer().shadow_passes(),
+        1,
+        "one shadow pass for five orbit frames"
+    );
+    // After five frames from elsewhere, the cached map draws this view exactly as a fresh
+    // renderer (which draws its shadow map for this very frame) does.
+    let cached = p.snapshot(&cam, (W, H)).unwrap();
+    let fresh = render(true, true, true);
+    assert_eq!(p.renderer().shadow_passes(), 1);
+    assert!(
+        cached.rgba == fresh.rgba,
+        "cached shadows differ from fresh ones"
+    );
+
+    // Setting the same value keeps the map; a change redraws it, once.
+    p.renderer().set_shadows(true);
+    p.frame(&orbit, (W, H)).unwrap();
+    assert_eq!(p.renderer().shadow_passes(), 1);
+    p.renderer().set_shadows(false);
+    let unlit = p.snapshot(&cam, (W, H)).unwrap();
+    p.frame(&orbit, (W, H)).unwrap();
+    assert_eq!(p.renderer().shadow_passes(), 2);
+    assert!(
+        unlit.rgba == render(true, true, false).rgba,
+        "stale shadows after turning them off"
+    );
+    p.renderer().set_shadows(true);
+    assert!(p.snapshot(&cam, (W, H)).unwrap().rgba == fresh.rgba);
+    assert_eq!(p.renderer().shadow_passes(), 3);
+
+    // A new scene (frames reduced to the legs) redraws the map: its shadows are the new ones.
+    let (glass2, frames2, _) = scene(false, true);
+    p.set_scene(&glass2, &frames2).unwrap();
+    let legs = p.snapshot(&cam, (W, H)).unwrap();
+    assert_eq!(p.renderer().shadow_passes(), 4);
+    assert!(
+        legs.rgba == render(false, true, true).rgba,
+        "stale shadows after a new scene"
+    );
+    assert!(legs.rgba != fresh.rgba);
+}
+
+fn expect_image_ok<T>(r: Result<T, dupin_render::RenderError>) -> T {
+    r.unwrap_or_else(|e| panic!("offscreen rendering failed: {e}; install mesa-vulkan-drivers"))
 }

@@ -13,7 +13,7 @@ use wasm_bindgen::prelude::*;
 /// Glass and frame buffers of a presentation scene, with counts for the page.
 pub(crate) struct Scene {
     pub(crate) glass: TriangleBuffers,
-    pub(crate) frames: TriangleBuffers,
+    pub(crate) frames: dupin_render::FrameInstances,
     pub(crate) panels: usize,
     pub(crate) beams: usize,
     /// Why the offset layer is missing, when it was asked for and the core refused it.
@@ -57,7 +57,7 @@ pub(crate) fn build_scene(mesh: &PolyMesh, offset: bool) -> Scene {
     let beams = frame_edges.len() / 6;
     Scene {
         glass,
-        frames: dupin_render::frame_buffers(&frame_edges, beam, node),
+        frames: dupin_render::frame_instances(&frame_edges, beam, node),
         panels,
         beams,
         offset_error,
@@ -296,6 +296,8 @@ mod tests {
         assert_eq!(s.beams, 2 * m.num_faces());
         assert_eq!(s.glass.triangle_count(), 2 * m.num_faces());
         // 4 sides per beam and 6 per node, 2 triangles a side.
+        assert_eq!(s.frames.beam_count(), s.beams);
+        assert_eq!(s.frames.node_count(), m.num_vertices());
         assert_eq!(
             s.frames.triangle_count(),
             2 * (4 * s.beams + 6 * m.num_vertices())
