@@ -28,6 +28,31 @@ pub fn skew_quad_grid(n: usize, rotation_deg: f64) -> PolyMesh {
     PolyMesh::new(p, faces).expect("grid indices are valid")
 }
 
+/// The `nu x nv` quad mesh of a torus's parameter lines (R = `major`, r = `minor`; its
+/// principal curvature lines, so the quads are planar up to O(h^2)): vertex `i * nv + j` at
+/// (u, v) = 2π (i / nu, j / nv), quads oriented along the outward normal.
+pub fn torus_quad_mesh(nu: usize, nv: usize, major: f64, minor: f64) -> PolyMesh {
+    let (nu, nv) = (nu.max(3), nv.max(3));
+    let torus = Torus { major, minor };
+    let (du, dv) = (
+        std::f64::consts::TAU / nu as f64,
+        std::f64::consts::TAU / nv as f64,
+    );
+    let p: Vec<Vec3> = (0..nu)
+        .flat_map(|i| (0..nv).map(move |j| (i, j)))
+        .map(|(i, j)| torus.position(i as f64 * du, j as f64 * dv))
+        .collect();
+    let faces: Vec<[u32; 4]> = (0..nu)
+        .flat_map(|i| {
+            (0..nv).map(move |j| {
+                let (i1, j1) = ((i + 1) % nu, (j + 1) % nv);
+                [i * nv + j, i1 * nv + j, i1 * nv + j1, i * nv + j1].map(|k| k as u32)
+            })
+        })
+        .collect();
+    PolyMesh::new(p, faces).expect("grid indices are valid")
+}
+
 /// The centroid dual of the regular triangulation of a torus (R = `major`, r = `minor`) with
 /// `nu x nv` vertices (each parameter quad split along the same diagonal, all valences 6):
 /// one vertex per triangle at its centroid, one hexagon per torus vertex. `nu * nv` hexagons,
@@ -356,6 +381,21 @@ pub fn pq_scene(name: &str) -> Result<PqSceneResult, PqSceneError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn torus_quad_mesh_is_closed_and_faces_outward() {
+        let m = torus_quad_mesh(12, 8, 2.0, 0.7);
+        assert_eq!((m.num_vertices(), m.num_faces()), (96, 96));
+        let topo = MeshTopology::new(&m).unwrap();
+        assert!((0..m.num_vertices()).all(|v| !topo.is_boundary(v)));
+        for f in 0..m.num_faces() {
+            let v: Vec<Vec3> = m.face(f).iter().map(|&i| m.positions[i as usize]).collect();
+            let n = (v[2] - v[0]).cross(&(v[3] - v[1]));
+            let c = (v[0] + v[1] + v[2] + v[3]) / 4.0;
+            let axis = Vec3::new(c.x, c.y, 0.0).normalize() * 2.0;
+            assert!(n.dot(&(c - axis)) > 0.0, "face {f} points inward");
+        }
+    }
 
     #[test]
     fn every_pq_scene_meets_the_contract_bounds() {

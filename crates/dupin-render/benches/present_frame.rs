@@ -7,7 +7,7 @@
 //! Run: `cargo bench -p dupin-render --bench present_frame -- --quick`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use dupin_core::{PolyMesh, Vec3, polymesh_buffers, polymesh_edges};
+use dupin_core::{polymesh_buffers, polymesh_edges, torus_quad_mesh};
 use dupin_render::{FrameInstances, OrbitCamera, PresentationOffscreen, frame_instances};
 use std::time::{Duration, Instant};
 
@@ -15,32 +15,9 @@ const SIZE: (u32, u32) = (960, 640);
 
 type Group<'a> = criterion::BenchmarkGroup<'a, criterion::measurement::WallTime>;
 
-/// The page's 10k demo: a torus (R = 2, r = 0.7) of 128 x 79 quads.
-fn torus(nu: usize, nv: usize) -> PolyMesh {
-    let mut pos = Vec::with_capacity(nu * nv);
-    for i in 0..nu {
-        for j in 0..nv {
-            let (u, v) = (
-                std::f64::consts::TAU * i as f64 / nu as f64,
-                std::f64::consts::TAU * j as f64 / nv as f64,
-            );
-            let r = 2.0 + 0.7 * v.cos();
-            pos.push(Vec3::new(r * u.cos(), r * u.sin(), 0.7 * v.sin()));
-        }
-    }
-    let faces: Vec<[u32; 4]> = (0..nu)
-        .flat_map(|i| {
-            (0..nv).map(move |j| {
-                let (i1, j1) = ((i + 1) % nu, (j + 1) % nv);
-                [i * nv + j, i1 * nv + j, i1 * nv + j1, i * nv + j1].map(|k| k as u32)
-            })
-        })
-        .collect();
-    PolyMesh::new(pos, &faces).unwrap()
-}
-
 fn bench(c: &mut Criterion) {
-    let m = torus(128, 79);
+    // The page's 10k demo: a torus (R = 2, r = 0.7) of 128 x 79 quads.
+    let m = torus_quad_mesh(128, 79, 2.0, 0.7);
     let (glass, _) = polymesh_buffers(&m, None);
     let edges = polymesh_edges(&m);
     let mean = edges

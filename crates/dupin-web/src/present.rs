@@ -7,7 +7,7 @@
 #![cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
 
 use crate::mesh_data::MeshData;
-use dupin_core::{PolyMesh, TriangleBuffers, Vec3, offset_mesh, polymesh_buffers};
+use dupin_core::{PolyMesh, TriangleBuffers, Vec3, offset_mesh, polymesh_buffers, torus_quad_mesh};
 use wasm_bindgen::prelude::*;
 
 /// Glass and frame buffers of a presentation scene, with counts for the page.
@@ -78,27 +78,7 @@ pub(crate) fn torus_panels(panels: u32) -> Result<PolyMesh, String> {
     }
     let nu = ((panels as f64 * 2.5).sqrt().round() as usize).max(4);
     let nv = (panels as usize).div_ceil(nu).max(4);
-    let (big, small) = (2.0f64, 0.7f64);
-    let mut pos = Vec::with_capacity(nu * nv);
-    for i in 0..nu {
-        for j in 0..nv {
-            let (u, v) = (
-                std::f64::consts::TAU * i as f64 / nu as f64,
-                std::f64::consts::TAU * j as f64 / nv as f64,
-            );
-            let r = big + small * v.cos();
-            pos.push(Vec3::new(r * u.cos(), r * u.sin(), small * v.sin()));
-        }
-    }
-    let faces: Vec<[u32; 4]> = (0..nu)
-        .flat_map(|i| {
-            (0..nv).map(move |j| {
-                let (i1, j1) = ((i + 1) % nu, (j + 1) % nv);
-                [i * nv + j, i1 * nv + j, i1 * nv + j1, i * nv + j1].map(|k| k as u32)
-            })
-        })
-        .collect();
-    PolyMesh::new(pos, &faces).map_err(|e| e.to_string())
+    Ok(torus_quad_mesh(nu, nv, 2.0, 0.7))
 }
 
 /// A torus panel mesh of about `panels` quads, for trying presentation mode at scale.

@@ -427,10 +427,9 @@ impl TileSet {
             | bit(1, -1) << 5
     }
 
-    /// Inserts `v`; returns whether it was new.
+    /// The index of tile `key`, created empty if absent.
     #[inline(always)]
-    fn insert(&mut self, v: Axial) -> bool {
-        let (key, bit) = Self::slot(v);
+    fn tile_or_insert(&mut self, key: Axial) -> u32 {
         let mut i = self.tile(key);
         if i == NONE {
             i = self.words.len() as u32;
@@ -439,6 +438,14 @@ impl TileSet {
             self.keys.push(key);
             self.last.set((key, i));
         }
+        i
+    }
+
+    /// Inserts `v`; returns whether it was new.
+    #[inline(always)]
+    fn insert(&mut self, v: Axial) -> bool {
+        let (key, bit) = Self::slot(v);
+        let i = self.tile_or_insert(key);
         let w = &mut self.words[i as usize][bit >> 6];
         let m = 1u64 << (bit & 63);
         let new = *w & m == 0;
@@ -449,14 +456,7 @@ impl TileSet {
     /// Inserts `(a, b)` for `b0 <= b <= b1`, all in one tile; returns how many were new.
     fn insert_run(&mut self, a: i64, b0: i64, b1: i64) -> usize {
         let (key, bit) = Self::slot((a, b0));
-        let mut i = self.tile(key);
-        if i == NONE {
-            i = self.words.len() as u32;
-            self.index.insert(key, i);
-            self.words.push([0; 4]);
-            self.keys.push(key);
-            self.last.set((key, i));
-        }
+        let i = self.tile_or_insert(key);
         let len = (b1 - b0 + 1) as u32;
         let m = ((1u64 << len) - 1) << (bit & 63);
         let w = &mut self.words[i as usize][bit >> 6];
