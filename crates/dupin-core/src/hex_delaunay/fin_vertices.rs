@@ -283,3 +283,145 @@ pub fn apply_fin_patches(
         "the patches replace whole fans"
     );
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::hex_delaunay::extended_refinement::ANGLE_MIN;
+
+    const S3: f64 = 1.732_050_807_568_877_2;
+
+    fn dir(deg: f64) -> Vec2 {
+        let a = deg.to_radians();
+        Vec2::new(a.cos(), a.sin())
+    }
+
+    /// The configuration of Fig. 9/10 with unit circumradius: `n` MOVED_CENTER_3 around the
+    /// top at the origin, the ends MOVED_CENTER_1 (moved 1/6 towards their fin), the rest of
+    /// the top's neighbours fixed.
+    fn config(n: usize) -> Run {
+        let mut key = 0i64;
+        let mut next = |p: Vec2| {
+            key += 1;
+            (p, (key, 0))
+        };
+        let nb: Vec<Vec2> = (0..6).map(|i| dir(30.0 + 60.0 * i as f64) * S3).collect();
+        let mut centres = Vec::new();
+        let mut fine = Vec::new();
+        for (i, &c) in nb.iter().enumerate().take(n) {
+            let th = 30.0 + 60.0 * i as f64;
+            centres.push(next(c));
+            fine.push([
+                next(c + dir(th - 60.0) * S3),
+                next(c + dir(th - 30.0) * 1.5),
+                next(c + dir(th) * S3),
+                next(c + dir(th + 30.0) * 1.5),
+                next(c + dir(th + 60.0) * S3),
+            ]);
+        }
+        // Fine hexagons shared by neighbours in the run are one vertex.
+        for i in 1..n {
+            fine[i][0] = fine[i - 1][4];
+        }
+        if n == 6 {
+            fine[0][0] = fine[5][4];
+        }
+        let ends = (n < 6).then(|| {
+            let l = nb[5] + (fine[0][0].0 - nb[5]) / 6.0;
+            let r = nb[n] + (fine[n - 1][4].0 - nb[n]) / 6.0;
+            [next(l), next(r)]
+        });
+        let others = if n < 6 {
+            ((n + 1)..5).map(|i| nb[i]).collect()
+        } else {
+            Vec::new()
+        };
+        Run {
+            top: next(Vec2::zeros()),
+            centres,
+            fine,
+            ends,
+            others,
+        }
+    }
+
+    fn angles(p: &[Vec2; 3]) -> [f64; 3] {
+        std::array::from_fn(|j| {
+            (p[(j + 1) % 3] - p[j])
+                .angle(&(p[(j + 2) % 3] - p[j]))
+                .to_degrees()
+        })
+    }
+
+    fn min_max(p: &FinPatch) -> (f64, f64, usize) {
+        let tris: Vec<[Vec2; 3]> = p
+            .triangles
+            .iter()
+            .map(|t| t.map(|v| p.position(v)))
+            .chain(p.around_top.iter().copied())
+            .collect();
+        let mut lo = f64::INFINITY;
+        let mut hi: f64 = 0.0;
+        for t in &tris {
+            assert!(
+                (t[1] - t[0]).perp(&(t[2] - t[0])) > 0.0,
+                "counter-clockwise"
+            );
+            for a in angles(t) {
+                lo = lo.min(a);
+                hi = hi.max(a);
+            }
+        }
+        (lo, hi, p.triangles.len())
+    }
+
+    /// Section 5.4 / 6.1: with the relocation formulas every triangle of a single MOVED_CENTER_3,
+    /// of runs of 2, 3, 4 and of a blossom has its angles in [α, 90°]; a blossom is 60
+    /// triangles (section 5.3), a single MOVED_CENTER_3 12, a run of n 10n + 4.
+    #[test]
+    fn runs_keep_the_angle_bounds() {
+        for n in [1, 2, 3, 4, 6] {
+            let p = run_patch(&config(n)).expect("a patch");
+            let (lo, hi, count) = min_max(&p);
+            assert!(
+                lo >= ANGLE_MIN - 1e-9 && hi <= 90.0 + 1e-9,
+                "n = {n}: angles {lo}..{hi}"
+            );
+            let expected = match n {
+                1 => 12,
+                6 => 60,
+                _ => 10 * n + 4,
+            };
+            assert_eq!(count, expected, "n = {n}");
+        }
+        assert!(
+            run_patch(&{
+                let mut r = config(4);
+                r.centres.push(r.centres[0]);
+                r.fine.push(r.fine[0]);
+                r
+            })
+            .is_none()
+        );
+    }
+
+    /// Our reading of the n = 2 MOVED_CENTER_4 formula: with C_M the mean of the original
+    /// centres the top's triangles fall below α; with the new centres they do not.
+    #[test]
+    fn the_two_run_top_needs_the_new_centres() {
+        let run = config(2);
+        let mut p = run_patch(&run).unwrap();
+        let c: Vec<Vec2> = run.centres.iter().map(|x| x.0).collect();
+        let t = run.top.0;
+        let literal = t * 1.25 - (c[0] + c[1]) * 0.125;
+        let top_key = run.top.1;
+        for m in p.moved.iter_mut().filter(|m| m.0 == top_key) {
+            m.1 = literal;
+        }
+        for tri in &mut p.around_top {
+            tri[0] = literal;
+        }
+        let (lo, _, _) = min_max(&p);
+        assert!(lo < ANGLE_MIN - 1.0, "literal C_M gives {lo}");
+    }
+}
