@@ -247,6 +247,8 @@ type Marks = (Hexes, Hexes);
 /// what a full pass would mark too.
 struct Pass<'a> {
     r: &'a Refinement,
+    /// The PSLG's segments (point index pairs); runs stay away from them (section 7.2).
+    segments: &'a [[u32; 2]],
     occupied: FxHashMap<(u32, Axial), Occupied>,
     /// In a full pass, once every occupied hexagon is analysed: the ring hexagons, with the
     /// shift of a moved 1-ring (so a leaf asks one map instead of its 18 neighbours).
@@ -259,9 +261,10 @@ struct Pass<'a> {
 }
 
 impl<'a> Pass<'a> {
-    fn new(r: &'a Refinement) -> Self {
+    fn new(r: &'a Refinement, segments: &'a [[u32; 2]]) -> Self {
         Pass {
             r,
+            segments,
             occupied: FxHashMap::default(),
             rings: None,
             split: FxHashSet::default(),
@@ -403,6 +406,17 @@ impl<'a> Pass<'a> {
             && tops_mask(h, k, v) == 0
     }
 
+    /// Whether a segment passes within `dist` of `c`. A scan of all segments: O(segments) per
+    /// run, only with a PSLG (a spatial index would make it O(1); not needed for our inputs).
+    fn near_segment(&self, c: Vec2, dist: f64) -> bool {
+        self.segments.iter().any(|&[i, j]| {
+            let (a, b) = (self.r.points[i as usize], self.r.points[j as usize]);
+            let d = b - a;
+            let t = ((c - a).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
+            (a + d * t - c).norm() <= dist
+        })
+    }
+
     /// The verdict on the MOVED_CENTER_3 run around the top `t` at level `k` (memoised).
     fn run(&mut self, k: u32, t: Axial) -> RunVerdict {
         if let Some(&v) = self.runs.get(&(k, t)) {
@@ -433,6 +447,7 @@ impl<'a> Pass<'a> {
             || on_boundary(k, t)
             || DIRS.iter().any(|&d| !h.is_present(k, add(t, d)))
             || self.in_some_ring(k, t)
+            || self.near_segment(f.position(k, t), 3.0 * f.radius(k))
         {
             return Rejected;
         }
@@ -447,8 +462,13 @@ impl<'a> Pass<'a> {
             let e = start + i;
             let y = add(t, dir(e));
             // No occupied hexagon within two steps: the rings' checks (`verify`) read the
-            // dual there as the plain one.
-            if on_boundary(k, y) || disc(y, 2).any(|z| self.r.point_in(k, z).is_some()) {
+            // dual there as the plain one. No segment within three radii (the paper's 7.2: no
+            // MOVED_CENTER hexagon at or next to a met one; measured: a run's fin vertices
+            // next to a segment broke its insertion on the IMR letters).
+            if on_boundary(k, y)
+                || disc(y, 2).any(|z| self.r.point_in(k, z).is_some())
+                || self.near_segment(f.position(k, y), 3.0 * f.radius(k))
+            {
                 return Rejected;
             }
             let c2 = (2 * y.0, 2 * y.1);
@@ -710,8 +730,8 @@ impl<'a> Pass<'a> {
 }
 
 /// A full pass: every occupied hexagon and every leaf. Returns the marks and the relocations.
-fn full_pass(r: &Refinement) -> (Marks, Relocation) {
-    let mut pass = Pass::new(r);
+fn full_pass(r: &Refinement, segments: &[[u32; 2]]) -> (Marks, Relocation) {
+    let mut pass = Pass::new(r, segments);
     for c in &r.cell_of {
         if let Cell::Full(k, x) = *c {
             pass.visit_occupied(k, x);
@@ -861,9 +881,14 @@ fn affected(r: &Refinement, index: &mut OccupiedIndex, changes: &[(u32, Axial)])
 }
 
 /// An incremental pass over the given leaves and occupied hexagons.
-fn region_pass(r: &Refinement, leaves: &[(u32, Axial)], occupied: &[(u32, Axial)]) -> Marks {
+fn region_pass(
+    r: &Refinement,
+    segments: &[[u32; 2]],
+    leaves: &[(u32, Axial)],
+    occupied: &[(u32, Axial)],
+) -> Marks {
     let h = &r.hierarchy;
-    let mut pass = Pass::new(r);
+    let mut pass = Pass::new(r, segments);
     for &(k, x) in occupied {
         pass.visit_occupied(k, x);
     }
@@ -913,17 +938,18 @@ fn disc(v: Axial, r: i64) -> impl Iterator<Item = Axial> {
 pub fn extended_pass(
     r: &mut Refinement,
     state: &mut ExtendedState,
+    segments: &[[u32; 2]],
 ) -> Result<Vec<(u32, Axial)>, HexDelaunayError> {
     loop {
         let full = state.changes.is_none();
         let (split, present) = match state.changes.take() {
             Some(changes) => {
                 let (leaves, occupied) = affected(r, &mut state.index, &changes);
-                region_pass(r, &leaves, &occupied)
+                region_pass(r, segments, &leaves, &occupied)
             }
             None => {
                 state.index.rebuild(r);
-                full_pass(r).0
+                full_pass(r, segments).0
             }
         };
         let mut made = Vec::new();
@@ -947,6 +973,6 @@ pub fn extended_pass(
 pub const ANGLE_MIN: f64 = 43.897_886_248_013_99;
 
 /// The relocations (section 5.4) of the finished extended refinement.
-pub fn relocated_centres(r: &Refinement) -> Relocation {
-    full_pass(r).1
+pub fn relocated_centres(r: &Refinement, segments: &[[u32; 2]]) -> Relocation {
+    full_pass(r, segments).1
 }

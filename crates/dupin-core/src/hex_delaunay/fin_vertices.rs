@@ -166,8 +166,8 @@ pub fn run_patch(run: &Run) -> Option<FinPatch> {
             return None;
         }
         let hat: Vec<Vec2> = c.iter().map(|&q| q * (2.0 / 3.0) + t / 3.0).collect();
-        for i in 0..n {
-            p.moved.push((run.centres[i].1, hat[i]));
+        for (centre, &q) in run.centres.iter().zip(&hat) {
+            p.moved.push((centre.1, q));
         }
         let h = |i: usize| VRef::Key(run.centres[i].1);
         let mid: Vec<VRef> = (0..n)
@@ -194,8 +194,8 @@ pub fn run_patch(run: &Run) -> Option<FinPatch> {
         let before = |i: usize| if i == 0 { e0 } else { shared[i - 1] };
         let after = |i: usize| if i == n - 1 && !cyc { e1 } else { shared[i] };
         t_new = top_new(t, &c);
-        for i in 0..n {
-            let (b, a, f) = (before(i), after(i), mid[i]);
+        for (i, &f) in mid.iter().enumerate() {
+            let (b, a) = (before(i), after(i));
             let [a0, m01, a1, m12, a2] = [0, 1, 2, 3, 4].map(|j| fk(i, j));
             p.triangles.extend([
                 [b, m01, f],

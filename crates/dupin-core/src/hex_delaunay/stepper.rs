@@ -161,7 +161,8 @@ impl HexDelaunayStepper {
         if self.mode == HexDelaunayMode::Extended {
             if self.last.is_empty() {
                 // Simple rules exhausted: one extended pass (section 5.2) is one step.
-                self.last = extended_pass(&mut self.refinement, &mut self.extended)?;
+                self.last =
+                    extended_pass(&mut self.refinement, &mut self.extended, &self.segments)?;
                 self.extended_clean = self.last.is_empty();
             } else {
                 self.extended.record(&self.last);
@@ -358,7 +359,9 @@ impl HexDelaunayStepper {
     fn dual(&self, snap: bool) -> (HexTriangulation, Vec<[u32; 2]>, FxHashMap<u32, Vec2>) {
         let h = &self.refinement.hierarchy;
         let Relocation { mut moved, patches } = match self.mode {
-            HexDelaunayMode::Extended if self.is_done() => relocated_centres(&self.refinement),
+            HexDelaunayMode::Extended if self.is_done() => {
+                relocated_centres(&self.refinement, &self.segments)
+            }
             _ => Relocation::default(),
         };
         let centres: FxHashSet<Key> = patches.iter().flat_map(|p| p.centres.clone()).collect();
