@@ -6,15 +6,17 @@
 //! dual mesh, keyed like the dual's vertices. Angles land in [α, 90°], α = 43.8979°.
 //!
 //! Types and formulas: MOVED_CENTER_1 (Ĉ = 5/6 C + 1/6 C_f0), MOVED_CENTER_2
-//! (Ĉ = 3/5 C + 2/5 C_f01), OCCUPIED_1/2 (point inside / outside the half-sized hexagon),
+//! (Ĉ = 3/5 C + 2/5 C_f01), MOVED_CENTER_3 and MOVED_CENTER_4 (runs around a common top, in
+//! `fin_vertices.rs`), OCCUPIED_1/2 (point inside / outside the half-sized hexagon),
 //! MOVED_CENTER_IN_RING (shifted by half the vector from the occupied centre to the corner
 //! nearest its point), FIXED_CENTER_IN_RING and FIXED_CENTER_REGULAR (not moved). Rules of 5.2:
 //! SUBDIVIDE, MOVED_CENTER_x in the 1-ring of an OCCUPIED_1 or the 1-/2-ring of an OCCUPIED_2,
 //! MOVED_CENTER_x whose fin-adjacent full hexagons are not fixed.
 //!
-//! Deviations (see docs/hexdelaunay.md): MOVED_CENTER_3 hexagons are subdivided like SUBDIVIDE
-//! ones, so MOVED_CENTER_4, the consecutive-MOVED_CENTER_3 rule and blossoms (with split
-//! counters, merge and break) never arise: more triangles, same bounds. Rules added:
+//! Deviations (see docs/hexdelaunay.md): the consecutive-MOVED_CENTER_3 and MOVED_CENTER_4
+//! rules are replaced by a local check of every triangle a run of MOVED_CENTER_3 and its moved
+//! top make (`Pass::analyse_run`); a run that fails it is split as SUBDIVIDE. No local
+//! coarsening into blossoms (split counters, merge, break). Rules added:
 //! (a) opposite-facing fin strips: a MOVED_CENTER hexagon is subdivided when an unsplit
 //! same-level neighbour has fins none of which is at or next to its own fin directions (two
 //! such centres move apart and leave a 35° triangle between them, a case Fig. 10 lacks);
@@ -32,6 +34,7 @@
 
 use super::dual::{Key, pack};
 use super::error::HexDelaunayError;
+use super::fin_vertices::{FinPatch, Run, run_patch, top_new};
 use super::hierarchy::{Cell, HexSet, Hierarchy};
 use super::lattice::{Axial, DIRS, add, hex_norm, in_domain, on_boundary, parents_of_midpoint};
 use super::simple_refinement::Refinement;
@@ -82,6 +85,14 @@ fn consecutive(mask: u8) -> Option<(usize, usize)> {
     }
 }
 
+/// For exactly three consecutive fins, the index of the first fin direction.
+fn three_consecutive(mask: u8) -> Option<usize> {
+    if mask.count_ones() != 3 {
+        return None;
+    }
+    (0..6).find(|&j| mask == (1 << j) | (1 << ((j + 1) % 6)) | (1 << ((j + 2) % 6)))
+}
+
 /// Position of the offset `dz` (hexagonal norm 2) in the order of `ring(_, 2)`.
 fn ring2_index(dz: Axial) -> usize {
     // ring(v, 2) walks side j from 2·DIRS[j] along DIRS[j + 2], two steps per side.
@@ -124,6 +135,73 @@ fn in_half_hexagon(p: Vec2, c: Vec2, r: f64) -> bool {
         .all(|&(nx, ny)| q.x * nx + q.y * ny <= 0.25 * SQRT3 * r)
 }
 
+/// The neighbours of the leaf `t` at level `k` that have three consecutive fins facing away
+/// from `t`, i.e. whose top neighbour (section 5.1) is `t`, as a bit mask over `DIRS`. Such a
+/// `t` is no FIXED_CENTER (it is a MOVED_CENTER_4). The middle fin of `y = t + d_i` is then
+/// `t + 2 d_i`, so a leaf with no split hexagon two steps out costs six look-ups.
+fn tops_mask(h: &Hierarchy, k: u32, t: Axial) -> u8 {
+    let mut m = 0;
+    for (i, d) in DIRS.iter().enumerate() {
+        if !h.is_split(k, add(t, add(*d, *d))) {
+            continue;
+        }
+        let y = add(t, *d);
+        if !h.is_present(k, y) || h.is_split(k, y) {
+            continue;
+        }
+        // Fins j..j+2 with the middle one j+1 = i, i.e. j = i - 1.
+        if three_consecutive(fin_mask(h, k, y)) == Some((i + 5) % 6) {
+            m |= 1 << i;
+        }
+    }
+    m
+}
+
+/// The first position and length of the single run of set bits of a top's mask (cyclic),
+/// `(0, 6)` for a blossom; None for several runs or five.
+fn run_shape(mask: u8) -> Option<(usize, usize)> {
+    if mask == 0x3f {
+        return Some((0, 6));
+    }
+    let s = (0..6).find(|&i| mask & (1 << i) != 0 && mask & (1 << ((i + 5) % 6)) == 0)?;
+    let n = (0..6)
+        .take_while(|&i| mask & (1 << ((s + i) % 6)) != 0)
+        .count();
+    (n == mask.count_ones() as usize && n != 5).then_some((s, n))
+}
+
+/// Where the top `t` at level `k` goes if its run is accepted (None if it cannot be).
+fn top_formula(h: &Hierarchy, k: u32, t: Axial) -> Option<Vec2> {
+    let (s, n) = run_shape(tops_mask(h, k, t))?;
+    let f = &h.frame;
+    let c: Vec<Vec2> = (0..n)
+        .map(|i| f.position(k, add(t, DIRS[(s + i) % 6])))
+        .collect();
+    Some(top_new(f.position(k, t), &c))
+}
+
+/// A top's verdict on its MOVED_CENTER_3 run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum RunVerdict {
+    /// Relocated: the patch's index in `Pass::patches`.
+    Accepted(usize),
+    /// Its MOVED_CENTER_3 hexagons are split (as SUBDIVIDE).
+    Rejected,
+    /// A hexagon it depends on is split this pass: decided on the next one.
+    Pending,
+}
+
+/// Whether the triangle `p` is counter-clockwise with angles in [α, 90°] (local tolerances as
+/// in `Pass::verify`) and edges at least `min_edge`.
+fn acute_enough(p: &[Vec2; 3], min_edge: f64) -> bool {
+    let cos_lo = (ANGLE_MIN - 1e-9).to_radians().cos();
+    (0..3).all(|j| {
+        let (u, w) = (p[(j + 1) % 3] - p[j], p[(j + 2) % 3] - p[j]);
+        let c = u.dot(&w) / (u.norm() * w.norm());
+        u.perp(&w) > 0.0 && c >= -1e-12 && c <= cos_lo && u.norm() >= min_edge
+    })
+}
+
 /// What section 5.1 (and our ring rules) make of an occupied hexagon.
 #[derive(Debug, Clone, Copy)]
 enum Occupied {
@@ -147,6 +225,8 @@ enum Leaf {
     Split,
     Fixed,
     Moved(Vec2),
+    /// A MOVED_CENTER_3 of an accepted run: its fan is replaced (`fin_vertices.rs`).
+    Fins,
 }
 
 /// Hexagons as (level, centre).
@@ -161,22 +241,30 @@ type Marks = (Hexes, Hexes);
 /// what a full pass would mark too.
 struct Pass<'a> {
     r: &'a Refinement,
+    /// The PSLG's segments (point index pairs); runs stay away from them (section 7.2).
+    segments: &'a [[u32; 2]],
     occupied: FxHashMap<(u32, Axial), Occupied>,
     /// In a full pass, once every occupied hexagon is analysed: the ring hexagons, with the
     /// shift of a moved 1-ring (so a leaf asks one map instead of its 18 neighbours).
     rings: Option<FxHashMap<(u32, Axial), Option<Vec2>>>,
     split: FxHashSet<(u32, Axial)>,
     present: FxHashSet<(u32, Axial)>,
+    /// The verdicts on MOVED_CENTER_3 runs, by top, and the accepted runs' patches.
+    runs: FxHashMap<(u32, Axial), RunVerdict>,
+    patches: Vec<FinPatch>,
 }
 
 impl<'a> Pass<'a> {
-    fn new(r: &'a Refinement) -> Self {
+    fn new(r: &'a Refinement, segments: &'a [[u32; 2]]) -> Self {
         Pass {
             r,
+            segments,
             occupied: FxHashMap::default(),
             rings: None,
             split: FxHashSet::default(),
             present: FxHashSet::default(),
+            runs: FxHashMap::default(),
+            patches: Vec::new(),
         }
     }
 
@@ -309,6 +397,144 @@ impl<'a> Pass<'a> {
             && fin_mask(h, k, v) == 0
             && self.r.point_in(k, v).is_none()
             && self.ring1_moved(k, v).is_none()
+            && tops_mask(h, k, v) == 0
+    }
+
+    /// Whether a segment passes within `dist` of `c`. A scan of all segments: O(segments) per
+    /// run, only with a PSLG (a spatial index would make it O(1); not needed for our inputs).
+    fn near_segment(&self, c: Vec2, dist: f64) -> bool {
+        self.segments.iter().any(|&[i, j]| {
+            let (a, b) = (self.r.points[i as usize], self.r.points[j as usize]);
+            let d = b - a;
+            let t = ((c - a).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
+            (a + d * t - c).norm() <= dist
+        })
+    }
+
+    /// The verdict on the MOVED_CENTER_3 run around the top `t` at level `k` (memoised).
+    fn run(&mut self, k: u32, t: Axial) -> RunVerdict {
+        if let Some(&v) = self.runs.get(&(k, t)) {
+            return v;
+        }
+        let v = self.analyse_run(k, t);
+        self.runs.insert((k, t), v);
+        v
+    }
+
+    /// Section 5.4 for the MOVED_CENTER_3 hexagons around the top `t` (see `fin_vertices.rs`
+    /// for the positions and triangles). The paper's conditions are checked (fin-side hexagons
+    /// fixed, one consecutive run per top, no ring, no boundary), with ours: no occupied
+    /// hexagon within three steps of the top, no other top or three-fin hexagon next to it.
+    /// Because the paper shows the bounds only by figures, every triangle of the patch and
+    /// around the moved top (with the neighbours' own relocations) must also have its angles
+    /// in [α, 90°] and its edges at least Fig. 8's √7/2·r of the fin level (so section 6.3's
+    /// argument is unchanged); else the run's hexagons are split, as SUBDIVIDE ones.
+    fn analyse_run(&mut self, k: u32, t: Axial) -> RunVerdict {
+        use RunVerdict::*;
+        let h = &self.r.hierarchy;
+        let f = &h.frame;
+        let mask = tops_mask(h, k, t);
+        if mask == 0
+            || !h.is_present(k, t)
+            || h.is_split(k, t)
+            || fin_mask(h, k, t) != 0
+            || on_boundary(k, t)
+            || DIRS.iter().any(|&d| !h.is_present(k, add(t, d)))
+            || self.in_some_ring(k, t)
+            || self.near_segment(f.position(k, t), 3.0 * f.radius(k))
+        {
+            return Rejected;
+        }
+        // Several runs (the paper's MOVED_CENTER_4 rule) or five are split.
+        let Some((start, n)) = run_shape(mask) else {
+            return Rejected;
+        };
+        let dir = |e: usize| DIRS[e % 6];
+        let mut centres = Vec::with_capacity(n);
+        let mut fine = Vec::with_capacity(n);
+        for i in 0..n {
+            let e = start + i;
+            let y = add(t, dir(e));
+            // No occupied hexagon within two steps: the rings' checks (`verify`) read the
+            // dual there as the plain one. No segment within three radii (the paper's 7.2: no
+            // MOVED_CENTER hexagon at or next to a met one; measured: a run's fin vertices
+            // next to a segment broke its insertion on the IMR letters).
+            if on_boundary(k, y)
+                || disc(y, 2).any(|z| self.r.point_in(k, z).is_some())
+                || self.near_segment(f.position(k, y), 3.0 * f.radius(k))
+            {
+                return Rejected;
+            }
+            let c2 = (2 * y.0, 2 * y.1);
+            let zs = [
+                add(c2, add(dir(e + 5), dir(e + 5))),
+                add(c2, add(dir(e + 5), dir(e))),
+                add(c2, add(dir(e), dir(e))),
+                add(c2, add(dir(e), dir(e + 1))),
+                add(c2, add(dir(e + 1), dir(e + 1))),
+            ];
+            if !zs.iter().all(|&z| self.fixed(k + 1, z)) {
+                return Rejected;
+            }
+            centres.push((f.position(k, y), pack(k, y)));
+            fine.push(zs.map(|z| (f.position(k + 1, z), pack(k + 1, z))));
+        }
+        // The other neighbours of the top, from the right end round to the left end.
+        let mut ring = Vec::new();
+        if n < 6 {
+            for i in n..6 {
+                let x = add(t, dir(start + i));
+                let h = &self.r.hierarchy;
+                let xm = fin_mask(h, k, x);
+                if three_consecutive(xm).is_some() {
+                    return Rejected;
+                }
+                let p = if xm == 0 && tops_mask(h, k, x) != 0 && !self.in_some_ring(k, x) {
+                    // Another top: at the fixed point its run is accepted too (else its
+                    // hexagons are split), so it is taken where its run puts it.
+                    match top_formula(h, k, x) {
+                        Some(p) => p,
+                        None => return Pending,
+                    }
+                } else {
+                    match self.leaf(k, x) {
+                        Leaf::Moved(p) => p,
+                        Leaf::Fixed => f.position(k, x),
+                        Leaf::Split => return Pending,
+                        Leaf::Fins => return Rejected,
+                    }
+                };
+                ring.push((p, pack(k, x)));
+            }
+        }
+        let ends = (n < 6).then(|| [ring[ring.len() - 1], ring[0]]);
+        let others = if n < 6 {
+            ring[1..ring.len() - 1].iter().map(|x| x.0).collect()
+        } else {
+            Vec::new()
+        };
+        let run = Run {
+            top: (f.position(k, t), pack(k, t)),
+            centres,
+            fine,
+            ends,
+            others,
+        };
+        let Some(patch) = run_patch(&run) else {
+            return Rejected;
+        };
+        let min_edge = 0.5 * 7f64.sqrt() * f.radius(k + 1) * (1.0 - 1e-9);
+        let ok = patch
+            .triangles
+            .iter()
+            .map(|tri| tri.map(|v| patch.position(v)))
+            .chain(patch.around_top.iter().copied())
+            .all(|p| acute_enough(&p, min_edge));
+        if !ok {
+            return Rejected;
+        }
+        self.patches.push(patch);
+        Accepted(self.patches.len() - 1)
     }
 
     /// Classifies the leaf full hexagon `v` at level `k` (5.1, 5.2, 5.4).
@@ -319,11 +545,26 @@ impl<'a> Pass<'a> {
         if mask == 0 {
             return match self.ring1_moved(k, v) {
                 Some(s) => Leaf::Moved(f.position(k, v) + s),
+                // MOVED_CENTER_4 (5.4): moved with its run of MOVED_CENTER_3.
+                None if tops_mask(h, k, v) != 0 => match self.run(k, v) {
+                    RunVerdict::Accepted(i) => Leaf::Moved(self.patches[i].top_position()),
+                    _ => Leaf::Fixed,
+                },
                 None => Leaf::Fixed,
             };
         }
         let Some((j, n)) = consecutive(mask) else {
-            return Leaf::Split; // SUBDIVIDE (and, here, MOVED_CENTER_3).
+            if let Some(j) = three_consecutive(mask)
+                && !self.in_some_ring(k, v)
+            {
+                // MOVED_CENTER_3: relocated with its run around its top neighbour.
+                return match self.run(k, add(v, DIRS[(j + 4) % 6])) {
+                    RunVerdict::Accepted(_) => Leaf::Fins,
+                    RunVerdict::Rejected => Leaf::Split,
+                    RunVerdict::Pending => Leaf::Fixed,
+                };
+            }
+            return Leaf::Split; // SUBDIVIDE, or MOVED_CENTER_3 in a ring.
         };
         // A boundary centre may only slide along Ω's edge: one fin, towards a boundary
         // neighbour. Ω's corners stay put (the triangles must tile Ω).
@@ -482,10 +723,9 @@ impl<'a> Pass<'a> {
     }
 }
 
-/// A full pass: every occupied hexagon and every leaf. Returns the marks and the relocated
-/// centres.
-fn full_pass(r: &Refinement) -> (Marks, FxHashMap<Key, Vec2>) {
-    let mut pass = Pass::new(r);
+/// A full pass: every occupied hexagon and every leaf. Returns the marks and the relocations.
+fn full_pass(r: &Refinement, segments: &[[u32; 2]]) -> (Marks, Relocation) {
+    let mut pass = Pass::new(r, segments);
     for c in &r.cell_of {
         if let Cell::Full(k, x) = *c {
             pass.visit_occupied(k, x);
@@ -498,7 +738,39 @@ fn full_pass(r: &Refinement) -> (Marks, FxHashMap<Key, Vec2>) {
             moved.insert(pack(k, v), p);
         }
     });
-    (pass.marks(), moved)
+    // The accepted runs, in the order of their tops (deterministic vertex numbering).
+    let mut accepted: Vec<((u32, Axial), usize)> = pass
+        .runs
+        .iter()
+        .filter_map(|(&t, v)| match v {
+            RunVerdict::Accepted(i) => Some((t, *i)),
+            _ => None,
+        })
+        .collect();
+    accepted.sort_unstable();
+    let mut patches = Vec::with_capacity(accepted.len());
+    for (_, i) in accepted {
+        let p = std::mem::take(&mut pass.patches[i]);
+        // The dual builder reports the vertex of every key in `moved`.
+        for &(key, q) in &p.moved {
+            moved.insert(key, q);
+        }
+        for &(key, q) in &p.uses {
+            moved.entry(key).or_insert(q);
+        }
+        patches.push(p);
+    }
+    (pass.marks(), Relocation { moved, patches })
+}
+
+/// The relocations of section 5.4 for the dual of a finished extended refinement.
+#[derive(Debug, Clone, Default)]
+pub struct Relocation {
+    /// New positions of moved centres (and the positions of the hexagons around a
+    /// MOVED_CENTER_3, so that the dual builder reports their vertices).
+    pub moved: FxHashMap<Key, Vec2>,
+    /// The MOVED_CENTER_3 hexagons, whose centre vertex the fins' vertices replace.
+    pub patches: Vec<FinPatch>,
 }
 
 /// Side of the square blocks of lattice coordinates (as a shift) that index the occupied
@@ -602,9 +874,14 @@ fn affected(r: &Refinement, index: &mut OccupiedIndex, changes: &[(u32, Axial)])
 }
 
 /// An incremental pass over the given leaves and occupied hexagons.
-fn region_pass(r: &Refinement, leaves: &[(u32, Axial)], occupied: &[(u32, Axial)]) -> Marks {
+fn region_pass(
+    r: &Refinement,
+    segments: &[[u32; 2]],
+    leaves: &[(u32, Axial)],
+    occupied: &[(u32, Axial)],
+) -> Marks {
     let h = &r.hierarchy;
-    let mut pass = Pass::new(r);
+    let mut pass = Pass::new(r, segments);
     for &(k, x) in occupied {
         pass.visit_occupied(k, x);
     }
@@ -654,17 +931,18 @@ fn disc(v: Axial, r: i64) -> impl Iterator<Item = Axial> {
 pub fn extended_pass(
     r: &mut Refinement,
     state: &mut ExtendedState,
+    segments: &[[u32; 2]],
 ) -> Result<Vec<(u32, Axial)>, HexDelaunayError> {
     loop {
         let full = state.changes.is_none();
         let (split, present) = match state.changes.take() {
             Some(changes) => {
                 let (leaves, occupied) = affected(r, &mut state.index, &changes);
-                region_pass(r, &leaves, &occupied)
+                region_pass(r, segments, &leaves, &occupied)
             }
             None => {
                 state.index.rebuild(r);
-                full_pass(r).0
+                full_pass(r, segments).0
             }
         };
         let mut made = Vec::new();
@@ -687,7 +965,7 @@ pub fn extended_pass(
 /// Lower angle bound of the extended refinement, degrees (tan α = 5/(3√3), section 5.4).
 pub const ANGLE_MIN: f64 = 43.897_886_248_013_99;
 
-/// The relocated centres (section 5.4) of the finished extended refinement.
-pub fn relocated_centres(r: &Refinement) -> FxHashMap<Key, Vec2> {
-    full_pass(r).1
+/// The relocations (section 5.4) of the finished extended refinement.
+pub fn relocated_centres(r: &Refinement, segments: &[[u32; 2]]) -> Relocation {
+    full_pass(r, segments).1
 }

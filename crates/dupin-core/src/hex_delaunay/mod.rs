@@ -24,13 +24,15 @@
 //! ([`HexTriangulation::segment_edges`]); the mode's angle bounds and the Delaunay property
 //! hold for every triangle that does not meet a segment ([`HexTriangulation::meets_segments`]).
 //!
-//! Not implemented: in the extended refinement, MOVED_CENTER_3/4 relocations and blossom coarsening with split counters, merge and break
-//! (sections 3.2, 5.3; MOVED_CENTER_3 hexagons are subdivided instead, see
-//! `extended_refinement.rs`). Incremental insertion is [`HexDelaunayStepper::insert`].
+//! Not implemented: split counters, merge/break and the local coarsening into blossoms
+//! (sections 3.2, 5.3); MOVED_CENTER_3/4 are relocated (runs and blossoms that the refinement
+//! leaves, under a local check, see `extended_refinement.rs` and `fin_vertices.rs`).
+//! Incremental insertion is [`HexDelaunayStepper::insert`].
 
 mod dual;
 mod error;
 mod extended_refinement;
+mod fin_vertices;
 mod hierarchy;
 mod lattice;
 mod min_enclosing_circle;

@@ -3,7 +3,8 @@
 
 use super::dual::{DualBuilder, Key, pack};
 use super::error::HexDelaunayError;
-use super::extended_refinement::{ExtendedState, extended_pass, relocated_centres};
+use super::extended_refinement::{ExtendedState, Relocation, extended_pass, relocated_centres};
+use super::fin_vertices::apply_fin_patches;
 use super::hierarchy::{Cell, Hierarchy};
 use super::lattice::{Axial, DIRS, Frame, add, parents_of_midpoint};
 use super::min_enclosing_circle::min_enclosing_circle;
@@ -14,7 +15,7 @@ use super::simple_refinement::Refinement;
 use super::{HexDelaunayMode, HexTriangulation, MAX_COORDINATE, MAX_LEVEL, MIN_EXTENT};
 use crate::math::Vec2;
 use robust::{Coord, orient2d};
-use rustc_hash::FxHashMap;
+use rustc_hash::{FxHashMap, FxHashSet};
 
 /// A leaf cell of the current hexagon mesh, for drawing.
 #[derive(Debug, Clone, PartialEq)]
@@ -160,7 +161,8 @@ impl HexDelaunayStepper {
         if self.mode == HexDelaunayMode::Extended {
             if self.last.is_empty() {
                 // Simple rules exhausted: one extended pass (section 5.2) is one step.
-                self.last = extended_pass(&mut self.refinement, &mut self.extended)?;
+                self.last =
+                    extended_pass(&mut self.refinement, &mut self.extended, &self.segments)?;
                 self.extended_clean = self.last.is_empty();
             } else {
                 self.extended.record(&self.last);
@@ -356,15 +358,21 @@ impl HexDelaunayStepper {
     /// segments as vertex pairs and the unsnapped positions of the snapped vertices.
     fn dual(&self, snap: bool) -> (HexTriangulation, Vec<[u32; 2]>, FxHashMap<u32, Vec2>) {
         let h = &self.refinement.hierarchy;
-        let mut moved: FxHashMap<Key, Vec2> = match self.mode {
-            HexDelaunayMode::Extended if self.is_done() => relocated_centres(&self.refinement),
-            _ => FxHashMap::default(),
+        let Relocation { mut moved, patches } = match self.mode {
+            HexDelaunayMode::Extended if self.is_done() => {
+                relocated_centres(&self.refinement, &self.segments)
+            }
+            _ => Relocation::default(),
         };
+        let centres: FxHashSet<Key> = patches.iter().flat_map(|p| p.centres.clone()).collect();
         // Section 7.3: unoccupied hexagons met by one segment move onto it; their previous
         // positions are kept so that a snap inverting a triangle can be undone.
         let mut snapped: Vec<(Key, Vec2)> = Vec::new();
         if snap {
             for (key, p) in snapped_centres(&self.refinement, &self.segments) {
+                if centres.contains(&key) {
+                    continue; // replaced by fin vertices; the segment walk splits what it crosses
+                }
                 let before = moved
                     .insert(key, p)
                     .unwrap_or_else(|| lattice_position(h, key));
@@ -382,8 +390,14 @@ impl HexDelaunayStepper {
             }
             point_key.push(key);
         }
-        let dual = DualBuilder::build(h, &moved);
+        let mut dual = DualBuilder::build(h, &moved);
         debug_assert_eq!(dual.positions.len(), h.leaf_count());
+        apply_fin_patches(
+            &mut dual.positions,
+            &mut dual.triangles,
+            &dual.moved_vertex,
+            &patches,
+        );
         let unique_vertex: Vec<u32> = point_key
             .iter()
             .map(|k| {

@@ -545,9 +545,21 @@ fn paper_data_sets_take_fewer_triangles_than_table_1() {
         let extended = paper_count(name, &pts, HexDelaunayMode::Extended);
         println!("{name}: simple {simple}, extended {extended} triangles (paper: {paper})");
         assert!(simple < paper, "{name}: {simple} triangles, paper {paper}");
-        // The extended mode subdivides MOVED_CENTER_3 hexagons and builds no blossoms (see
-        // extended_refinement.rs), so it is not below the paper's counts everywhere; its counts
-        // are reported in BENCHMARKS.md, its guarantees checked above.
+        // The extended mode still splits MOVED_CENTER_3 runs that fail its local check and
+        // coarsens nothing into blossoms (see extended_refinement.rs), so it is not below the
+        // paper's counts everywhere; its counts are reported in BENCHMARKS.md, its guarantees
+        // checked above.
+    }
+}
+
+#[test]
+#[ignore = "the 1k / 2k sets in the extended mode (BENCHMARKS.md, Table 1); run with --release"]
+fn paper_data_sets_extended_large() {
+    for (name, pts, paper) in paper_data_sets() {
+        if pts.len() > 100 {
+            let extended = paper_count(name, &pts, HexDelaunayMode::Extended);
+            println!("{name}: extended {extended} triangles (paper: {paper})");
+        }
     }
 }
 
