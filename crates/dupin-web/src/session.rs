@@ -238,7 +238,7 @@ pub fn color_legend(mode: &str) -> Result<JsValue, JsError> {
         color: [f32; 3],
     }
     let stops: Vec<Stop> = match ColorMode::parse(mode)? {
-        ColorMode::Planarity => [-12.0, -9.5, -7.0, -4.5, -2.0]
+        ColorMode::Planarity => [-15.0, -12.0, -8.5, -5.0, -2.0]
             .iter()
             .map(|&e| Stop {
                 label: format!("1e{e}"),
@@ -825,9 +825,11 @@ fn regularity_color(d: f64) -> [f32; 3] {
     [0, 1, 2].map(|k| a[k] + (b[k] - a[k]) * t)
 }
 
-/// Blue (planar to 1e-12) -> white (1e-7) -> red (1e-2 and worse), log scale; linear RGB.
+/// Blue (planar to 1e-15, about the rounding of f64) -> white (1e-8.5) -> red (1e-2 and
+/// worse), log scale; linear RGB. The floor is that low so the last exact (SQP) steps, which
+/// take planarity from ~1e-12 to ~1e-15 by sub-pixel moves, still show as a change.
 fn planarity_color(p: f64) -> [f32; 3] {
-    let t = ((p.max(1e-12).log10() + 12.0) / 10.0).clamp(0.0, 1.0) as f32;
+    let t = ((p.max(1e-15).log10() + 15.0) / 13.0).clamp(0.0, 1.0) as f32;
     let (blue, white, red) = ([0.20, 0.45, 0.85], [0.92, 0.92, 0.92], [0.85, 0.20, 0.15]);
     let mix = |a: [f32; 3], b: [f32; 3], s: f32| [0, 1, 2].map(|k| a[k] + (b[k] - a[k]) * s);
     if t < 0.5 {
@@ -1035,9 +1037,10 @@ mod tests {
 
     #[test]
     fn colour_ramps_are_ordered_and_clamped() {
-        assert_eq!(planarity_color(0.0), planarity_color(1e-12));
+        assert_eq!(planarity_color(0.0), planarity_color(1e-15));
         assert_eq!(planarity_color(1.0), planarity_color(1e-2));
-        assert!(planarity_color(1e-12)[2] > planarity_color(1e-12)[0]);
+        assert!(planarity_color(1e-15)[2] > planarity_color(1e-15)[0]);
+        assert_ne!(planarity_color(1e-12), planarity_color(1e-15));
         assert!(planarity_color(1e-2)[0] > planarity_color(1e-2)[2]);
         assert_eq!(regularity_color(0.4), regularity_color(3.0));
         assert!(regularity_color(0.0)[2] > regularity_color(0.0)[0]);
