@@ -44,7 +44,11 @@ function showStatus(text, isError = false) {
   statusEl.classList.toggle('error', isError);
 }
 
-function syncHash() { history.replaceState(null, '', writeHash(config)); }
+// Only when the hash changed: replaceState per worker message was main-thread work for nothing.
+function syncHash() {
+  const h = writeHash(config);
+  if (h !== location.hash) history.replaceState(null, '', h);
+}
 
 function showMesh(next, reframe) {
   viewer.setMesh(next, reframe);
@@ -59,12 +63,16 @@ function showMesh(next, reframe) {
   dirty = true;
 }
 
+// Writes only changed properties (each write invalidates style, and layout under the cursor
+// makes Chromium hit-test a synthetic mouse move).
+function setProp(el, key, value) { if (el[key] !== value) el[key] = value; }
+
 function updateButtons() {
-  $('step').disabled = !running || done;
-  $('play').disabled = !running || done;
-  $('reset').disabled = !running;
-  $('play').textContent = playing ? 'Pause' : 'Play';
-  for (const id of ['export-json', 'export-svg']) $(id).disabled = !running;
+  setProp($('step'), 'disabled', !running || done);
+  setProp($('play'), 'disabled', !running || done);
+  setProp($('reset'), 'disabled', !running);
+  setProp($('play'), 'textContent', playing ? 'Pause' : 'Play');
+  for (const id of ['export-json', 'export-svg']) setProp($(id), 'disabled', !running);
 }
 
 // ---- loading a configuration -----------------------------------------------------------------
@@ -77,6 +85,7 @@ function load(next, { reframe = true, field = null } = {}) {
       solver.post('pause');
       solver.gen += 1; // drop anything the worker still sends for the previous run
       running = false; playing = false; done = true;
+      panelNext = null;
       config = next;
       showMesh(m, reframe);
       lastMetrics = { phase: 'done', iteration: 0, faces: m.triangleCount, vertices: m.vertexCount, maxPlanarity: 0 };
@@ -140,19 +149,30 @@ function applyState(s) {
   lastFaces = m.faces;
   lastPhase = m.phase;
   lastMetrics = m;
-  stepLog.push({ phase: m.phase, layer: m.layer, iteration: m.iteration, faces: m.faces, maxPlanarity: m.maxPlanarity, steps: s.steps, ms: m.ms, timing: m.timing, mainMs: performance.now() - t0main, at: performance.now() });
+  const entry = { phase: m.phase, layer: m.layer, iteration: m.iteration, faces: m.faces, maxPlanarity: m.maxPlanarity, steps: s.steps, ms: m.ms, timing: m.timing, mainMs: performance.now() - t0main, panelMs: null, at: performance.now() };
+  stepLog.push(entry);
   if (stepLog.length > 5000) stepLog.shift();
   // The panel, histogram and URL in a task of their own: with the mesh upload above they made
-  // 50-75 ms tasks on the loaded box (the page's long-task budget is 50 ms).
-  setTimeout(() => {
-    const t1 = performance.now();
-    showMetrics(metricsEl, m, config);
-    drawHistogram($('histogram'), m);
-    syncHash();
-    updateButtons();
-    noteTask('panel', t1);
-  }, 0);
+  // 50-75 ms tasks on the loaded box (the page's long-task budget is 50 ms). Coalesced: if
+  // several states arrive before it runs, only the latest is written (the last one always is).
+  const first = !panelNext;
+  panelNext = { m, entry };
+  if (first) setTimeout(showPanel, 0);
   if (playing) requestAnimationFrame(() => solver.post('ack'));
+}
+
+let panelNext = null; // { m, entry }: the state the panel task will show
+function showPanel() {
+  if (!panelNext) return; // a torus preview replaced the run meanwhile
+  const t1 = performance.now();
+  const { m, entry } = panelNext;
+  panelNext = null;
+  showMetrics(metricsEl, m, config);
+  drawHistogram($('histogram'), m);
+  syncHash();
+  updateButtons();
+  entry.panelMs = performance.now() - t1;
+  noteTask('panel', t1);
 }
 
 // ---- offset and support layers (conical scenes): computed in Rust, toggled here -----------------
