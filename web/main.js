@@ -152,19 +152,32 @@ function applyState(s) {
   const entry = { phase: m.phase, layer: m.layer, iteration: m.iteration, faces: m.faces, maxPlanarity: m.maxPlanarity, steps: s.steps, ms: m.ms, timing: m.timing, mainMs: performance.now() - t0main, panelMs: null, at: performance.now() };
   stepLog.push(entry);
   if (stepLog.length > 5000) stepLog.shift();
-  // The panel, histogram and URL in a task of their own: with the mesh upload above they made
-  // 50-75 ms tasks on the loaded box (the page's long-task budget is 50 ms). Coalesced: if
-  // several states arrive before it runs, only the latest is written (the last one always is).
-  const first = !panelNext;
-  panelNext = { m, entry };
-  if (first) setTimeout(showPanel, 0);
+  schedulePanel(m, entry);
   if (playing) requestAnimationFrame(() => solver.post('ack'));
 }
 
+// The panel (contract data attributes, text, histogram), URL and buttons are written together in
+// a task of their own: with the mesh upload they made 50-75 ms tasks on the loaded box (the
+// page's long-task budget is 50 ms). Coalesced, latest state wins; while playing at most every
+// PANEL_MS (a 10k run posts ~14 states/s, more than anyone reads, and each update costs style,
+// layout and paint); a step, a pause and the final state are written in the next task.
+const PANEL_MS = 200;
 let panelNext = null; // { m, entry }: the state the panel task will show
+let panelTimer = 0;
+let panelAt = -Infinity;
+function schedulePanel(m, entry) {
+  panelNext = { m, entry };
+  const wait = playing && !done ? Math.max(0, panelAt + PANEL_MS - performance.now()) : 0;
+  if (panelTimer && wait > 0) return; // the pending update will show the latest state
+  clearTimeout(panelTimer);
+  panelTimer = setTimeout(showPanel, wait);
+}
+
 function showPanel() {
+  panelTimer = 0;
   if (!panelNext) return; // a torus preview replaced the run meanwhile
   const t1 = performance.now();
+  panelAt = t1;
   const { m, entry } = panelNext;
   panelNext = null;
   showMetrics(metricsEl, m, config);
@@ -179,13 +192,14 @@ function showPanel() {
 /** Enables the layer toggles where the run has an offset, else shows why not; `info` is
  * Session.layerInfo (measures of the layers on show). */
 function showLayers({ unavailable, info }) {
-  for (const id of ['toggle-offset', 'toggle-support', 'offset-distance']) $(id).disabled = !!unavailable;
-  $('offset-reason').textContent = unavailable ?? '';
+  // Called per worker state: writes only what changed (see setProp).
+  for (const id of ['toggle-offset', 'toggle-support', 'offset-distance']) setProp($(id), 'disabled', !!unavailable);
+  setProp($('offset-reason'), 'textContent', unavailable ?? '');
   const li = $('layer-info');
-  li.textContent = info
+  setProp(li, 'textContent', info
     ? `offset: ${info.offsetFaces} faces, planarity ${info.offsetPlanarity.toExponential(1)} · ${info.beams} beams, planarity ${info.beamPlanarity.toExponential(1)}`
-    : '';
-  if (info) Object.assign(li.dataset, { beams: String(info.beams), beamPlanarity: String(info.beamPlanarity), offsetPlanarity: String(info.offsetPlanarity) });
+    : '');
+  if (info) for (const [k, v] of Object.entries({ beams: info.beams, beamPlanarity: info.beamPlanarity, offsetPlanarity: info.offsetPlanarity })) setProp(li.dataset, k, String(v));
   else for (const k of ['beams', 'beamPlanarity', 'offsetPlanarity']) delete li.dataset[k];
 }
 
