@@ -181,10 +181,17 @@ function showPanel() {
   const { m, entry } = panelNext;
   panelNext = null;
   showMetrics(metricsEl, m, config);
+  const t2 = performance.now();
   drawHistogram($('histogram'), m);
-  syncHash();
+  const t3 = performance.now();
+  // history.replaceState took 10-80 ms of wall time per call on the loaded box (it waits on the
+  // browser process; entry.panelParts.hash): the URL follows a playing run only when it stops
+  // (done, a step, a pause: see the play button).
+  if (!playing || done) syncHash();
+  const t4 = performance.now();
   updateButtons();
   entry.panelMs = performance.now() - t1;
+  entry.panelParts = { metrics: t2 - t1, histogram: t3 - t2, hash: t4 - t3, buttons: performance.now() - t4 };
   noteTask('panel', t1);
 }
 
@@ -454,7 +461,12 @@ async function main() {
   });
   window.addEventListener('hashchange', () => { if (location.hash !== writeHash(config)) restore(location.hash); });
   $('step').addEventListener('click', () => solver.post('step'));
-  $('play').addEventListener('click', () => { solver.post(playing ? 'pause' : 'play'); playing = !playing; updateButtons(); });
+  $('play').addEventListener('click', () => {
+    solver.post(playing ? 'pause' : 'play');
+    playing = !playing;
+    if (!playing) syncHash(); // the URL was left behind while playing (showPanel)
+    updateButtons();
+  });
   $('reset').addEventListener('click', () => { if (running) load({ ...config, steps: 1 }, { reframe: true }); });
   $('color-mode').addEventListener('change', (e) => setColorMode(e.target.value));
   $('panel-edge').addEventListener('change', (e) => {
