@@ -86,6 +86,7 @@ function load(next, { reframe = true, field = null } = {}) {
       solver.gen += 1; // drop anything the worker still sends for the previous run
       running = false; playing = false; done = true;
       panelNext = null;
+      meshNext = null;
       config = next;
       showMesh(m, reframe);
       lastMetrics = { phase: 'done', iteration: 0, faces: m.triangleCount, vertices: m.vertexCount, maxPlanarity: 0 };
@@ -136,15 +137,10 @@ function applyState(s) {
   config.steps = s.steps;
   done = s.done;
   playing = s.playing;
-  try {
-    const next = MeshData.fromArrays(s.mesh.positions, s.mesh.normals, s.mesh.indices, s.mesh.colors, s.mesh.edges);
-    // Frame the growing mesh at its first step and once more when its last layer is in, unless
-    // the user has taken the camera.
-    const grown = lastPhase === 'triangulation' && m.phase !== 'triangulation';
-    showMesh(next, lastFaces === 0 ? !userMoved : grown && !userMoved);
-  } catch (e) {
-    showStatus(`${viewer.backend} · ${e.message ?? e}`, true);
-  }
+  // Frame the growing mesh at its first step and once more when its last layer is in, unless
+  // the user has taken the camera.
+  const grown = lastPhase === 'triangulation' && m.phase !== 'triangulation';
+  scheduleMesh(s.mesh, lastFaces === 0 ? !userMoved : grown && !userMoved, m.faces);
   if (s.layers) showLayers(s.layers);
   lastFaces = m.faces;
   lastPhase = m.phase;
@@ -154,6 +150,38 @@ function applyState(s) {
   if (stepLog.length > 5000) stepLog.shift();
   schedulePanel(m, entry);
   if (playing) requestAnimationFrame(() => solver.post('ack'));
+}
+
+// Meshes to the GPU: at once when stepped, paused or done; while playing at most one per
+// min(200 ms, faces / 50 ms), latest wins (a reframe asked for by a skipped state is kept). A 10k
+// mesh upload and the frame after it waited 30-200 ms on the GPU process (SwiftShader) on the
+// loaded box, and skipped meshes also leave the GPU process's cores to the worker.
+let meshNext = null; // { arrays, reframe }: the mesh the next upload shows
+let meshTimer = 0;
+let meshAt = -Infinity;
+function scheduleMesh(arrays, reframe, faces) {
+  meshNext = { arrays, reframe: reframe || (meshNext?.reframe ?? false) };
+  const wait = playing && !done ? Math.max(0, meshAt + Math.min(200, faces / 50) - performance.now()) : 0;
+  if (wait > 0) {
+    if (!meshTimer) meshTimer = setTimeout(uploadMesh, wait);
+    return;
+  }
+  clearTimeout(meshTimer);
+  uploadMesh();
+}
+
+function uploadMesh() {
+  meshTimer = 0;
+  if (!meshNext) return; // a torus preview replaced the run meanwhile
+  const { arrays: a, reframe } = meshNext;
+  meshNext = null;
+  meshAt = performance.now();
+  try {
+    showMesh(MeshData.fromArrays(a.positions, a.normals, a.indices, a.colors, a.edges), reframe);
+  } catch (e) {
+    showStatus(`${viewer.backend} · ${e.message ?? e}`, true);
+  }
+  noteTask('mesh', meshAt);
 }
 
 // The panel (contract data attributes, text, histogram), URL and buttons are written together in
