@@ -44,7 +44,11 @@ function showStatus(text, isError = false) {
   statusEl.classList.toggle('error', isError);
 }
 
-function syncHash() { history.replaceState(null, '', writeHash(config)); }
+// Only when the hash changed: replaceState per worker message was main-thread work for nothing.
+function syncHash() {
+  const h = writeHash(config);
+  if (h !== location.hash) history.replaceState(null, '', h);
+}
 
 function showMesh(next, reframe) {
   viewer.setMesh(next, reframe);
@@ -59,12 +63,16 @@ function showMesh(next, reframe) {
   dirty = true;
 }
 
+// Writes only changed properties (each write invalidates style, and layout under the cursor
+// makes Chromium hit-test a synthetic mouse move).
+function setProp(el, key, value) { if (el[key] !== value) el[key] = value; }
+
 function updateButtons() {
-  $('step').disabled = !running || done;
-  $('play').disabled = !running || done;
-  $('reset').disabled = !running;
-  $('play').textContent = playing ? 'Pause' : 'Play';
-  for (const id of ['export-json', 'export-svg']) $(id).disabled = !running;
+  setProp($('step'), 'disabled', !running || done);
+  setProp($('play'), 'disabled', !running || done);
+  setProp($('reset'), 'disabled', !running);
+  setProp($('play'), 'textContent', playing ? 'Pause' : 'Play');
+  for (const id of ['export-json', 'export-svg']) setProp($(id), 'disabled', !running);
 }
 
 // ---- loading a configuration -----------------------------------------------------------------
@@ -77,6 +85,8 @@ function load(next, { reframe = true, field = null } = {}) {
       solver.post('pause');
       solver.gen += 1; // drop anything the worker still sends for the previous run
       running = false; playing = false; done = true;
+      panelNext = null;
+      meshNext = null;
       config = next;
       showMesh(m, reframe);
       lastMetrics = { phase: 'done', iteration: 0, faces: m.triangleCount, vertices: m.vertexCount, maxPlanarity: 0 };
@@ -127,45 +137,104 @@ function applyState(s) {
   config.steps = s.steps;
   done = s.done;
   playing = s.playing;
-  try {
-    const next = MeshData.fromArrays(s.mesh.positions, s.mesh.normals, s.mesh.indices, s.mesh.colors, s.mesh.edges);
-    // Frame the growing mesh at its first step and once more when its last layer is in, unless
-    // the user has taken the camera.
-    const grown = lastPhase === 'triangulation' && m.phase !== 'triangulation';
-    showMesh(next, lastFaces === 0 ? !userMoved : grown && !userMoved);
-  } catch (e) {
-    showStatus(`${viewer.backend} · ${e.message ?? e}`, true);
-  }
+  // Frame the growing mesh at its first step and once more when its last layer is in, unless
+  // the user has taken the camera.
+  const grown = lastPhase === 'triangulation' && m.phase !== 'triangulation';
+  scheduleMesh(s.mesh, lastFaces === 0 ? !userMoved : grown && !userMoved, m.faces);
   if (s.layers) showLayers(s.layers);
   lastFaces = m.faces;
   lastPhase = m.phase;
   lastMetrics = m;
-  stepLog.push({ phase: m.phase, layer: m.layer, iteration: m.iteration, faces: m.faces, maxPlanarity: m.maxPlanarity, steps: s.steps, ms: m.ms, timing: m.timing, mainMs: performance.now() - t0main, at: performance.now() });
+  const entry = { phase: m.phase, layer: m.layer, iteration: m.iteration, faces: m.faces, maxPlanarity: m.maxPlanarity, steps: s.steps, ms: m.ms, timing: m.timing, mainMs: performance.now() - t0main, panelMs: null, at: performance.now() };
+  stepLog.push(entry);
   if (stepLog.length > 5000) stepLog.shift();
-  // The panel, histogram and URL in a task of their own: with the mesh upload above they made
-  // 50-75 ms tasks on the loaded box (the page's long-task budget is 50 ms).
-  setTimeout(() => {
-    const t1 = performance.now();
-    showMetrics(metricsEl, m, config);
-    drawHistogram($('histogram'), m);
-    syncHash();
-    updateButtons();
-    noteTask('panel', t1);
-  }, 0);
+  schedulePanel(m, entry);
   if (playing) requestAnimationFrame(() => solver.post('ack'));
+}
+
+// Meshes to the GPU: at once when stepped, paused or done; while playing at most one per
+// min(200 ms, faces / 50 ms), latest wins (a reframe asked for by a skipped state is kept). A 10k
+// mesh upload and the frame after it waited 30-200 ms on the GPU process (SwiftShader) on the
+// loaded box, and skipped meshes also leave the GPU process's cores to the worker.
+let meshNext = null; // { arrays, reframe }: the mesh the next upload shows
+let meshTimer = 0;
+let meshAt = -Infinity;
+function scheduleMesh(arrays, reframe, faces) {
+  meshNext = { arrays, reframe: reframe || (meshNext?.reframe ?? false) };
+  const wait = playing && !done ? Math.max(0, meshAt + Math.min(200, faces / 50) - performance.now()) : 0;
+  if (wait > 0) {
+    if (!meshTimer) meshTimer = setTimeout(uploadMesh, wait);
+    return;
+  }
+  clearTimeout(meshTimer);
+  uploadMesh();
+}
+
+function uploadMesh() {
+  meshTimer = 0;
+  if (!meshNext) return; // a torus preview replaced the run meanwhile
+  const { arrays: a, reframe } = meshNext;
+  meshNext = null;
+  meshAt = performance.now();
+  try {
+    showMesh(MeshData.fromArrays(a.positions, a.normals, a.indices, a.colors, a.edges), reframe);
+  } catch (e) {
+    showStatus(`${viewer.backend} · ${e.message ?? e}`, true);
+  }
+  noteTask('mesh', meshAt);
+}
+
+// The panel (contract data attributes, text, histogram), URL and buttons are written together in
+// a task of their own: with the mesh upload they made 50-75 ms tasks on the loaded box (the
+// page's long-task budget is 50 ms). Coalesced, latest state wins; while playing at most every
+// PANEL_MS (a 10k run posts ~14 states/s, more than anyone reads, and each update costs style,
+// layout and paint); a step, a pause and the final state are written in the next task.
+const PANEL_MS = 200;
+let panelNext = null; // { m, entry }: the state the panel task will show
+let panelTimer = 0;
+let panelAt = -Infinity;
+function schedulePanel(m, entry) {
+  panelNext = { m, entry };
+  const wait = playing && !done ? Math.max(0, panelAt + PANEL_MS - performance.now()) : 0;
+  if (panelTimer && wait > 0) return; // the pending update will show the latest state
+  clearTimeout(panelTimer);
+  panelTimer = setTimeout(showPanel, wait);
+}
+
+function showPanel() {
+  panelTimer = 0;
+  if (!panelNext) return; // a torus preview replaced the run meanwhile
+  const t1 = performance.now();
+  panelAt = t1;
+  const { m, entry } = panelNext;
+  panelNext = null;
+  showMetrics(metricsEl, m, config);
+  const t2 = performance.now();
+  drawHistogram($('histogram'), m);
+  const t3 = performance.now();
+  // history.replaceState took 10-80 ms of wall time per call on the loaded box (it waits on the
+  // browser process; entry.panelParts.hash): the URL follows a playing run only when it stops
+  // (done, a step, a pause: see the play button).
+  if (!playing || done) syncHash();
+  const t4 = performance.now();
+  updateButtons();
+  entry.panelMs = performance.now() - t1;
+  entry.panelParts = { metrics: t2 - t1, histogram: t3 - t2, hash: t4 - t3, buttons: performance.now() - t4 };
+  noteTask('panel', t1);
 }
 
 // ---- offset and support layers (conical scenes): computed in Rust, toggled here -----------------
 /** Enables the layer toggles where the run has an offset, else shows why not; `info` is
  * Session.layerInfo (measures of the layers on show). */
 function showLayers({ unavailable, info }) {
-  for (const id of ['toggle-offset', 'toggle-support', 'offset-distance']) $(id).disabled = !!unavailable;
-  $('offset-reason').textContent = unavailable ?? '';
+  // Called per worker state: writes only what changed (see setProp).
+  for (const id of ['toggle-offset', 'toggle-support', 'offset-distance']) setProp($(id), 'disabled', !!unavailable);
+  setProp($('offset-reason'), 'textContent', unavailable ?? '');
   const li = $('layer-info');
-  li.textContent = info
+  setProp(li, 'textContent', info
     ? `offset: ${info.offsetFaces} faces, planarity ${info.offsetPlanarity.toExponential(1)} · ${info.beams} beams, planarity ${info.beamPlanarity.toExponential(1)}`
-    : '';
-  if (info) Object.assign(li.dataset, { beams: String(info.beams), beamPlanarity: String(info.beamPlanarity), offsetPlanarity: String(info.offsetPlanarity) });
+    : '');
+  if (info) for (const [k, v] of Object.entries({ beams: info.beams, beamPlanarity: info.beamPlanarity, offsetPlanarity: info.offsetPlanarity })) setProp(li.dataset, k, String(v));
   else for (const k of ['beams', 'beamPlanarity', 'offsetPlanarity']) delete li.dataset[k];
 }
 
@@ -420,7 +489,12 @@ async function main() {
   });
   window.addEventListener('hashchange', () => { if (location.hash !== writeHash(config)) restore(location.hash); });
   $('step').addEventListener('click', () => solver.post('step'));
-  $('play').addEventListener('click', () => { solver.post(playing ? 'pause' : 'play'); playing = !playing; updateButtons(); });
+  $('play').addEventListener('click', () => {
+    solver.post(playing ? 'pause' : 'play');
+    playing = !playing;
+    if (!playing) syncHash(); // the URL was left behind while playing (showPanel)
+    updateButtons();
+  });
   $('reset').addEventListener('click', () => { if (running) load({ ...config, steps: 1 }, { reframe: true }); });
   $('color-mode').addEventListener('change', (e) => setColorMode(e.target.value));
   $('panel-edge').addEventListener('change', (e) => {

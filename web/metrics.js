@@ -10,24 +10,39 @@ const svgEl = (tag, attrs) => {
 const exp = (x) => (x === 0 ? '0' : x.toExponential(2));
 const mm = (rel, edge) => `${(rel * edge * 1000).toPrecision(3)} mm`;
 
+// Both writers below touch only what changed since the last call (cached per element): a step
+// changes a few numbers, and rebuilding ~50 nodes per worker message cost style, layout and
+// paint on a page thread that shares two cores with the worker and SwiftShader (issue 7).
+const panels = new WeakMap(); // dl -> { keys, dds }
+const charts = new WeakMap(); // svg -> { shape, bars: [{ rect, title, c, h }] }
+
+function setData(el, key, value) {
+  if (value === undefined || value === null) {
+    if (key in el.dataset) delete el.dataset[key];
+  } else if (el.dataset[key] !== String(value)) {
+    el.dataset[key] = String(value);
+  }
+}
+
+function setText(node, text) {
+  if (node.textContent !== text) node.textContent = text;
+}
+
 /** Writes metrics `m` (from Session.step/metrics, plus `ms` and `steps`) into `dl`. */
 export function showMetrics(dl, m, { panelEdge }) {
-  Object.assign(dl.dataset, {
+  const data = {
     phase: m.phase,
-    layer: String(m.layer ?? 0),
-    iteration: String(m.iteration),
-    faces: String(m.faces),
-    maxPlanarity: String(m.maxPlanarity),
-    meanPlanarity: String(m.meanPlanarity ?? 0),
-    invalidFaces: String(m.invalidFaces ?? 0),
-    steps: String(m.steps ?? 0),
-  });
-  // PQ scenes: level and the scene's residuals (absent attributes for other runs).
-  const extra = { level: m.level, levels: m.levels, conicalResidual: m.conicalResidual, circularResidual: m.circularResidual, maxDeterminant: m.maxDeterminant, singularPointsInside: m.singularPointsInside };
-  for (const [k, v] of Object.entries(extra)) {
-    if (v === undefined || v === null) delete dl.dataset[k];
-    else dl.dataset[k] = String(v);
-  }
+    layer: m.layer ?? 0,
+    iteration: m.iteration,
+    faces: m.faces,
+    maxPlanarity: m.maxPlanarity,
+    meanPlanarity: m.meanPlanarity ?? 0,
+    invalidFaces: m.invalidFaces ?? 0,
+    steps: m.steps ?? 0,
+    // PQ scenes: level and the scene's residuals (absent attributes for other runs).
+    level: m.level, levels: m.levels, conicalResidual: m.conicalResidual, circularResidual: m.circularResidual, maxDeterminant: m.maxDeterminant, singularPointsInside: m.singularPointsInside,
+  };
+  for (const [k, v] of Object.entries(data)) setData(dl, k, v);
   const rows = [
     ['phase', m.phase], ['layer', m.layer ?? 0], ['iteration', m.iteration], ['faces', m.faces],
     ['vertices', m.vertices],
@@ -41,12 +56,21 @@ export function showMetrics(dl, m, { panelEdge }) {
   if (m.circularResidual !== undefined) rows.push(['circular residual', exp(m.circularResidual)]);
   if (m.maxDeterminant !== undefined) rows.push(['max determinant', exp(m.maxDeterminant)]);
   if (m.singularPointsInside !== undefined) rows.push(['singular points on strip', m.singularPointsInside]);
-  dl.replaceChildren(...rows.flatMap(([k, v]) => {
-    const dt = document.createElement('dt'); dt.textContent = k;
-    const dd = document.createElement('dd'); dd.textContent = String(v);
-    dd.dataset.metric = k.replaceAll(' ', '-');
-    return [dt, dd];
-  }));
+  const keys = rows.map(([k]) => k).join('|');
+  let panel = panels.get(dl);
+  if (panel?.keys !== keys || dl.children.length !== 2 * rows.length) {
+    const dds = [];
+    dl.replaceChildren(...rows.flatMap(([k]) => {
+      const dt = document.createElement('dt'); dt.textContent = k;
+      const dd = document.createElement('dd');
+      dd.dataset.metric = k.replaceAll(' ', '-');
+      dds.push(dd);
+      return [dt, dd];
+    }));
+    panel = { keys, dds };
+    panels.set(dl, panel);
+  }
+  rows.forEach(([, v], i) => setText(panel.dds[i], String(v)));
 }
 
 /** Bar chart of `m.histogram` over log10 planarity `m.histLog10`. */
@@ -54,23 +78,42 @@ export function drawHistogram(svg, m) {
   const counts = m.histogram ?? [];
   const [lo, hi] = m.histLog10 ?? [-16, -2];
   const W = 200, H = 60, max = Math.max(1, ...counts);
-  svg.setAttribute('viewBox', `0 0 ${W} ${H + 12}`);
-  svg.dataset.total = String(counts.reduce((a, b) => a + b, 0));
+  setData(svg, 'total', counts.reduce((a, b) => a + b, 0));
   const bw = W / Math.max(1, counts.length);
-  svg.replaceChildren(
-    ...counts.map((c, i) => {
-      const h = c === 0 ? 0 : Math.max(1, (H * Math.log1p(c)) / Math.log1p(max));
-      const r = svgEl('rect', { x: i * bw + 0.5, y: H - h, width: bw - 1, height: h, class: 'bar' });
-      r.append(svgEl('title', {}));
-      r.firstChild.textContent = `${c} faces with planarity in [1e${lo + i}, 1e${lo + i + 1})`;
-      return r;
-    }),
-    ...[lo, (lo + hi) / 2, hi].map((e, k) => {
-      const t = svgEl('text', { x: (k * W) / 2, y: H + 10, 'text-anchor': ['start', 'middle', 'end'][k] });
-      t.textContent = `1e${e}`;
-      return t;
-    }),
-  );
+  const shape = `${counts.length} ${lo} ${hi}`;
+  let chart = charts.get(svg);
+  if (chart?.shape !== shape || svg.children.length !== counts.length + 3) {
+    svg.setAttribute('viewBox', `0 0 ${W} ${H + 12}`);
+    const bars = counts.map((_, i) => {
+      const rect = svgEl('rect', { x: i * bw + 0.5, y: H, width: bw - 1, height: 0, class: 'bar' });
+      const title = svgEl('title', {});
+      rect.append(title);
+      return { rect, title, c: null, h: 0 };
+    });
+    svg.replaceChildren(
+      ...bars.map((b) => b.rect),
+      ...[lo, (lo + hi) / 2, hi].map((e, k) => {
+        const t = svgEl('text', { x: (k * W) / 2, y: H + 10, 'text-anchor': ['start', 'middle', 'end'][k] });
+        t.textContent = `1e${e}`;
+        return t;
+      }),
+    );
+    chart = { shape, bars };
+    charts.set(svg, chart);
+  }
+  counts.forEach((c, i) => {
+    const b = chart.bars[i];
+    const h = c === 0 ? 0 : Math.max(1, (H * Math.log1p(c)) / Math.log1p(max));
+    if (b.h !== h) {
+      b.rect.setAttribute('y', String(H - h));
+      b.rect.setAttribute('height', String(h));
+      b.h = h;
+    }
+    if (b.c !== c) {
+      b.title.textContent = `${c} faces with planarity in [1e${lo + i}, 1e${lo + i + 1})`;
+      b.c = c;
+    }
+  });
 }
 
 /** Legend of a colour mode from its stops `[{label, color: [r, g, b] linear}]`. */
