@@ -56,9 +56,13 @@ fn for_each_leaf(h: &Hierarchy, mut f: impl FnMut(u32, Axial)) {
             if !h.is_split(k + 1, c) {
                 f(k + 1, c);
             }
-            for d in DIRS {
-                let m = add(c, d);
-                if !in_domain(k + 1, m) || !h.is_present(k + 1, m) || h.is_split(k + 1, m) {
+            // `c + d` is the midpoint of `x` (split) and `x + d`: present when `x + d` is split
+            // or outside Ω, read for all six from one tile (what `is_present` would ask).
+            let split = h.split_neighbours(k, x);
+            for (j, d) in DIRS.iter().enumerate() {
+                let m = add(c, *d);
+                let present = split & (1 << j) != 0 || !in_domain(k, add(x, *d));
+                if !in_domain(k + 1, m) || !present || h.is_split(k + 1, m) {
                     continue;
                 }
                 let (a, _) = parents_of_midpoint(m);
