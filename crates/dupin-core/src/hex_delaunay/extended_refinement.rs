@@ -40,6 +40,7 @@ use super::lattice::{Axial, DIRS, add, hex_norm, in_domain, on_boundary, parents
 use super::simple_refinement::Refinement;
 use crate::math::Vec2;
 use rustc_hash::{FxHashMap, FxHashSet};
+use std::sync::Mutex;
 
 const SQRT3: f64 = 1.732_050_807_568_877_2;
 
@@ -55,9 +56,13 @@ fn for_each_leaf(h: &Hierarchy, mut f: impl FnMut(u32, Axial)) {
             if !h.is_split(k + 1, c) {
                 f(k + 1, c);
             }
-            for d in DIRS {
-                let m = add(c, d);
-                if !in_domain(k + 1, m) || !h.is_present(k + 1, m) || h.is_split(k + 1, m) {
+            // `c + d` is the midpoint of `x` (split) and `x + d`: present when `x + d` is split
+            // or outside Ω, read for all six from one tile (what `is_present` would ask).
+            let split = h.split_neighbours(k, x);
+            for (j, d) in DIRS.iter().enumerate() {
+                let m = add(c, *d);
+                let present = split & (1 << j) != 0 || !in_domain(k, add(x, *d));
+                if !in_domain(k + 1, m) || !present || h.is_split(k + 1, m) {
                     continue;
                 }
                 let (a, _) = parents_of_midpoint(m);
@@ -900,20 +905,44 @@ fn region_pass(
 /// hexagons near them (a work queue of affected hexagons, one pass per wave of splits). A run
 /// ends only after a full pass finds nothing, so the result is a fixed point of the full
 /// rules, at O(changes) cost per incremental pass.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Default)]
 pub struct ExtendedState {
     changes: Option<Vec<(u32, Axial)>>,
     index: OccupiedIndex,
+    /// The relocations of the last full pass that found nothing, with the split count and
+    /// number of points it saw: the dual takes them instead of a further full pass. Taken
+    /// from behind `&self` (a Mutex, not a RefCell, keeps the stepper `Sync`) so that they
+    /// are not held twice while the dual is built (peak memory).
+    relocation: Mutex<Option<(usize, usize, Relocation)>>,
+}
+
+impl Clone for ExtendedState {
+    fn clone(&self) -> Self {
+        ExtendedState {
+            changes: self.changes.clone(),
+            index: self.index.clone(),
+            relocation: Mutex::new(lock(&self.relocation).clone()),
+        }
+    }
+}
+
+/// The cached relocations (a panic while holding the lock cannot leave them half-written).
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
 impl ExtendedState {
     /// Forces a full pass next (after insertions).
     pub fn reset(&mut self) {
         self.changes = None;
+        *lock(&self.relocation) = None;
     }
 
     /// Records splits made outside the extended passes (simple rules, balancing).
     pub fn record(&mut self, made: &[(u32, Axial)]) {
+        if !made.is_empty() {
+            *lock(&self.relocation) = None;
+        }
         if let Some(c) = &mut self.changes {
             c.extend_from_slice(made);
         }
@@ -933,6 +962,7 @@ pub fn extended_pass(
     state: &mut ExtendedState,
     segments: &[[u32; 2]],
 ) -> Result<Vec<(u32, Axial)>, HexDelaunayError> {
+    *lock(&state.relocation) = None;
     loop {
         let full = state.changes.is_none();
         let (split, present) = match state.changes.take() {
@@ -942,7 +972,13 @@ pub fn extended_pass(
             }
             None => {
                 state.index.rebuild(r);
-                full_pass(r, segments).0
+                let (marks, relocation) = full_pass(r, segments);
+                if marks.0.is_empty() && marks.1.is_empty() {
+                    // The fixed point: these are the dual's relocations.
+                    let seen = (r.hierarchy.split_count, r.points.len());
+                    *lock(&state.relocation) = Some((seen.0, seen.1, relocation));
+                }
+                marks
             }
         };
         let mut made = Vec::new();
@@ -965,7 +1001,20 @@ pub fn extended_pass(
 /// Lower angle bound of the extended refinement, degrees (tan α = 5/(3√3), section 5.4).
 pub const ANGLE_MIN: f64 = 43.897_886_248_013_99;
 
-/// The relocations (section 5.4) of the finished extended refinement.
-pub fn relocated_centres(r: &Refinement, segments: &[[u32; 2]]) -> Relocation {
-    full_pass(r, segments).1
+/// The relocations (section 5.4) of the finished extended refinement: those of the last full
+/// pass if nothing changed since (same splits and points; taken, so a second call makes a
+/// new one), else a new full pass.
+pub fn relocated_centres(
+    r: &Refinement,
+    state: &ExtendedState,
+    segments: &[[u32; 2]],
+) -> Relocation {
+    match lock(&state.relocation).take() {
+        Some((splits, points, relocation))
+            if splits == r.hierarchy.split_count && points == r.points.len() =>
+        {
+            relocation
+        }
+        _ => full_pass(r, segments).1,
+    }
 }

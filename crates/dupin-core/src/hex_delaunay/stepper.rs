@@ -360,7 +360,7 @@ impl HexDelaunayStepper {
         let h = &self.refinement.hierarchy;
         let Relocation { mut moved, patches } = match self.mode {
             HexDelaunayMode::Extended if self.is_done() => {
-                relocated_centres(&self.refinement, &self.segments)
+                relocated_centres(&self.refinement, &self.extended, &self.segments)
             }
             _ => Relocation::default(),
         };

@@ -309,6 +309,20 @@ fn larger_uniform_sets() {
     }
 }
 
+/// The dual of a finished extended run takes the relocations of the last full pass; a second
+/// call computes them anew and must agree (a stale cache would differ).
+#[test]
+fn extended_cached_relocation_matches_a_new_full_pass() {
+    let mut rng = ChaCha8Rng::seed_from_u64(17);
+    for family in FAMILIES {
+        let pts = sample(family, &mut rng);
+        let mut s = HexDelaunayStepper::new(&pts, &[], HexDelaunayMode::Extended).unwrap();
+        s.run().unwrap();
+        let cached = s.triangulation();
+        assert_eq!(cached, s.triangulation(), "{family:?}");
+    }
+}
+
 #[test]
 fn stepper_matches_one_shot_and_cells_tile() {
     let mut rng = ChaCha8Rng::seed_from_u64(5);
