@@ -20,6 +20,21 @@ fn thread_cpu_seconds() -> Option<f64> {
     Some(ns * 1e-9)
 }
 
+/// Thread CPU since `c0` and the optimiser's counters, for the printed report lines.
+fn optimiser_summary(o: &PlanarityOptimiser, c0: Option<f64>) -> String {
+    format!(
+        "thread CPU {:.3} s, {} iterations, {} CG iterations, {} planarity rejections, {} factorisations (nnz(L) {}), max_planarity {:.2e}",
+        c0.and_then(|c| Some(thread_cpu_seconds()? - c))
+            .unwrap_or(f64::NAN),
+        o.iteration(),
+        o.cg_iterations(),
+        o.planarity_rejections(),
+        o.factorizations(),
+        o.factor_len(),
+        o.max_planarity()
+    )
+}
+
 /// Base-curve edge lengths that give about 1k, 10k and 50k hexagons on the default torus.
 const SIZES: [(&str, f64); 3] = [("1k", 0.49), ("10k", 0.155), ("50k", 0.069)];
 
@@ -84,16 +99,9 @@ fn bench(c: &mut Criterion) {
                 o.step(&mut m, torus.as_ref()).unwrap();
             }
             eprintln!(
-                "phex torus-bound {label} optimisation from 1e-3 noise: {} faces, thread CPU {:.3} s, {} iterations, {} CG iterations, {} planarity rejections, {} factorisations (nnz(L) {}), max_planarity {:.2e}",
+                "phex torus-bound {label} optimisation from 1e-3 noise: {} faces, {}",
                 m.num_faces(),
-                c0.and_then(|c| Some(thread_cpu_seconds()? - c))
-                    .unwrap_or(f64::NAN),
-                o.iteration(),
-                o.cg_iterations(),
-                o.planarity_rejections(),
-                o.factorizations(),
-                o.factor_len(),
-                o.max_planarity()
+                optimiser_summary(&o, c0)
             );
         }
         g.bench_function("optimisation", |b| {
@@ -143,15 +151,9 @@ fn bench_dupin_start(
     let c0 = thread_cpu_seconds();
     let o = run(&d);
     eprintln!(
-        "phex torus {label} optimisation from the Dupin-duality start: {} faces, thread CPU {:.3} s, {} iterations, {} CG iterations, {} planarity rejections, {} factorisations, max_planarity {:.2e}",
+        "phex torus {label} optimisation from the Dupin-duality start: {} faces, {}",
         d.mesh.num_faces(),
-        c0.and_then(|c| Some(thread_cpu_seconds()? - c))
-            .unwrap_or(f64::NAN),
-        o.iteration(),
-        o.cg_iterations(),
-        o.planarity_rejections(),
-        o.factorizations(),
-        o.max_planarity()
+        optimiser_summary(&o, c0)
     );
     g.bench_function("optimisation_dupin_start", |b| {
         b.iter(|| black_box(run(&d).max_planarity()))
