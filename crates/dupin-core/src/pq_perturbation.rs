@@ -47,8 +47,8 @@ use crate::mesh::PolyMesh;
 use crate::mesh_topology::{MeshTopology, TopologyError};
 use crate::planarity::max_planarity;
 use crate::solver::{
-    ConstrainedLeastSquares, LevenbergMarquardt, LmOptions, LmStep, NonlinearLeastSquares,
-    SparseSystem, Sqp, SqpOptions,
+    BlockLayout, BlockLeastSquares, BlockSystem, ConstrainedLeastSquares, LevenbergMarquardt,
+    LmOptions, LmStep, SolverError, SparseSystem, Sqp, SqpOptions,
 };
 use std::f64::consts::PI;
 use thiserror::Error;
@@ -234,6 +234,8 @@ struct Terms {
     /// Whether the solver should eliminate the plane unknowns (all planar faces are quads).
     eliminate_planes: bool,
     num_vars: usize,
+    /// The unknowns as blocks: one of 3 per vertex variable, then one of 4 per plane.
+    layout: BlockLayout,
     convex: Vec<bool>,
     conical_vertices: Vec<usize>,
     /// Fairness stencils: (start offsets, (vertex, coefficient)).
@@ -254,14 +256,76 @@ struct Problem<'a> {
     w_close: f64,
 }
 
-/// Accumulates per-vertex gradients of one residual and emits them merged.
-struct RowGrad(Vec<(u32, Vec3)>);
-impl RowGrad {
-    fn add(&mut self, v: u32, g: Vec3) {
-        if let Some(e) = self.0.iter_mut().find(|e| e.0 == v) {
-            e.1 += g;
+/// Where a [`Problem`] writes its rows: per-block gradients for the Gauss-Newton solver, or
+/// scalar triplets for the SQP refinement (one emission code for both).
+trait Rows {
+    /// Starts a row with the given value.
+    fn row(&mut self, value: f64);
+    /// Sets the value of the current row.
+    fn set_value(&mut self, value: f64);
+    /// Adds `g` (3 components for a vertex, 4 for a plane) to the current row's gradient
+    /// with respect to the block whose first variable is `var`.
+    fn add(&mut self, var: u32, g: [f64; 4]);
+}
+
+struct BlockRows<'a> {
+    sys: &'a mut BlockSystem,
+    terms: &'a Terms,
+}
+
+impl Rows for BlockRows<'_> {
+    #[inline]
+    fn row(&mut self, value: f64) {
+        self.sys.push_row(value);
+    }
+    #[inline]
+    fn set_value(&mut self, value: f64) {
+        if let Some(r) = self.sys.residuals.last_mut() {
+            *r = value;
+        }
+    }
+    #[inline]
+    fn add(&mut self, var: u32, g: [f64; 4]) {
+        self.sys.add(self.terms.block_of_var(var), g);
+    }
+}
+
+struct TripletRows<'a> {
+    sys: &'a mut SparseSystem,
+    first_plane: usize,
+}
+
+impl Rows for TripletRows<'_> {
+    fn row(&mut self, value: f64) {
+        self.sys.push_residual(value);
+    }
+    fn set_value(&mut self, value: f64) {
+        if let Some(r) = self.sys.residuals.last_mut() {
+            *r = value;
+        }
+    }
+    fn add(&mut self, var: u32, g: [f64; 4]) {
+        let row = self.sys.residuals.len() as u32 - 1;
+        let size = if (var as usize) < self.first_plane {
+            3
         } else {
-            self.0.push((v, g));
+            4
+        };
+        for (k, &gk) in g.iter().enumerate().take(size) {
+            self.sys.push_entry(row, var + k as u32, gk);
+        }
+    }
+}
+
+impl Terms {
+    /// The block of the variables starting at `var` (vertex blocks of 3, then planes of 4).
+    #[inline]
+    fn block_of_var(&self, var: u32) -> u32 {
+        let fp = self.first_plane as u32;
+        if var < fp {
+            var / 3
+        } else {
+            fp / 3 + (var - fp) / 4
         }
     }
 }
@@ -278,44 +342,29 @@ impl Problem<'_> {
         }
     }
 
+    /// Adds the gradient `g` with respect to vertex `v` (nothing for a fixed vertex).
     #[inline]
-    fn emit(&self, out: &mut SparseSystem, row: u32, v: u32, g: Vec3) {
+    fn emit<O: Rows>(&self, out: &mut O, v: u32, g: Vec3) {
         let b = self.terms.var_of[v as usize];
         if b != NONE {
-            out.push_entry(row, b, g.x);
-            out.push_entry(row, b + 1, g.y);
-            out.push_entry(row, b + 2, g.z);
+            out.add(b, [g.x, g.y, g.z, 0.0]);
         }
     }
 
-    fn emit_row(&self, out: &mut SparseSystem, value: f64, grad: &RowGrad) {
-        let r = out.push_residual(value);
-        for &(v, g) in &grad.0 {
-            self.emit(out, r, v, g);
-        }
-    }
-
-    fn face_points(&self, x: &[f64], f: usize) -> Vec<Vec3> {
-        self.mesh.face(f).iter().map(|&v| self.pos(x, v)).collect()
-    }
-
-    /// Determinant terms of face `f` for quadruples starting at `ks`.
-    fn dets(&self, x: &[f64], f: usize, all: bool, out: &mut SparseSystem) {
+    /// Determinant terms of face `f`: every three consecutive unit edge vectors.
+    fn dets<O: Rows>(&self, x: &[f64], f: usize, out: &mut O) {
         let face = self.mesh.face(f);
         let n = face.len();
         if n < 4 {
             return;
         }
-        let pts = self.face_points(x, f);
-        let count = if all { n } else { n - 3 };
-        for k in 0..count {
+        for k in 0..n {
             let idx = [k, (k + 1) % n, (k + 2) % n, (k + 3) % n];
-            let (d, g) = quad_det_grad(idx.map(|i| pts[i]));
-            let mut rg = RowGrad(Vec::with_capacity(4));
+            let (d, g) = quad_det_grad(idx.map(|i| self.pos(x, face[i])));
+            out.row(d);
             for (j, &i) in idx.iter().enumerate() {
-                rg.add(face[i], g[j]);
+                self.emit(out, face[i], g[j]);
             }
-            self.emit_row(out, d, &rg);
         }
     }
 
@@ -323,7 +372,7 @@ impl Problem<'_> {
     /// the face's initial centroid (so the offset `d` stays near 0 and the derivatives in `n`
     /// are of the face's size rather than of its distance to the origin: far better
     /// conditioned normal equations).
-    fn planes(&self, x: &[f64], f: usize, out: &mut SparseSystem) {
+    fn planes<O: Rows>(&self, x: &[f64], f: usize, out: &mut O) {
         let pb = self.terms.plane_of[f];
         if pb == NONE {
             return;
@@ -335,57 +384,56 @@ impl Problem<'_> {
         let c = self.terms.centers[f];
         for &v in self.mesh.face(f) {
             let p = self.pos(x, v) - c;
-            let r = out.push_residual((n.dot(&p) - d) * inv);
-            self.emit(out, r, v, n * inv);
-            for k in 0..3u32 {
-                out.push_entry(r, pb + k, p[k as usize] * inv);
-            }
-            out.push_entry(r, pb + 3, -inv);
+            out.row((n.dot(&p) - d) * inv);
+            self.emit(out, v, n * inv);
+            out.add(pb, [p.x * inv, p.y * inv, p.z * inv, -inv]);
         }
-        let r = out.push_residual(n.norm_squared() - 1.0);
-        for k in 0..3u32 {
-            out.push_entry(r, pb + k, 2.0 * n[k as usize]);
-        }
+        out.row(n.norm_squared() - 1.0);
+        out.add(pb, [2.0 * n.x, 2.0 * n.y, 2.0 * n.z, 0.0]);
     }
 
     /// Sum over corners `ks` of face `f` of the corner angles, minus `target`.
-    fn angle_sum(&self, x: &[f64], f: usize, ks: &[usize], target: f64, out: &mut SparseSystem) {
+    fn angle_sum<O: Rows>(&self, x: &[f64], f: usize, ks: &[usize], target: f64, out: &mut O) {
         let face = self.mesh.face(f);
         let n = face.len();
-        let pts = self.face_points(x, f);
+        // The row's value is known after its gradients: start it at 0 and set it at the end.
+        out.row(0.0);
         let mut sum = -target;
-        let mut rg = RowGrad(Vec::with_capacity(n));
         for &k in ks {
             let (a, b) = ((k + n - 1) % n, (k + 1) % n);
-            let (w, g) = angle_grad(pts[k], pts[a], pts[b]);
+            let (w, g) = angle_grad(
+                self.pos(x, face[k]),
+                self.pos(x, face[a]),
+                self.pos(x, face[b]),
+            );
             sum += w;
-            rg.add(face[k], g[0]);
-            rg.add(face[a], g[1]);
-            rg.add(face[b], g[2]);
+            self.emit(out, face[k], g[0]);
+            self.emit(out, face[a], g[1]);
+            self.emit(out, face[b], g[2]);
         }
-        self.emit_row(out, sum, &rg);
+        out.set_value(sum);
     }
 
-    fn conical(&self, x: &[f64], out: &mut SparseSystem) {
+    /// The angle balance `w1 - w2 + w3 - w4` of eq. (6) at every interior valence-4 vertex.
+    fn conical<O: Rows>(&self, x: &[f64], out: &mut O) {
         for &v in &self.terms.conical_vertices {
-            let star = self.topo.star(v);
+            out.row(0.0);
             let mut sum = 0.0;
-            let mut rg = RowGrad(Vec::with_capacity(5));
-            for (k, &c) in star.iter().enumerate() {
+            for (k, &c) in self.topo.star(v).iter().enumerate() {
                 let a = self.topo.source(self.topo.prev(c));
                 let b = self.topo.target(c);
                 let (w, g) = angle_grad(self.pos(x, v as u32), self.pos(x, a), self.pos(x, b));
                 let s = if k % 2 == 0 { 1.0 } else { -1.0 };
                 sum += s * w;
-                rg.add(v as u32, g[0] * s);
-                rg.add(a, g[1] * s);
-                rg.add(b, g[2] * s);
+                self.emit(out, v as u32, g[0] * s);
+                self.emit(out, a, g[1] * s);
+                self.emit(out, b, g[2] * s);
             }
-            self.emit_row(out, sum, &rg);
+            out.set_value(sum);
         }
     }
 
-    fn fairness_closeness(&self, x: &[f64], out: &mut SparseSystem) {
+    fn fairness_closeness<O: Rows>(&self, x: &[f64], out: &mut O) {
         let t = self.terms;
         if self.w_fair > 0.0 {
             let s = self.w_fair.sqrt() / t.scale;
@@ -396,12 +444,11 @@ impl Problem<'_> {
                     val += c * self.pos(x, v);
                 }
                 for k in 0..3 {
-                    let r = out.push_residual(s * val[k]);
+                    out.row(s * val[k]);
                     for &(v, c) in st {
-                        let b = t.var_of[v as usize];
-                        if b != NONE {
-                            out.push_entry(r, b + k as u32, s * c);
-                        }
+                        let mut g = Vec3::zeros();
+                        g[k] = s * c;
+                        self.emit(out, v, g);
                     }
                 }
             }
@@ -414,18 +461,14 @@ impl Problem<'_> {
                 }
                 let n = t.normals0[v];
                 let d = (self.pos(x, v as u32) - t.positions0[v]).dot(&n);
-                let r = out.push_residual(s * d);
-                self.emit(out, r, v as u32, s * n);
+                out.row(s * d);
+                self.emit(out, v as u32, s * n);
             }
         }
     }
-}
 
-impl NonlinearLeastSquares for Problem<'_> {
-    fn num_variables(&self) -> usize {
-        self.terms.num_vars
-    }
-    fn evaluate(&self, x: &[f64], out: &mut SparseSystem) {
+    /// The penalty objective of eq. (5) (with the plane terms).
+    fn penalty<O: Rows>(&self, x: &[f64], out: &mut O) {
         for f in 0..self.mesh.num_faces() {
             let n = self.mesh.face(f).len();
             if self.mode == PqMode::Circular && n == 4 {
@@ -436,7 +479,7 @@ impl NonlinearLeastSquares for Problem<'_> {
                 self.angle_sum(x, f, &ks, (n as f64 - 2.0) * PI, out);
             }
             if self.determinant_terms {
-                self.dets(x, f, true, out);
+                self.dets(x, f, out);
             }
             self.planes(x, f, out);
         }
@@ -445,26 +488,9 @@ impl NonlinearLeastSquares for Problem<'_> {
         }
         self.fairness_closeness(x, out);
     }
-    /// The 4 plane unknowns of a face are seen by that face's plane residuals only: the
-    /// solver eliminates them and factors a matrix on the vertex unknowns. Done for quad
-    /// meshes only: eliminating the plane of an n-gon couples all its 3n vertex unknowns,
-    /// which for hexagons costs more fill than the 4 unknowns save (torus dual: 0.22 s
-    /// instead of 0.14 s).
-    fn local_blocks(&self) -> Option<(usize, usize)> {
-        self.terms
-            .eliminate_planes
-            .then_some((self.terms.first_plane, 4))
-    }
-}
 
-impl ConstrainedLeastSquares for Problem<'_> {
-    fn num_variables(&self) -> usize {
-        self.terms.num_vars
-    }
-    fn objective(&self, x: &[f64], out: &mut SparseSystem) {
-        self.fairness_closeness(x, out);
-    }
-    fn constraints(&self, x: &[f64], out: &mut SparseSystem) {
+    /// The exact constraints: planes, and the circular or conical angle conditions.
+    fn constraint_rows<O: Rows>(&self, x: &[f64], out: &mut O) {
         for f in 0..self.mesh.num_faces() {
             self.planes(x, f, out);
             if self.mode == PqMode::Circular && self.mesh.face(f).len() == 4 {
@@ -474,6 +500,61 @@ impl ConstrainedLeastSquares for Problem<'_> {
         if self.mode == PqMode::Conical {
             self.conical(x, out);
         }
+    }
+
+    /// The 4 plane unknowns of a face are seen by that face's plane residuals only: the
+    /// solver eliminates them and factors a matrix on the vertex unknowns. Done for quad
+    /// meshes only: eliminating the plane of an n-gon couples all its 3n vertex unknowns,
+    /// which for hexagons costs more fill than the 4 unknowns save.
+    fn local_from(&self) -> usize {
+        if self.terms.eliminate_planes {
+            self.terms.first_plane / 3
+        } else {
+            self.terms.layout.num_blocks()
+        }
+    }
+}
+
+impl BlockLeastSquares for Problem<'_> {
+    fn layout(&self) -> &BlockLayout {
+        &self.terms.layout
+    }
+    fn local_from(&self) -> usize {
+        Problem::local_from(self)
+    }
+    fn evaluate(&self, x: &[f64], out: &mut BlockSystem) -> Result<(), SolverError> {
+        self.penalty(
+            x,
+            &mut BlockRows {
+                sys: out,
+                terms: self.terms,
+            },
+        );
+        Ok(())
+    }
+}
+
+impl ConstrainedLeastSquares for Problem<'_> {
+    fn num_variables(&self) -> usize {
+        self.terms.num_vars
+    }
+    fn objective(&self, x: &[f64], out: &mut SparseSystem) {
+        self.fairness_closeness(
+            x,
+            &mut TripletRows {
+                sys: out,
+                first_plane: self.terms.first_plane,
+            },
+        );
+    }
+    fn constraints(&self, x: &[f64], out: &mut SparseSystem) {
+        self.constraint_rows(
+            x,
+            &mut TripletRows {
+                sys: out,
+                first_plane: self.terms.first_plane,
+            },
+        );
     }
     /// The plane constraints `(n·v - d)/L` are bilinear: their Hessian couples v and n by
     /// `I/L`; `|n|² - 1` has Hessian `2I` on n. Angle constraints keep the Gauss-Newton part.
@@ -511,15 +592,22 @@ impl ConstrainedLeastSquares for Problem<'_> {
 /// refinement).
 struct Feasibility<'a, 'b>(&'a Problem<'b>);
 
-impl NonlinearLeastSquares for Feasibility<'_, '_> {
-    fn num_variables(&self) -> usize {
-        self.0.terms.num_vars
+impl BlockLeastSquares for Feasibility<'_, '_> {
+    fn layout(&self) -> &BlockLayout {
+        &self.0.terms.layout
     }
-    fn evaluate(&self, x: &[f64], out: &mut SparseSystem) {
-        self.0.constraints(x, out);
+    fn local_from(&self) -> usize {
+        self.0.local_from()
     }
-    fn local_blocks(&self) -> Option<(usize, usize)> {
-        NonlinearLeastSquares::local_blocks(self.0)
+    fn evaluate(&self, x: &[f64], out: &mut BlockSystem) -> Result<(), SolverError> {
+        self.0.constraint_rows(
+            x,
+            &mut BlockRows {
+                sys: out,
+                terms: self.0.terms,
+            },
+        );
+        Ok(())
     }
 }
 
@@ -767,6 +855,10 @@ impl PqPerturbation {
             first_plane,
             centers,
             eliminate_planes: mesh.faces().all(|f| f.len() <= 4),
+            layout: BlockLayout::new(
+                std::iter::repeat_n(3, first_plane / 3)
+                    .chain(std::iter::repeat_n(4, (num_vars - first_plane) / 4)),
+            ),
             var_of,
             num_vars,
             convex,
@@ -875,12 +967,12 @@ impl PqPerturbation {
         };
         let mut x = self.x.clone();
         let outcome = match self.phase {
-            PqPhase::Penalty => self.lm.step(&problem, &mut x).map(|_| ()),
+            PqPhase::Penalty => self.lm.step_blocks(&problem, &mut x).map(|_| ()),
             _ if self.options.refinement == Refinement::GaussNewton => {
                 let feasibility = Feasibility(&problem);
                 let fast = |s: &LmStep| s.cost_after <= CHORD_RATE * CHORD_RATE * s.cost_before;
                 let chord = if self.chord {
-                    self.lm.chord_step(&feasibility, &mut x)
+                    self.lm.chord_step_blocks(&feasibility, &mut x)
                 } else {
                     Ok(None)
                 };
@@ -890,7 +982,7 @@ impl PqPerturbation {
                         Ok(())
                     }
                     // No chord step, or one that did not help: a Newton step.
-                    _ => self.lm.step(&feasibility, &mut x).map(|s| {
+                    _ => self.lm.step_blocks(&feasibility, &mut x).map(|s| {
                         self.chord = fast(&s);
                     }),
                 }
@@ -898,7 +990,7 @@ impl PqPerturbation {
             _ => match self.sqp.step(&problem, &mut x) {
                 Ok(_) => Ok(()),
                 // Fall back to a damped penalty step when SQP finds no descent.
-                Err(_) => self.lm.step(&problem, &mut x).map(|_| ()),
+                Err(_) => self.lm.step_blocks(&problem, &mut x).map(|_| ()),
             },
         };
         self.iteration += 1;
@@ -955,6 +1047,9 @@ impl PqPerturbation {
         // Near-Gauss-Newton steps on the constraints: quadratic convergence once close. If the
         // first one is rejected (far from feasible), retry at the penalty phase's damping.
         let last = self.lm.damping();
+        // The exact phase's constraints are curved (angles, |n| = 1): a Newton step that
+        // overshoots is repaired by a second-order correction rather than halved.
+        self.lm.set_second_order_correction(true);
         self.lm.set_damping_with_fallback(1e-9, last);
     }
 

@@ -51,7 +51,7 @@
 //! (element -> variable list) instead of triplets.
 
 use super::PhexError;
-use crate::solver::{Ordering, SparseCholesky};
+use crate::solver::SparseCholesky;
 use crate::{PolyMesh, SolverError, Surface, Vec2, Vec3, max_planarity};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::amd;
@@ -285,7 +285,7 @@ impl Factor {
             pattern.row_indices(),
         );
         let fwd = vertex_amd_ordering(pattern);
-        let chol = SparseCholesky::analyse(matrix.as_ref(), Ordering::Custom(&fwd))?;
+        let chol = SparseCholesky::analyse(matrix.as_ref(), &fwd)?;
         Ok(Factor {
             permuted: vec![0.0; chol.nnz()],
             chol,

@@ -1,10 +1,12 @@
 //! Sparse Cholesky factorisation of symmetric positive definite matrices whose pattern
-//! repeats, shared by the solvers (the Gauss-Newton normal equations of [`super::pattern`]
-//! and the P-Hex planarity optimisation): the symbolic analysis for a given fill-reducing
+//! repeats, shared by the solvers (the Gauss-Newton normal equations of
+//! [`super::block_normal`] and the P-Hex planarity optimisation): the symbolic analysis for a
+//! given fill-reducing
 //! ordering once, then any number of numeric factorisations and solves (faer's supernodal
 //! Cholesky).
 //!
-//! Input: the upper triangle pattern of `A` (CSC, sorted rows) and an [`Ordering`]. The
+//! Input: the upper triangle pattern of `A` (CSC, sorted rows) and a fill-reducing ordering
+//! (`fwd[new] = old`, chosen by the caller: AMD on a block or vertex graph). The
 //! matrix is stored already permuted, `P A Pᵀ` as its lower triangle (faer's supernodal
 //! layout), and the values are written straight into that layout through
 //! [`SparseCholesky::positions`]; so faer's analysis runs with the identity ordering and
@@ -16,20 +18,11 @@ use faer::Side;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::linalg::amd;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Conj, Par};
-
-/// The fill-reducing ordering of a [`SparseCholesky`].
-pub(crate) enum Ordering<'a> {
-    /// faer's approximate minimum degree on the scalar pattern.
-    Amd,
-    /// A given order: `fwd[new] = old` (a permutation of `0..n`).
-    Custom(&'a [u32]),
-}
 
 /// A symbolic Cholesky analysis of one pattern with its numeric storage and workspace.
 pub(crate) struct SparseCholesky {
@@ -66,28 +59,10 @@ impl SparseCholesky {
     /// for the given ordering. Fails on a malformed ordering or when faer runs out of memory.
     pub(crate) fn analyse(
         upper: SymbolicSparseColMatRef<'_, u32>,
-        ordering: Ordering<'_>,
+        fwd: &[u32],
     ) -> Result<Self, SolverError> {
         let n = upper.ncols();
-        let fwd: Vec<u32> = match ordering {
-            Ordering::Amd => {
-                let mut perm = vec![0u32; n];
-                let mut perm_inv = vec![0u32; n];
-                let nnz = upper.row_idx().len();
-                let mut mem = MemBuffer::try_new(amd::order_maybe_unsorted_scratch::<u32>(n, nnz))
-                    .map_err(|e| fe(&e))?;
-                amd::order_maybe_unsorted(
-                    &mut perm,
-                    &mut perm_inv,
-                    upper,
-                    amd::Control::default(),
-                    MemStack::new(&mut mem),
-                )
-                .map_err(|e| fe(&e))?;
-                perm
-            }
-            Ordering::Custom(fwd) => fwd.to_vec(),
-        };
+        let fwd = fwd.to_vec();
         if fwd.len() != n {
             return Err(SolverError::Factorization(
                 "the ordering has the wrong length".into(),
@@ -301,7 +276,8 @@ mod tests {
             .unwrap()
             .solve(&nalgebra::DVector::from_column_slice(&b));
         let reversed: Vec<u32> = (0..n as u32).rev().collect();
-        for ordering in [Ordering::Amd, Ordering::Custom(&reversed)] {
+        let identity: Vec<u32> = (0..n as u32).collect();
+        for ordering in [&identity, &reversed] {
             let mut chol = SparseCholesky::analyse(upper.as_ref(), ordering).unwrap();
             let mut values = vec![0.0; chol.nnz()];
             for (k, &v) in upper_values.iter().enumerate() {
@@ -323,6 +299,6 @@ mod tests {
                 }
             }
         }
-        assert!(SparseCholesky::analyse(upper.as_ref(), Ordering::Custom(&[0, 0])).is_err());
+        assert!(SparseCholesky::analyse(upper.as_ref(), &[0, 0]).is_err());
     }
 }

@@ -2,8 +2,8 @@
 //! Sec. 2.2: "an unconstrained least squares problem which can be solved effectively by the
 //! Gauss-Newton method with L-M regularization").
 
-use super::pattern::{Factor, PatternMatrix};
-use super::schur::BlockSchur;
+use super::block_normal::BlockNormal;
+use super::block_system::{BlockLayout, BlockSystem};
 use super::{SolverError, SparseSystem};
 
 /// A nonlinear least-squares problem `min ½ |r(x)|²` with a sparse Jacobian.
@@ -22,6 +22,77 @@ pub trait NonlinearLeastSquares {
     }
 }
 
+/// A least-squares problem whose Jacobian comes in blocks (the crate's mesh problems): the
+/// unknowns are grouped by a [`BlockLayout`] and every residual row gives its gradient per
+/// block ([`BlockSystem`]).
+pub(crate) trait BlockLeastSquares {
+    /// The variable blocks.
+    fn layout(&self) -> &BlockLayout;
+    /// The blocks from this index on are local (every row touches at most one of them) and
+    /// are eliminated before the sparse factorisation; the default eliminates none.
+    fn local_from(&self) -> usize {
+        self.layout().num_blocks()
+    }
+    /// Fills `out` (cleared by the caller) with r(x) and its block Jacobian at `x`.
+    fn evaluate(&self, x: &[f64], out: &mut BlockSystem) -> Result<(), SolverError>;
+}
+
+/// A scalar [`NonlinearLeastSquares`] seen as blocks of one unknown (with its
+/// [`NonlinearLeastSquares::local_blocks`] as local blocks).
+struct Scalar<'a, P: ?Sized> {
+    problem: &'a P,
+    layout: BlockLayout,
+    local_from: usize,
+    block_of: Vec<(u32, u8)>,
+    triplets: std::cell::RefCell<SparseSystem>,
+}
+
+impl<'a, P: NonlinearLeastSquares + ?Sized> Scalar<'a, P> {
+    fn new(problem: &'a P) -> Self {
+        let n = problem.num_variables();
+        let blocks = problem.local_blocks().filter(|&(first, size)| {
+            (1..=4).contains(&size) && first > 0 && first < n && (n - first).is_multiple_of(size)
+        });
+        let (first, size) = blocks.unwrap_or((n, 1));
+        let sizes =
+            std::iter::repeat_n(1, first).chain(std::iter::repeat_n(size, (n - first) / size));
+        let block_of = (0..n)
+            .map(|v| {
+                if v < first {
+                    (v as u32, 0)
+                } else {
+                    (
+                        (first + (v - first) / size) as u32,
+                        ((v - first) % size) as u8,
+                    )
+                }
+            })
+            .collect();
+        Scalar {
+            problem,
+            layout: BlockLayout::new(sizes),
+            local_from: first,
+            block_of,
+            triplets: Default::default(),
+        }
+    }
+}
+
+impl<P: NonlinearLeastSquares + ?Sized> BlockLeastSquares for Scalar<'_, P> {
+    fn layout(&self) -> &BlockLayout {
+        &self.layout
+    }
+    fn local_from(&self) -> usize {
+        self.local_from
+    }
+    fn evaluate(&self, x: &[f64], out: &mut BlockSystem) -> Result<(), SolverError> {
+        let mut t = self.triplets.borrow_mut();
+        t.clear();
+        self.problem.evaluate(x, &mut t);
+        out.fill_from_sparse(&t, &self.block_of)
+    }
+}
+
 /// Settings of [`LevenbergMarquardt`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LmOptions {
@@ -37,6 +108,13 @@ pub struct LmOptions {
     /// Step halvings tried on a rejected step before the damping is raised (each costs one
     /// evaluation instead of a factorisation).
     pub step_halvings: usize,
+    /// When the full step raises the cost, first try a second-order correction: one chord
+    /// step from the trial point with the same factorisation (`h₂ = -(J₀ᵀJ₀ + μD)⁻¹ J₀ᵀ
+    /// r(x + h)`, an evaluation and two triangular solves), accepted if `x + h + h₂` lowers
+    /// the cost. The Maratos-effect remedy of SQP (Nocedal and Wright, Numerical
+    /// Optimization, Sec. 15.6): on curved constraints the Newton step is right to first
+    /// order and wrong to second, which halving throws away and the correction repairs.
+    pub second_order_correction: bool,
     /// Factor by which the damping shrinks after an accepted step with a good model (gain
     /// ratio ρ > 0.75; less, by Nielsen's rule, for 0.5 < ρ ≤ 0.75; > 1).
     pub decrease: f64,
@@ -50,6 +128,7 @@ impl Default for LmOptions {
             max_retries: 12,
             decrease: 3.0,
             step_halvings: 0,
+            second_order_correction: false,
             marquardt_scaling: false,
         }
     }
@@ -73,23 +152,13 @@ pub struct LmStep {
 pub struct LevenbergMarquardt {
     options: LmOptions,
     damping: f64,
-    normal: PatternMatrix,
-    sys: SparseSystem,
-    trial_sys: SparseSystem,
+    normal: BlockNormal,
+    sys: BlockSystem,
+    trial_sys: BlockSystem,
     /// Number of factorisations so far.
     factorizations: usize,
     /// The accepted point whose evaluation is in `trial_sys`, while still valid.
     cached_x: Option<Vec<f64>>,
-    /// Residual count and Jacobian (row, col) pattern behind the cached normal matrix.
-    last_pattern: (usize, Vec<(u32, u32)>),
-    /// Block structure requested for the current plan (`None`: full system).
-    last_blocks: Option<(usize, usize)>,
-    /// Whether `schur` holds a plan for `last_pattern`.
-    planned: bool,
-    /// Block elimination of the current assembly, if used.
-    schur: BlockSchur,
-    /// Whether the current assembly eliminates blocks.
-    schur_active: bool,
     /// Damping the first rejected try jumps to (0: plain growth), see
     /// [`Self::set_damping_with_fallback`].
     fallback: f64,
@@ -99,7 +168,7 @@ pub struct LevenbergMarquardt {
     /// The damping of that factorisation.
     chord_damping: f64,
     /// Evaluation at a chord step's trial point.
-    chord_sys: SparseSystem,
+    chord_sys: BlockSystem,
 }
 
 impl LevenbergMarquardt {
@@ -108,20 +177,15 @@ impl LevenbergMarquardt {
         LevenbergMarquardt {
             options,
             damping: options.initial_damping,
-            normal: PatternMatrix::new(Factor::CholeskyUpper),
-            sys: SparseSystem::new(),
-            trial_sys: SparseSystem::new(),
+            normal: BlockNormal::default(),
+            sys: BlockSystem::default(),
+            trial_sys: BlockSystem::default(),
             cached_x: None,
             factorizations: 0,
-            last_pattern: (0, Vec::new()),
-            last_blocks: None,
-            planned: false,
-            schur: BlockSchur::default(),
-            schur_active: false,
             fallback: 0.0,
             chord_ready: false,
             chord_damping: 0.0,
-            chord_sys: SparseSystem::new(),
+            chord_sys: BlockSystem::default(),
         }
     }
 
@@ -135,6 +199,11 @@ impl LevenbergMarquardt {
     /// Number of sparse factorisations done so far (one per tried step).
     pub fn factorizations(&self) -> usize {
         self.factorizations
+    }
+
+    /// Number of symbolic analyses of a sparsity pattern done so far.
+    pub fn analyses(&self) -> usize {
+        self.normal.analyses()
     }
 
     /// Sets the relative damping μ.
@@ -152,57 +221,26 @@ impl LevenbergMarquardt {
         self.fallback = fallback;
     }
 
+    /// Turns the second-order correction ([`LmOptions::second_order_correction`]) on or off.
+    pub fn set_second_order_correction(&mut self, on: bool) {
+        self.options.second_order_correction = on;
+    }
+
     /// The current relative damping μ.
     pub fn damping(&self) -> f64 {
         self.damping
     }
 
-    /// Assembles JᵀJ (upper triangle) of the current system, or with `blocks` its part on
-    /// the non-block variables plus the block data, and returns the gradient Jᵀr and the
-    /// per-variable damping scale `D`. The damping-dependent tail is added by
-    /// [`Self::damped_step`]. The analysis of the Jacobian pattern (row grouping, block
-    /// couplings, the position of every product in the sparse matrix) is done once per
-    /// pattern; a repeated pattern costs one pass over the products.
-    fn assemble(&mut self, n: usize, blocks: Option<(usize, usize)>) -> (Vec<f64>, Vec<f64>) {
-        let blocks = blocks.filter(|&(first, size)| {
-            (1..=4).contains(&size) && first > 0 && first < n && (n - first).is_multiple_of(size)
-        });
-        let same_jacobian = self.last_pattern.0 == self.sys.residuals.len()
-            && self.last_pattern.1.len() == self.sys.entries.len()
-            && self
-                .sys
-                .entries
-                .iter()
-                .zip(&self.last_pattern.1)
-                .all(|(e, &(r, c))| e.row == r && e.col == c);
-        let replan = !same_jacobian || self.last_blocks != blocks || !self.planned;
-        if !same_jacobian {
-            self.last_pattern.0 = self.sys.residuals.len();
-            self.last_pattern.1.clear();
-            self.last_pattern
-                .1
-                .extend(self.sys.entries.iter().map(|e| (e.row, e.col)));
-        }
-        if replan {
-            let ok = blocks.is_some_and(|(first, size)| self.schur.plan(&self.sys, n, first, size));
-            if !ok {
-                self.schur.plan(&self.sys, n, n, 1);
-            }
-            self.last_blocks = blocks;
-            self.planned = true;
-        }
-        let dim = self.schur.reduced_dim();
-        self.schur_active = dim < n;
-        if !replan && self.normal.has_pattern(dim) {
-            self.normal.begin_values_only();
-        } else {
-            self.normal.begin(dim);
-        }
-        let mut g = vec![0.0; n];
-        let mut diag = vec![0.0; n];
-        self.schur
-            .assemble(&self.sys, &mut self.normal, &mut g, &mut diag);
-        self.normal.mark_base();
+    /// Assembles the normal equations of `self.sys` and returns the gradient Jᵀr and the
+    /// per-variable damping scale `D`. The analysis of the Jacobian pattern is done once per
+    /// pattern ([`BlockNormal`]); a repeated pattern costs one pass over the rows.
+    fn assemble<P: BlockLeastSquares + ?Sized>(
+        &mut self,
+        problem: &P,
+    ) -> Result<(Vec<f64>, Vec<f64>), SolverError> {
+        let (g, mut diag) =
+            self.normal
+                .assemble(&self.sys, problem.layout(), problem.local_from())?;
         let scale = diag.iter().fold(0.0f64, |a, &b| a.max(b)).max(1e-300);
         for v in &mut diag {
             *v = if self.options.marquardt_scaling {
@@ -211,32 +249,7 @@ impl LevenbergMarquardt {
                 scale
             };
         }
-        (g, diag)
-    }
-
-    /// Solves `(JᵀJ + μ D) h = -g` with the assembled matrix (only the damping-dependent tail
-    /// changes between tries).
-    fn damped_step(&mut self, g: &[f64], d: &[f64], mu: f64) -> Result<Vec<f64>, SolverError> {
-        self.normal.truncate_to_base();
-        if self.schur_active {
-            self.schur.add_complement(&mut self.normal, mu, d)?;
-        }
-        let dim = self.schur.reduced_dim();
-        for (i, di) in d.iter().enumerate().take(dim) {
-            self.normal.push(i as u32, i as u32, mu * di);
-        }
-        let mut rhs: Vec<f64> = if self.schur_active {
-            self.schur.reduced_rhs(g)
-        } else {
-            g.iter().map(|v| -v).collect()
-        };
-        self.factorizations += 1;
-        self.normal.solve(&mut rhs)?;
-        if self.schur_active {
-            Ok(self.schur.back_substitute(rhs, g))
-        } else {
-            Ok(rhs)
-        }
+        Ok((g, diag))
     }
 
     /// One damped Gauss-Newton step on `x` (updated in place when a step reduces the cost).
@@ -249,14 +262,24 @@ impl LevenbergMarquardt {
         problem: &P,
         x: &mut [f64],
     ) -> Result<LmStep, SolverError> {
-        let n = problem.num_variables();
+        self.step_blocks(&Scalar::new(problem), x)
+    }
+
+    /// [`Self::step`] for a block problem.
+    pub(crate) fn step_blocks<P: BlockLeastSquares + ?Sized>(
+        &mut self,
+        problem: &P,
+        x: &mut [f64],
+    ) -> Result<LmStep, SolverError> {
+        let layout = problem.layout();
+        let n = layout.num_variables();
         self.chord_ready = false;
         if self.cached_x.as_deref() == Some(&*x) {
             std::mem::swap(&mut self.sys, &mut self.trial_sys);
         } else {
             self.sys.clear();
-            problem.evaluate(x, &mut self.sys);
-            self.sys.validate(n)?;
+            problem.evaluate(x, &mut self.sys)?;
+            self.sys.validate(layout)?;
         }
         self.cached_x = None;
         let cost_before = self.sys.cost();
@@ -268,11 +291,16 @@ impl LevenbergMarquardt {
                 damping: self.damping,
             });
         }
-        let (g, d) = self.assemble(n, problem.local_blocks());
+        let (g, d) = self.assemble(problem)?;
         let mut trial = vec![0.0; n];
         let mut grow = 2.0;
         for _ in 0..=self.options.max_retries {
-            let h = match self.damped_step(&g, &d, self.damping) {
+            self.factorizations += 1;
+            let h = match self
+                .normal
+                .factor(layout, self.damping, &d)
+                .and_then(|()| self.normal.solve(layout, &g))
+            {
                 Ok(h) => h,
                 Err(_) => {
                     self.damping = (self.damping * 10.0).max(1e-12);
@@ -292,14 +320,36 @@ impl LevenbergMarquardt {
                     trial[i] = x[i] + h[i];
                 }
                 self.trial_sys.clear();
-                problem.evaluate(&trial, &mut self.trial_sys);
-                cost_after = if self.trial_sys.validate(n).is_ok() {
+                let ok = problem.evaluate(&trial, &mut self.trial_sys).is_ok()
+                    && self.trial_sys.validate(layout).is_ok();
+                cost_after = if ok {
                     self.trial_sys.cost()
                 } else {
                     f64::INFINITY
                 };
                 if cost_after < cost_before {
                     break;
+                }
+                if k == 0
+                    && ok
+                    && self.options.second_order_correction
+                    && self.trial_sys.same_pattern(&self.sys)
+                {
+                    let g2 = self.sys.gradient(layout, &self.trial_sys.residuals);
+                    if let Ok(h2) = self.normal.solve(layout, &g2) {
+                        let corrected: Vec<f64> =
+                            trial.iter().zip(&h2).map(|(a, b)| a + b).collect();
+                        self.chord_sys.clear();
+                        let ok2 = problem.evaluate(&corrected, &mut self.chord_sys).is_ok()
+                            && self.chord_sys.validate(layout).is_ok();
+                        if ok2 && self.chord_sys.cost() < cost_before {
+                            cost_after = self.chord_sys.cost();
+                            std::mem::swap(&mut self.trial_sys, &mut self.chord_sys);
+                            trial = corrected;
+                            h.iter_mut().zip(&h2).for_each(|(a, b)| *a += b);
+                            break;
+                        }
+                    }
                 }
             }
             if cost_after < cost_before && shortened {
@@ -379,23 +429,24 @@ impl LevenbergMarquardt {
         problem: &P,
         x: &mut [f64],
     ) -> Result<Option<LmStep>, SolverError> {
-        let n = problem.num_variables();
+        self.chord_step_blocks(&Scalar::new(problem), x)
+    }
+
+    /// [`Self::chord_step`] for a block problem.
+    pub(crate) fn chord_step_blocks<P: BlockLeastSquares + ?Sized>(
+        &mut self,
+        problem: &P,
+        x: &mut [f64],
+    ) -> Result<Option<LmStep>, SolverError> {
+        let layout = problem.layout();
         if !self.chord_ready || self.cached_x.as_deref() != Some(&*x) {
             return Ok(None);
         }
         // `sys`: the evaluation the factor was made from; `trial_sys`: the one at `x`.
-        let (j0, now) = (&self.sys, &self.trial_sys);
-        let same = j0.residuals.len() == now.residuals.len()
-            && j0.entries.len() == now.entries.len()
-            && j0
-                .entries
-                .iter()
-                .zip(&now.entries)
-                .all(|(a, b)| a.row == b.row && a.col == b.col);
-        if !same || j0.entries.iter().any(|e| e.col as usize >= n) {
+        if !self.sys.same_pattern(&self.trial_sys) {
             return Ok(None);
         }
-        let cost_before = now.cost();
+        let cost_before = self.trial_sys.cost();
         let unchanged = LmStep {
             cost_before,
             cost_after: cost_before,
@@ -405,28 +456,16 @@ impl LevenbergMarquardt {
         if cost_before == 0.0 {
             return Ok(Some(unchanged));
         }
-        let mut g = vec![0.0; n];
-        for e in &j0.entries {
-            g[e.col as usize] += e.value * now.residuals[e.row as usize];
-        }
-        let mut rhs: Vec<f64> = if self.schur_active {
-            self.schur.reduced_rhs(&g)
-        } else {
-            g.iter().map(|v| -v).collect()
-        };
-        if self.normal.solve_factored(&mut rhs).is_err() {
+        let g = self.sys.gradient(layout, &self.trial_sys.residuals);
+        let Ok(h) = self.normal.solve(layout, &g) else {
             self.chord_ready = false;
             return Ok(None);
-        }
-        let h = if self.schur_active {
-            self.schur.back_substitute(rhs, &g)
-        } else {
-            rhs
         };
         let trial: Vec<f64> = x.iter().zip(&h).map(|(a, b)| a + b).collect();
         self.chord_sys.clear();
-        problem.evaluate(&trial, &mut self.chord_sys);
-        let cost_after = if self.chord_sys.validate(n).is_ok() {
+        let ok = problem.evaluate(&trial, &mut self.chord_sys).is_ok()
+            && self.chord_sys.validate(layout).is_ok();
+        let cost_after = if ok {
             self.chord_sys.cost()
         } else {
             f64::INFINITY
@@ -746,7 +785,7 @@ mod tests {
         for _ in 0..3 {
             let s_full = lm_full.step(&full, &mut x_full).unwrap();
             let s_blocked = lm_blocked.step(&blocked, &mut x_blocked).unwrap();
-            assert!(lm_blocked.schur_active && !lm_full.schur_active);
+            assert!(lm_blocked.normal.eliminates() && !lm_full.normal.eliminates());
             assert!((s_full.cost_after - s_blocked.cost_after).abs() <= 1e-12);
             for j in 0..n {
                 assert!(
@@ -763,7 +802,7 @@ mod tests {
         let mut lm = LevenbergMarquardt::new(options);
         let mut x = vec![0.5; n];
         lm.step(&two, &mut x).unwrap();
-        assert!(!lm.schur_active);
+        assert!(!lm.normal.eliminates());
     }
 
     #[test]

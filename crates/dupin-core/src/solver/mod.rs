@@ -2,12 +2,14 @@
 //! (PQ / conical / circular perturbation here, P-Hex planarity optimisation later).
 //!
 //! A problem hands over its residuals and the sparse Jacobian as triplets in a
-//! [`SparseSystem`]. Two step types are offered:
+//! [`SparseSystem`] (the crate's own mesh problems as per-block gradients in a `BlockSystem`,
+//! a vertex or face plane at a time). Two step types are offered:
 //!
 //! - [`LevenbergMarquardt`]: Gauss-Newton on the normal equations `(JᵀJ + μI) h = -Jᵀr` with
 //!   Levenberg-Marquardt damping `μ` adapted after every accepted or rejected step (conical
-//!   paper, Sec. 2.2, penalty method, eq. (5)). The normal matrix is factored by faer's sparse
-//!   Cholesky.
+//!   paper, Sec. 2.2, penalty method, eq. (5)). The normal matrix is assembled in blocks,
+//!   local blocks (face planes) are eliminated, and the rest is factored by faer's sparse
+//!   Cholesky (`block_normal.rs`).
 //! - [`Sqp`]: sequential quadratic programming for `min ½|r(x)|²` subject to `c(x) = 0`, one
 //!   Newton step on the KKT system of eq. (3) of the conical paper, factored by faer's sparse LU,
 //!   with a soft line search on an exact-penalty merit function.
@@ -16,13 +18,16 @@
 //! as long as the problem emits the same (row, column) pattern, so iterating on a fixed mesh
 //! costs one numeric factorisation per step.
 
+mod block_normal;
+mod block_system;
 mod cholesky;
 mod gauss_newton;
 mod pattern;
-mod schur;
 mod sqp;
 
-pub(crate) use cholesky::{Ordering, SparseCholesky};
+pub(crate) use block_system::{BlockLayout, BlockSystem};
+pub(crate) use cholesky::SparseCholesky;
+pub(crate) use gauss_newton::BlockLeastSquares;
 pub use gauss_newton::{LevenbergMarquardt, LmOptions, LmStep, NonlinearLeastSquares};
 pub use sqp::{ConstrainedLeastSquares, Sqp, SqpOptions, SqpStep};
 

@@ -1,183 +1,39 @@
 //! Assembly of square sparse matrices from (row, col, value) lists whose pattern repeats, with
-//! the symbolic analysis (triplet order and symbolic factorisation) cached across calls.
+//! the symbolic analysis (triplet order and symbolic LU) cached across calls: the KKT
+//! matrices of the SQP refinement. (The Gauss-Newton normal equations are assembled in blocks,
+//! `block_normal.rs`, which uses [`csc_pattern`] on block pairs.)
 
 use super::SolverError;
-use super::cholesky::{Ordering, SparseCholesky};
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 
-/// Which factorisation a cached pattern feeds.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Factor {
-    /// Cholesky of a symmetric positive definite matrix whose upper triangle is given.
-    CholeskyUpper,
-    /// LU with partial pivoting of a general square matrix.
-    Lu,
-}
-
-enum Symbolic {
-    /// Supernodal Cholesky on the AMD-permuted matrix: the cached slots point into its
-    /// permuted layout.
-    Llt(Box<SparseCholesky>),
-    Lu(SymbolicLu<u32>),
-}
-
-/// A square sparse matrix assembled repeatedly from the same index pattern.
-///
-/// Two assembly modes: while a pattern is being built ([`Self::begin`]) positions and values
-/// are recorded; once the pattern is analysed ([`Self::begin_values_only`]) every pushed
-/// value goes straight to its precomputed CSC slot (no intermediate list, no sorting). A
-/// base point ([`Self::mark_base`]) lets the caller redo the tail of an assembly (e.g. the
-/// damping terms of a retried step) without redoing the rest.
+/// A square sparse matrix assembled repeatedly from the same index pattern and solved by
+/// sparse LU with partial pivoting.
 pub(crate) struct PatternMatrix {
-    kind: Factor,
     n: usize,
-    /// The pattern the cache was built for.
+    /// The (row, column) list the cached analysis was made for.
     pairs: Vec<(u32, u32)>,
-    /// Cached analysis: the CSC pattern, the slot of every assembled entry in the factored
-    /// layout (the CSC one for LU, the permuted one of the Cholesky), so assembly is a
-    /// scatter-add without re-sorting or allocating, and the symbolic factorisation.
-    cached: Option<(SymbolicSparseColMat<u32>, Vec<u32>, Symbolic)>,
-    /// CSC values of the matrix being factored (filled directly in values-only mode).
+    /// CSC pattern, CSC slot of every listed entry, symbolic LU.
+    cached: Option<(SymbolicSparseColMat<u32>, Vec<u32>, SymbolicLu<u32>)>,
     csc_values: Vec<f64>,
-    /// CSC values at the base point, restored by [`Self::truncate_to_base`].
-    csc_base: Vec<f64>,
-    /// Whether `csc_base` holds the base point of the current assembly.
-    base_valid: bool,
-    /// Number of entries pushed before the base point.
-    base_len: usize,
-    /// Number of entries pushed in values-only mode (index into the cached slots).
-    cursor: usize,
-    /// Pairs of the matrix being assembled (build mode).
     new_pairs: Vec<(u32, u32)>,
-    /// Values of the matrix being assembled, aligned with `new_pairs` (build mode).
     values: Vec<f64>,
-    /// Values-only mode: entries follow the cached pattern and go straight to `csc_values`.
-    same_pattern: bool,
-    /// The cached slots follow the entry order of the last build-mode assembly (false while
-    /// a new one has not been analysed, e.g. after a failed analysis).
-    fresh: bool,
-    /// The Cholesky values hold the factor of the last successful [`Self::solve`] (reused by
-    /// [`Self::solve_factored`]).
-    factored: bool,
 }
 
 impl PatternMatrix {
-    pub(crate) fn new(kind: Factor) -> Self {
+    pub(crate) fn new() -> Self {
         PatternMatrix {
-            kind,
             n: 0,
             pairs: Vec::new(),
             cached: None,
             csc_values: Vec::new(),
-            csc_base: Vec::new(),
-            base_valid: false,
-            base_len: 0,
-            cursor: 0,
             new_pairs: Vec::new(),
             values: Vec::new(),
-            same_pattern: false,
-            fresh: false,
-            factored: false,
         }
     }
 
-    /// Whether a pattern has been analysed for size `n` (so values-only assembly is possible).
-    pub(crate) fn has_pattern(&self, n: usize) -> bool {
-        self.cached.is_some() && self.n == n && self.fresh
-    }
-
-    /// Starts a values-only assembly: the caller pushes values with [`Self::push`] in the
-    /// exact order of the cached pattern (see [`Self::has_pattern`]).
-    pub(crate) fn begin_values_only(&mut self) {
-        debug_assert!(self.cached.is_some());
-        let nnz = self.cached.as_ref().map_or(0, |c| c.0.row_idx().len());
-        self.csc_values.clear();
-        self.csc_values.resize(nnz, 0.0);
-        self.cursor = 0;
-        self.base_valid = false;
-        self.same_pattern = true;
-        self.factored = false;
-    }
-
-    /// Number of entries assembled so far.
-    pub(crate) fn len(&self) -> usize {
-        if self.same_pattern {
-            self.cursor
-        } else {
-            self.values.len()
-        }
-    }
-
-    /// Marks the current point of the assembly as the base that [`Self::truncate_to_base`]
-    /// returns to.
-    pub(crate) fn mark_base(&mut self) {
-        self.base_len = self.len();
-        if self.same_pattern {
-            self.csc_base.clone_from(&self.csc_values);
-            self.base_valid = true;
-        } else {
-            self.base_valid = false;
-        }
-    }
-
-    /// Drops everything assembled after the base point, so the tail of an assembly can be
-    /// redone (e.g. for a new damping).
-    pub(crate) fn truncate_to_base(&mut self) {
-        if self.same_pattern {
-            debug_assert!(self.base_valid);
-            self.csc_values.copy_from_slice(&self.csc_base);
-            self.cursor = self.base_len;
-        } else {
-            self.values.truncate(self.base_len);
-            self.new_pairs.truncate(self.base_len);
-        }
-    }
-
-    /// Adds the next entry in either mode: its position is recorded while the pattern is being
-    /// built (after [`Self::begin`]); in values-only mode it must follow the cached order.
-    #[inline]
-    pub(crate) fn push(&mut self, row: u32, col: u32, value: f64) {
-        if self.same_pattern {
-            let slots = &self
-                .cached
-                .as_ref()
-                .expect("values-only mode has a pattern")
-                .1;
-            if let Some(&slot) = slots.get(self.cursor) {
-                self.csc_values[slot as usize] += value;
-            }
-            // Past the end: caught by `solve` as a pattern mismatch.
-            self.cursor += 1;
-        } else {
-            self.new_pairs.push((row, col));
-            self.values.push(value);
-        }
-    }
-
-    /// The destination of the next entries, for tight assembly loops: the same as calling
-    /// [`Self::push`] for each, without looking up the mode every time.
-    pub(crate) fn sink(&mut self) -> Sink<'_> {
-        if self.same_pattern {
-            Sink::Direct {
-                slots: &self
-                    .cached
-                    .as_ref()
-                    .expect("values-only mode has a pattern")
-                    .1,
-                csc: &mut self.csc_values,
-                cursor: &mut self.cursor,
-            }
-        } else {
-            Sink::Build {
-                pairs: &mut self.new_pairs,
-                values: &mut self.values,
-            }
-        }
-    }
-
-    /// Starts a new assembly of an `n x n` matrix.
+    /// Starts a new `n x n` assembly.
     pub(crate) fn begin(&mut self, n: usize) {
         if n != self.n {
             self.cached = None;
@@ -185,141 +41,41 @@ impl PatternMatrix {
         }
         self.new_pairs.clear();
         self.values.clear();
-        self.base_valid = false;
-        self.base_len = 0;
-        self.same_pattern = false;
-        self.fresh = false;
-        self.factored = false;
     }
 
-    /// Adds `value` at (row, col); repeated positions are summed.
+    /// Adds `value` at (row, col); repeats are summed.
     #[inline]
     pub(crate) fn add(&mut self, row: u32, col: u32, value: f64) {
         self.new_pairs.push((row, col));
         self.values.push(value);
     }
 
-    /// Factors the assembled matrix and solves `A x = rhs` in place.
+    /// Solves `A x = rhs` in place for the assembled `A` (analysing its pattern only when it
+    /// differs from the last one).
     pub(crate) fn solve(&mut self, rhs: &mut [f64]) -> Result<(), SolverError> {
         let n = self.n;
         let fe = |e: &dyn std::fmt::Debug| SolverError::Factorization(format!("{e:?}"));
-        self.factored = false;
-        if self.same_pattern {
-            // Values-only assembly: the values are in place if exactly the cached entries came.
-            let expected = self.cached.as_ref().map_or(usize::MAX, |c| c.1.len());
-            if self.cursor != expected {
-                return Err(SolverError::Factorization(
-                    "values-only assembly without a matching pattern".into(),
-                ));
-            }
-        }
-        let mut reuse =
-            self.same_pattern || (self.cached.is_some() && self.pairs == self.new_pairs);
-        // A Cholesky pattern contained in the cached one (e.g. the constraints-only phase after
-        // the penalty phase) reuses its symbolic factorisation: the missing entries are zeros.
-        if !reuse
-            && !self.same_pattern
-            && self.kind == Factor::CholeskyUpper
-            && let Some((sym, slots, Symbolic::Llt(chol))) = self.cached.as_mut()
-        {
-            let (col_ptr, row_idx) = (sym.col_ptr(), sym.row_idx());
-            let mut new_slots = Vec::with_capacity(self.new_pairs.len());
-            for &(r, c) in &self.new_pairs {
-                if c as usize >= n {
-                    break;
-                }
-                let range = col_ptr[c as usize] as usize..col_ptr[c as usize + 1] as usize;
-                match row_idx[range.clone()].binary_search(&r) {
-                    Ok(at) => new_slots.push((range.start + at) as u32),
-                    Err(_) => break,
-                }
-            }
-            // Only when the new pattern fills most of the cached one: a much sparser matrix
-            // (e.g. without the fairness couplings) is cheaper to factor with its own analysis.
-            let filled = if new_slots.len() == self.new_pairs.len() {
-                let mut seen = vec![false; row_idx.len()];
-                new_slots.iter().for_each(|&k| seen[k as usize] = true);
-                seen.iter().filter(|&&b| b).count()
-            } else {
-                0
-            };
-            if 10 * filled >= 9 * row_idx.len() {
-                let positions = chol.positions();
-                new_slots
-                    .iter_mut()
-                    .for_each(|k| *k = positions[*k as usize]);
-                *slots = new_slots;
-                std::mem::swap(&mut self.pairs, &mut self.new_pairs);
-                self.new_pairs.clear();
-                reuse = true;
-            }
-        }
-        if !reuse {
-            let (sym, mut slots) = csc_pattern(n, &self.new_pairs)?;
-            let symbolic = match self.kind {
-                Factor::CholeskyUpper => {
-                    let chol = SparseCholesky::analyse(sym.as_ref(), Ordering::Amd)?;
-                    let positions = chol.positions();
-                    slots.iter_mut().for_each(|k| *k = positions[*k as usize]);
-                    Symbolic::Llt(Box::new(chol))
-                }
-                Factor::Lu => Symbolic::Lu(SymbolicLu::try_new(sym.as_ref()).map_err(|e| fe(&e))?),
-            };
-            self.cached = Some((sym, slots, symbolic));
+        if self.cached.is_none() || self.pairs != self.new_pairs {
+            let (sym, slots) = csc_pattern(n, &self.new_pairs)?;
+            let lu = SymbolicLu::try_new(sym.as_ref()).map_err(|e| fe(&e))?;
+            self.cached = Some((sym, slots, lu));
             std::mem::swap(&mut self.pairs, &mut self.new_pairs);
-            self.new_pairs.clear();
         }
-        self.fresh = true;
-        let (sym, slots, symbolic) = self.cached.as_mut().expect("cache built above");
-        if !self.same_pattern {
-            // Scatter the recorded values (the part before the base point kept aside), then go
-            // on in values-only mode: further tails (e.g. damping retries) need no comparison.
-            self.csc_values.clear();
-            self.csc_values.resize(sym.row_idx().len(), 0.0);
-            let base = self.base_len.min(self.values.len());
-            for (&slot, &v) in slots.iter().zip(&self.values[..base]) {
-                self.csc_values[slot as usize] += v;
-            }
-            self.csc_base.clone_from(&self.csc_values);
-            self.base_valid = true;
-            for (&slot, &v) in slots[base..].iter().zip(&self.values[base..]) {
-                self.csc_values[slot as usize] += v;
-            }
-            self.cursor = self.values.len();
-            self.same_pattern = true;
+        let (sym, slots, symbolic) = self.cached.as_ref().expect("cache built above");
+        self.csc_values.clear();
+        self.csc_values.resize(sym.row_idx().len(), 0.0);
+        for (&slot, &v) in slots.iter().zip(&self.values) {
+            self.csc_values[slot as usize] += v;
         }
-        match symbolic {
-            Symbolic::Llt(chol) => {
-                chol.factorize(&self.csc_values)?;
-                self.factored = true;
-                chol.solve_in_place(rhs)
-            }
-            Symbolic::Lu(s) => {
-                let mat = SparseColMatRef::<u32, f64>::new(sym.as_ref(), &self.csc_values);
-                let f = Lu::try_new_with_symbolic(s.clone(), mat.as_ref()).map_err(|e| fe(&e))?;
-                f.solve_in_place(faer::MatMut::from_column_major_slice_mut(rhs, n, 1));
-                if rhs.iter().all(|v| v.is_finite()) {
-                    Ok(())
-                } else {
-                    Err(SolverError::Factorization(
-                        "the solve produced non-finite values (singular matrix)".into(),
-                    ))
-                }
-            }
-        }
-    }
-}
-
-impl PatternMatrix {
-    /// Solves `A x = rhs` in place with the Cholesky factor of the last successful
-    /// [`Self::solve`], without a new factorisation (chord steps). Fails when there is no such
-    /// factor (an LU matrix, a failed factorisation, or a new assembly begun since).
-    pub(crate) fn solve_factored(&mut self, rhs: &mut [f64]) -> Result<(), SolverError> {
-        match self.cached.as_mut() {
-            Some((_, _, Symbolic::Llt(chol))) if self.factored => chol.solve_in_place(rhs),
-            _ => Err(SolverError::Factorization(
-                "no factorisation to reuse".into(),
-            )),
+        let mat = SparseColMatRef::<u32, f64>::new(sym.as_ref(), &self.csc_values);
+        let f = Lu::try_new_with_symbolic(symbolic.clone(), mat.as_ref()).map_err(|e| fe(&e))?;
+        f.solve_in_place(faer::MatMut::from_column_major_slice_mut(rhs, n, 1));
+        if rhs.iter().all(|v| v.is_finite()) {
+            Ok(())
+        } else {
+            Err(SolverError::Factorization(
+                "the solve produced non-finite values (singular matrix)".into(),
+            ))
         }
     }
 }
@@ -329,7 +85,7 @@ impl PatternMatrix {
 /// entries, repeats included (several per product of the Gauss-Newton assembly, millions on
 /// the large meshes); here bucketing by column and a per-row marker make it linear, and
 /// only the distinct rows of a column are sorted.
-fn csc_pattern(
+pub(crate) fn csc_pattern(
     n: usize,
     pairs: &[(u32, u32)],
 ) -> Result<(SymbolicSparseColMat<u32>, Vec<u32>), SolverError> {
@@ -387,43 +143,6 @@ fn csc_pattern(
         SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx),
         slots,
     ))
-}
-
-/// Where the entries of an assembly go, from [`PatternMatrix::sink`].
-pub(crate) enum Sink<'a> {
-    /// Pattern being built: positions and values are recorded.
-    Build {
-        pairs: &'a mut Vec<(u32, u32)>,
-        values: &'a mut Vec<f64>,
-    },
-    /// Values-only: each value is added at its cached CSC slot.
-    Direct {
-        slots: &'a [u32],
-        csc: &'a mut [f64],
-        cursor: &'a mut usize,
-    },
-}
-
-impl Sink<'_> {
-    /// Adds the next entry (see [`PatternMatrix::push`]).
-    #[inline(always)]
-    pub(crate) fn push(&mut self, row: u32, col: u32, value: f64) {
-        match self {
-            Sink::Build { pairs, values } => {
-                pairs.push((row, col));
-                values.push(value);
-            }
-            Sink::Direct { slots, csc, cursor } => {
-                // Past the end of the pattern: caught by `solve` as a mismatch.
-                if let Some(&slot) = slots.get(**cursor)
-                    && let Some(c) = csc.get_mut(slot as usize)
-                {
-                    *c += value;
-                }
-                **cursor += 1;
-            }
-        }
-    }
 }
 
 /// Reusable buffers of [`add_gram`].

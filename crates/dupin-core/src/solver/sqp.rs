@@ -15,7 +15,7 @@
 //! the system solvable when constraints are redundant or contradict fixed variables; the step
 //! then satisfies them in the least-squares sense.
 
-use super::pattern::{Factor, GramScratch, PatternMatrix, add_gram};
+use super::pattern::{GramScratch, PatternMatrix, add_gram};
 use super::{SolverError, SparseSystem};
 
 /// A least-squares objective with equality constraints, both with sparse Jacobians.
@@ -93,7 +93,7 @@ impl Sqp {
     pub fn new(options: SqpOptions) -> Self {
         Sqp {
             options,
-            kkt: PatternMatrix::new(Factor::Lu),
+            kkt: PatternMatrix::new(),
             obj: SparseSystem::new(),
             cons: SparseSystem::new(),
             trial_obj: SparseSystem::new(),

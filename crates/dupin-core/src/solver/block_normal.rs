@@ -1,0 +1,622 @@
+//! The damped normal equations `(JᵀJ + μD) h = -Jᵀr` of a [`BlockSystem`], assembled, reduced
+//! and factored block by block.
+//!
+//! Inputs: a block system on a [`BlockLayout`] and an elimination threshold `elim`: the blocks
+//! `elim..` are *local* (every residual row touches at most one of them, e.g. the plane of one
+//! face in the PQ perturbation of the conical paper, Sec. 2.2). Output: the step `h`. The local
+//! blocks are eliminated (Schur complement, block Gaussian elimination, exact in exact
+//! arithmetic): the sparse Cholesky factors
+//! `S = A + μD_a - Σ_e B_e (C_e + μD_e)⁻¹ B_eᵀ` on the kept blocks `0..elim` only, and
+//! `h_e = (C_e + μD_e)⁻¹ (-g_e - B_eᵀ h_a)` follows per block. `A`, `B_e`, `C_e` are the
+//! blocks of `JᵀJ`.
+//!
+//! Everything structural is done once per Jacobian pattern, at block level: which block pairs
+//! `S` couples, the block CSC pattern and its scalar expansion, the fill-reducing ordering
+//! (AMD on the block graph, each block's unknowns kept together) and faer's symbolic
+//! factorisation, and for every row the slot each of its block products goes to. An assembly
+//! is then one pass over the rows adding 4 x 4 outer products into those slots. A later pattern
+//! whose block pairs all exist in the analysed one (the exact phase of the PQ perturbation,
+//! a subset of the penalty phase) reuses the analysis when it fills at least 90% of it.
+//!
+//! Written by hand: no sparse library takes block-row Jacobians, eliminates problem-defined
+//! local blocks and keeps the analysis for a repeated pattern; the dense 4 x 4 algebra is
+//! nalgebra's, the sparse factorisation faer's ([`SparseCholesky`]).
+
+use super::SolverError;
+use super::block_system::{BlockLayout, BlockSystem, MAX_BLOCK};
+use super::cholesky::SparseCholesky;
+use super::pattern::csc_pattern;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::SymbolicSparseColMat;
+use faer::sparse::linalg::amd;
+use nalgebra::{Matrix4, Vector4};
+
+const NONE: u32 = u32::MAX;
+/// Set on a row pair slot whose product is stored transposed (the later entry's block is the
+/// smaller one, so it names the block row).
+const TRANSPOSED: u32 = 1 << 31;
+
+type Block = Matrix4<f64>;
+
+#[inline]
+fn vec4(g: &[f64; MAX_BLOCK]) -> Vector4<f64> {
+    Vector4::new(g[0], g[1], g[2], g[3])
+}
+
+/// `acc += a bᵀ` on a row-major 4 x 4 block (plain arrays: the compiler vectorises this,
+/// nalgebra's generic `ger` it does not).
+#[inline(always)]
+fn add_outer(acc: &mut [f64; 16], a: &[f64; MAX_BLOCK], b: &[f64; MAX_BLOCK]) {
+    for k in 0..4 {
+        for l in 0..4 {
+            acc[4 * k + l] += a[k] * b[l];
+        }
+    }
+}
+
+/// The block pattern of the reduced matrix `S` and its scalar factorisation.
+struct Structure {
+    /// Kept blocks (`S` is `nk x nk` blocks).
+    nk: usize,
+    /// Block CSC of the upper triangle (block row <= block column, rows sorted).
+    col_ptr: Vec<u32>,
+    row_blk: Vec<u32>,
+    /// Per block slot, 16 positions (row-major 4 x 4) of its scalar entries in the values
+    /// `chol` factors (`NONE` outside the blocks' sizes and below a diagonal block's diagonal).
+    val_pos: Vec<u32>,
+    /// Position of each kept unknown's diagonal entry.
+    diag_pos: Vec<u32>,
+    /// Every scalar entry as (index into the slots' flattened 4 x 4 blocks, position).
+    scatter: Vec<(u32, u32)>,
+    chol: SparseCholesky,
+}
+
+impl Structure {
+    fn slots(&self) -> usize {
+        self.row_blk.len()
+    }
+
+    /// The slot of block pair (i, j), i <= j, if the pattern has it.
+    fn find(&self, i: u32, j: u32) -> Option<u32> {
+        let (s, e) = (
+            self.col_ptr[j as usize] as usize,
+            self.col_ptr[j as usize + 1] as usize,
+        );
+        self.row_blk[s..e]
+            .binary_search(&i)
+            .ok()
+            .map(|k| (s + k) as u32)
+    }
+
+    /// Analyses the upper block pairs `pairs` ((row, column), row <= column; the diagonal of
+    /// every kept block included) and returns the structure and each pair's slot.
+    fn analyse(
+        layout: &BlockLayout,
+        nk: usize,
+        pairs: &[(u32, u32)],
+    ) -> Result<(Self, Vec<u32>), SolverError> {
+        let (pattern, slots) = csc_pattern(nk, pairs)?;
+        let col_ptr = pattern.col_ptr().to_vec();
+        let row_blk = pattern.row_idx().to_vec();
+        // Scalar upper pattern: column `offset(j) + l` lists, for every block row i of block
+        // column j in order, the rows offset(i) + k (k <= l on the diagonal block).
+        let n = layout.offset(nk);
+        let mut scol = vec![0u32; n + 1];
+        let mut srow: Vec<u32> = Vec::new();
+        let mut entry_of = vec![NONE; row_blk.len() * 16];
+        for j in 0..nk {
+            let (oj, sj) = (layout.offset(j), layout.size(j));
+            for l in 0..sj {
+                for s in col_ptr[j] as usize..col_ptr[j + 1] as usize {
+                    let i = row_blk[s] as usize;
+                    let (oi, si) = (layout.offset(i), layout.size(i));
+                    let rows = if i == j { l + 1 } else { si };
+                    for k in 0..rows {
+                        entry_of[s * 16 + k * 4 + l] = srow.len() as u32;
+                        srow.push((oi + k) as u32);
+                    }
+                }
+                scol[oj + l + 1] = srow.len() as u32;
+            }
+        }
+        let upper = SymbolicSparseColMat::new_checked(n, n, scol, None, srow);
+        // AMD on the block graph; each block's unknowns stay consecutive.
+        let mut perm = vec![0u32; nk];
+        let mut perm_inv = vec![0u32; nk];
+        let mut mem =
+            MemBuffer::try_new(amd::order_maybe_unsorted_scratch::<u32>(nk, row_blk.len()))
+                .map_err(|e| SolverError::Factorization(format!("{e:?}")))?;
+        amd::order_maybe_unsorted(
+            &mut perm,
+            &mut perm_inv,
+            pattern.as_ref(),
+            amd::Control::default(),
+            MemStack::new(&mut mem),
+        )
+        .map_err(|e| SolverError::Factorization(format!("{e:?}")))?;
+        let mut fwd = Vec::with_capacity(n);
+        for &b in &perm {
+            let o = layout.offset(b as usize);
+            fwd.extend((o..o + layout.size(b as usize)).map(|v| v as u32));
+        }
+        let chol = SparseCholesky::analyse(upper.as_ref(), &fwd)?;
+        let positions = chol.positions();
+        let val_pos: Vec<u32> = entry_of
+            .iter()
+            .map(|&e| {
+                if e == NONE {
+                    NONE
+                } else {
+                    positions[e as usize]
+                }
+            })
+            .collect();
+        let scatter = val_pos
+            .iter()
+            .enumerate()
+            .filter(|&(_, &p)| p != NONE)
+            .map(|(q, &p)| (q as u32, p))
+            .collect();
+        let mut diag_pos = vec![NONE; n];
+        for j in 0..nk {
+            let s = col_ptr[j + 1] as usize - 1; // the diagonal block ends its column
+            let o = layout.offset(j);
+            for k in 0..layout.size(j) {
+                diag_pos[o + k] = val_pos[s * 16 + k * 4 + k];
+            }
+        }
+        Ok((
+            Structure {
+                nk,
+                col_ptr,
+                row_blk,
+                val_pos,
+                diag_pos,
+                scatter,
+                chol,
+            },
+            slots,
+        ))
+    }
+}
+
+/// How the rows of one Jacobian pattern land in a [`Structure`].
+struct RowMap {
+    /// The pattern this map was made for.
+    pattern: BlockSystem,
+    elim: usize,
+    /// Slot of every kept block's diagonal block.
+    diag_slot: Vec<u32>,
+    /// Per row, the slots of its kept entry pairs (i <= j in row order), flagged
+    /// [`TRANSPOSED`] where entry j has the smaller block.
+    pair_start: Vec<u32>,
+    pair_slot: Vec<u32>,
+    /// Per row, the position within the row of its local-block entry, or `NONE`.
+    row_elim: Vec<u32>,
+    /// Per entry of a row with a local block: the index of its coupling block `B`.
+    b_index: Vec<u32>,
+    /// Per local block: the kept blocks it couples (sorted), `e_cols[e_start[e]..]`, and the
+    /// slots of their pairs (i <= j), `e_pair[e_pair_start[e]..]`.
+    e_start: Vec<u32>,
+    e_cols: Vec<u32>,
+    e_pair_start: Vec<u32>,
+    e_pair: Vec<u32>,
+}
+
+/// Reusable analysis and numeric storage of the block normal equations.
+#[derive(Default)]
+pub(crate) struct BlockNormal {
+    structure: Option<Structure>,
+    map: Option<RowMap>,
+    /// Per slot: the kept part `A` of `JᵀJ` (row-major 4 x 4, padded).
+    acc: Vec<[f64; 16]>,
+    /// Per local block: `C_e`, and `(C_e + μD_e)⁻¹` of the last factorisation.
+    c: Vec<Block>,
+    inv: Vec<Block>,
+    /// Coupling blocks `B` (kept components x local components).
+    b: Vec<Block>,
+    /// Scalar values of `A` and of the damped reduced matrix.
+    base: Vec<f64>,
+    values: Vec<f64>,
+    factored: bool,
+    /// Number of symbolic analyses made (for tests and benchmarks).
+    analyses: usize,
+}
+
+impl BlockNormal {
+    /// Whether the current analysis eliminates local blocks.
+    #[cfg(test)]
+    pub(crate) fn eliminates(&self) -> bool {
+        self.map.as_ref().is_some_and(|m| m.e_start.len() > 1)
+    }
+
+    /// Number of symbolic analyses so far.
+    pub(crate) fn analyses(&self) -> usize {
+        self.analyses
+    }
+
+    /// Makes sure the analysis fits the pattern of `sys` with local blocks `elim..` (ignored,
+    /// i.e. nothing eliminated, when a row touches two of them or nothing would be kept).
+    fn prepare(
+        &mut self,
+        sys: &BlockSystem,
+        layout: &BlockLayout,
+        elim: usize,
+    ) -> Result<(), SolverError> {
+        let nb = layout.num_blocks();
+        let mut elim = elim.min(nb);
+        if elim == 0 {
+            elim = nb;
+        }
+        if elim < nb {
+            let two = (0..sys.num_rows()).any(|r| {
+                sys.row(r)
+                    .iter()
+                    .filter(|e| e.block as usize >= elim)
+                    .count()
+                    > 1
+            });
+            if two {
+                elim = nb;
+            }
+        }
+        if let Some(m) = &self.map
+            && m.elim == elim
+            && m.pattern.same_pattern(sys)
+        {
+            return Ok(());
+        }
+        self.map = None;
+        let nk = elim;
+        // The block pairs of S, in the order the row map reads their slots back: the kept
+        // diagonals, every row's kept pairs, every local block's couplings.
+        let mut pairs: Vec<(u32, u32)> = (0..nk as u32).map(|b| (b, b)).collect();
+        let mut pair_start = Vec::with_capacity(sys.num_rows() + 1);
+        let mut row_elim = Vec::with_capacity(sys.num_rows());
+        let mut transposed = Vec::new();
+        let mut couplings: Vec<(u32, u32)> = Vec::new();
+        pair_start.push(0u32);
+        for r in 0..sys.num_rows() {
+            let row = sys.row(r);
+            let mut local = NONE;
+            for (i, a) in row.iter().enumerate() {
+                if a.block as usize >= nk {
+                    local = i as u32;
+                    continue;
+                }
+                for b in &row[i..] {
+                    if b.block as usize >= nk {
+                        continue;
+                    }
+                    transposed.push(b.block < a.block);
+                    pairs.push((a.block.min(b.block), a.block.max(b.block)));
+                }
+            }
+            if local != NONE {
+                let e = row[local as usize].block - nk as u32;
+                for a in row.iter().filter(|a| (a.block as usize) < nk) {
+                    couplings.push((e, a.block));
+                }
+            }
+            row_elim.push(local);
+            pair_start.push(transposed.len() as u32);
+        }
+        let ne = nb - nk;
+        couplings.sort_unstable();
+        couplings.dedup();
+        let mut e_start = vec![0u32; ne + 1];
+        for &(e, _) in &couplings {
+            e_start[e as usize + 1] += 1;
+        }
+        for e in 0..ne {
+            e_start[e + 1] += e_start[e];
+        }
+        let e_cols: Vec<u32> = couplings.iter().map(|p| p.1).collect();
+        let mut e_pair_start = vec![0u32];
+        let first_e_pair = pairs.len();
+        for e in 0..ne {
+            let cols = &e_cols[e_start[e] as usize..e_start[e + 1] as usize];
+            for (i, &ci) in cols.iter().enumerate() {
+                for &cj in &cols[i..] {
+                    pairs.push((ci, cj));
+                }
+            }
+            e_pair_start.push((pairs.len() - first_e_pair) as u32);
+        }
+        // Reuse the analysed structure if it holds every pair and this pattern fills it.
+        let reused = self.structure.as_ref().and_then(|s| {
+            if s.nk != nk {
+                return None;
+            }
+            let mut slots = Vec::with_capacity(pairs.len());
+            let mut used = vec![false; s.slots()];
+            for &(i, j) in &pairs {
+                let k = s.find(i, j)?;
+                used[k as usize] = true;
+                slots.push(k);
+            }
+            let filled = used.iter().filter(|&&u| u).count();
+            (10 * filled >= 9 * s.slots()).then_some(slots)
+        });
+        let slots = match reused {
+            Some(slots) => slots,
+            None => {
+                self.structure = None;
+                let (s, slots) = Structure::analyse(layout, nk, &pairs)?;
+                self.analyses += 1;
+                self.structure = Some(s);
+                slots
+            }
+        };
+        let diag_slot = slots[..nk].to_vec();
+        let row_pairs = &slots[nk..first_e_pair];
+        let pair_slot: Vec<u32> = row_pairs
+            .iter()
+            .zip(&transposed)
+            .map(|(&s, &t)| if t { s | TRANSPOSED } else { s })
+            .collect();
+        let e_pair = slots[first_e_pair..].to_vec();
+        let mut b_index = Vec::new();
+        for (r, &local) in row_elim.iter().enumerate() {
+            let row = sys.row(r);
+            if local == NONE {
+                b_index.extend(std::iter::repeat_n(NONE, row.len()));
+                continue;
+            }
+            let e = (row[local as usize].block as usize) - nk;
+            let (s, t) = (e_start[e] as usize, e_start[e + 1] as usize);
+            for a in row {
+                b_index.push(if (a.block as usize) < nk {
+                    let k = e_cols[s..t]
+                        .binary_search(&a.block)
+                        .expect("every coupling is listed");
+                    (s + k) as u32
+                } else {
+                    NONE
+                });
+            }
+        }
+        let st = self.structure.as_ref().expect("structure set above");
+        self.acc.clear();
+        self.acc.resize(st.slots(), [0.0; 16]);
+        self.c.clear();
+        self.c.resize(ne, Block::zeros());
+        self.inv.clear();
+        self.inv.resize(ne, Block::zeros());
+        self.b.clear();
+        self.b.resize(e_cols.len(), Block::zeros());
+        let nnz = st.chol.nnz();
+        self.base.clear();
+        self.base.resize(nnz, 0.0);
+        self.values.clear();
+        self.values.resize(nnz, 0.0);
+        self.factored = false;
+        let mut pattern = BlockSystem::default();
+        pattern.clone_from(sys);
+        self.map = Some(RowMap {
+            pattern,
+            elim: nk,
+            diag_slot,
+            pair_start,
+            pair_slot,
+            row_elim,
+            b_index,
+            e_start,
+            e_cols,
+            e_pair_start,
+            e_pair,
+        });
+        Ok(())
+    }
+
+    /// Assembles `JᵀJ` of `sys` (kept part, local blocks and couplings) and returns the
+    /// gradient `Jᵀr` and the diagonal of `JᵀJ`, both over all unknowns.
+    pub(crate) fn assemble(
+        &mut self,
+        sys: &BlockSystem,
+        layout: &BlockLayout,
+        elim: usize,
+    ) -> Result<(Vec<f64>, Vec<f64>), SolverError> {
+        self.prepare(sys, layout, elim)?;
+        let (map, st) = (
+            self.map.as_ref().expect("prepared"),
+            self.structure.as_ref().expect("prepared"),
+        );
+        let nk = map.elim;
+        let n = layout.num_variables();
+        let mut g = vec![0.0; n];
+        let mut diag = vec![0.0; n];
+        self.acc.fill([0.0; 16]);
+        self.c.fill(Block::zeros());
+        self.b.fill(Block::zeros());
+        let mut entry = 0usize;
+        for r in 0..sys.num_rows() {
+            let row = sys.row(r);
+            let res = sys.residuals[r];
+            let slots = &map.pair_slot[map.pair_start[r] as usize..map.pair_start[r + 1] as usize];
+            let mut p = 0;
+            for (i, a) in row.iter().enumerate() {
+                let o = layout.offset(a.block as usize);
+                for k in 0..layout.size(a.block as usize) {
+                    g[o + k] += a.grad[k] * res;
+                }
+                if a.block as usize >= nk {
+                    continue;
+                }
+                for b in &row[i..] {
+                    if b.block as usize >= nk {
+                        continue;
+                    }
+                    let s = slots[p];
+                    p += 1;
+                    if s & TRANSPOSED != 0 {
+                        add_outer(&mut self.acc[(s & !TRANSPOSED) as usize], &b.grad, &a.grad);
+                    } else {
+                        add_outer(&mut self.acc[s as usize], &a.grad, &b.grad);
+                    }
+                }
+            }
+            let local = map.row_elim[r];
+            if local != NONE {
+                let le = &row[local as usize];
+                let ge = vec4(&le.grad);
+                self.c[le.block as usize - nk].ger(1.0, &ge, &ge, 1.0);
+                for (i, a) in row.iter().enumerate() {
+                    let bi = map.b_index[entry + i];
+                    if bi != NONE {
+                        self.b[bi as usize].ger(1.0, &vec4(&a.grad), &ge, 1.0);
+                    }
+                }
+            }
+            entry += row.len();
+        }
+        for (b, &s) in map.diag_slot.iter().enumerate() {
+            let o = layout.offset(b);
+            for k in 0..layout.size(b) {
+                diag[o + k] = self.acc[s as usize][5 * k];
+            }
+        }
+        for (e, c) in self.c.iter().enumerate() {
+            let o = layout.offset(nk + e);
+            for k in 0..layout.size(nk + e) {
+                diag[o + k] = c[(k, k)];
+            }
+        }
+        let acc = self.acc.as_flattened();
+        for &(from, to) in &st.scatter {
+            self.base[to as usize] = acc[from as usize];
+        }
+        self.factored = false;
+        Ok((g, diag))
+    }
+
+    /// Factors the reduced matrix of the last assembly with damping `μ d` (`d` over all
+    /// unknowns). Fails when a damped local block or the reduced matrix is not positive
+    /// definite.
+    pub(crate) fn factor(
+        &mut self,
+        layout: &BlockLayout,
+        mu: f64,
+        d: &[f64],
+    ) -> Result<(), SolverError> {
+        self.factored = false;
+        let (map, st) = match (self.map.as_ref(), self.structure.as_mut()) {
+            (Some(m), Some(s)) => (m, s),
+            _ => {
+                return Err(SolverError::Factorization(
+                    "no assembled system to factor".into(),
+                ));
+            }
+        };
+        let nk = map.elim;
+        self.values.copy_from_slice(&self.base);
+        for (&at, &dv) in st.diag_pos.iter().zip(d) {
+            self.values[at as usize] += mu * dv;
+        }
+        let mut y: Vec<Block> = Vec::new();
+        for (e, c) in self.c.iter().enumerate() {
+            let (o, size) = (layout.offset(nk + e), layout.size(nk + e));
+            let mut ct = *c;
+            for k in 0..4 {
+                if k < size {
+                    ct[(k, k)] += mu * d[o + k];
+                } else {
+                    ct[(k, k)] = 1.0;
+                }
+            }
+            let inv = ct
+                .cholesky()
+                .ok_or_else(|| {
+                    SolverError::Factorization(format!("local block {e} is not positive definite"))
+                })?
+                .inverse();
+            let (s, t) = (map.e_start[e] as usize, map.e_start[e + 1] as usize);
+            let bs = &self.b[s..t];
+            y.clear();
+            y.extend(bs.iter().map(|b| b * inv));
+            let mut q = map.e_pair_start[e] as usize;
+            for (i, yi) in y.iter().enumerate() {
+                for bj in &bs[i..] {
+                    let slot = map.e_pair[q] as usize;
+                    q += 1;
+                    let prod = yi * bj.transpose();
+                    let pos = &st.val_pos[slot * 16..slot * 16 + 16];
+                    for (w, &at) in pos.iter().enumerate() {
+                        if at != NONE {
+                            self.values[at as usize] -= prod[(w / 4, w % 4)];
+                        }
+                    }
+                }
+            }
+            self.inv[e] = inv;
+        }
+        st.chol.factorize(&self.values)?;
+        self.factored = true;
+        Ok(())
+    }
+
+    /// Solves `(JᵀJ + μD) h = -g` with the last factorisation (any `g` over all unknowns;
+    /// [`Self::factor`] must have succeeded since the last assembly).
+    pub(crate) fn solve(
+        &mut self,
+        layout: &BlockLayout,
+        g: &[f64],
+    ) -> Result<Vec<f64>, SolverError> {
+        let (map, st) = match (self.map.as_ref(), self.structure.as_mut()) {
+            (Some(m), Some(s)) if self.factored => (m, s),
+            _ => {
+                return Err(SolverError::Factorization(
+                    "no factorisation to solve with".into(),
+                ));
+            }
+        };
+        let nk = map.elim;
+        let local = |e: usize, v: &[f64]| {
+            let (o, size) = (layout.offset(nk + e), layout.size(nk + e));
+            let mut w = Vector4::zeros();
+            for k in 0..size {
+                w[k] = v[o + k];
+            }
+            w
+        };
+        let nkv = layout.offset(nk);
+        let mut h: Vec<f64> = g[..nkv].iter().map(|v| -v).collect();
+        for (e, inv) in self.inv.iter().enumerate() {
+            let y = inv * local(e, g);
+            for bi in map.e_start[e] as usize..map.e_start[e + 1] as usize {
+                let a = map.e_cols[bi] as usize;
+                let by = self.b[bi] * y;
+                let o = layout.offset(a);
+                for k in 0..layout.size(a) {
+                    h[o + k] += by[k];
+                }
+            }
+        }
+        st.chol.solve_in_place(&mut h)?;
+        h.resize(g.len(), 0.0);
+        for (e, inv) in self.inv.iter().enumerate() {
+            let mut t = -local(e, g);
+            for bi in map.e_start[e] as usize..map.e_start[e + 1] as usize {
+                let a = map.e_cols[bi] as usize;
+                let o = layout.offset(a);
+                let mut ha = Vector4::zeros();
+                for k in 0..layout.size(a) {
+                    ha[k] = h[o + k];
+                }
+                t -= self.b[bi].transpose() * ha;
+            }
+            let he = inv * t;
+            let o = layout.offset(nk + e);
+            for k in 0..layout.size(nk + e) {
+                h[o + k] = he[k];
+            }
+        }
+        if h.iter().all(|v| v.is_finite()) {
+            Ok(h)
+        } else {
+            Err(SolverError::Factorization(
+                "the solve produced non-finite values (singular matrix)".into(),
+            ))
+        }
+    }
+}
