@@ -274,17 +274,17 @@ struct BlockRows<'a> {
 }
 
 impl Rows for BlockRows<'_> {
-    #[inline]
+    #[inline(always)]
     fn row(&mut self, value: f64) {
         self.sys.push_row(value);
     }
-    #[inline]
+    #[inline(always)]
     fn set_value(&mut self, value: f64) {
         if let Some(r) = self.sys.residuals.last_mut() {
             *r = value;
         }
     }
-    #[inline]
+    #[inline(always)]
     fn add(&mut self, var: u32, g: [f64; 4]) {
         self.sys.add(self.terms.block_of_var(var), g);
     }
@@ -343,7 +343,7 @@ impl Problem<'_> {
     }
 
     /// Adds the gradient `g` with respect to vertex `v` (nothing for a fixed vertex).
-    #[inline]
+    #[inline(always)]
     fn emit<O: Rows>(&self, out: &mut O, v: u32, g: Vec3) {
         let b = self.terms.var_of[v as usize];
         if b != NONE {

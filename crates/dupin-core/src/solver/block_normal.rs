@@ -61,13 +61,12 @@ struct Structure {
     /// Block CSC of the upper triangle (block row <= block column, rows sorted).
     col_ptr: Vec<u32>,
     row_blk: Vec<u32>,
-    /// Per block slot, 16 positions (row-major 4 x 4) of its scalar entries in the values
-    /// `chol` factors (`NONE` outside the blocks' sizes and below a diagonal block's diagonal).
-    val_pos: Vec<u32>,
     /// Position of each kept unknown's diagonal entry.
     diag_pos: Vec<u32>,
-    /// Every scalar entry as (index into the slots' flattened 4 x 4 blocks, position).
+    /// Every scalar entry as (index into the slots' flattened 4 x 4 blocks, position), in
+    /// slot order: slot `s` owns `scatter[slot_start[s]..slot_start[s + 1]]`.
     scatter: Vec<(u32, u32)>,
+    slot_start: Vec<u32>,
     chol: SparseCholesky,
 }
 
@@ -141,6 +140,9 @@ impl Structure {
         }
         let chol = SparseCholesky::analyse(upper.as_ref(), &fwd)?;
         let positions = chol.positions();
+        // Per block slot, the positions (row-major 4 x 4) of its scalar entries in the values
+        // `chol` factors (`NONE` outside the blocks' sizes and below a diagonal block's
+        // diagonal).
         let val_pos: Vec<u32> = entry_of
             .iter()
             .map(|&e| {
@@ -151,12 +153,16 @@ impl Structure {
                 }
             })
             .collect();
-        let scatter = val_pos
-            .iter()
-            .enumerate()
-            .filter(|&(_, &p)| p != NONE)
-            .map(|(q, &p)| (q as u32, p))
-            .collect();
+        let mut scatter = Vec::new();
+        let mut slot_start = vec![0u32];
+        for (s, pos) in val_pos.chunks(16).enumerate() {
+            for (w, &p) in pos.iter().enumerate() {
+                if p != NONE {
+                    scatter.push(((s * 16 + w) as u32, p));
+                }
+            }
+            slot_start.push(scatter.len() as u32);
+        }
         let mut diag_pos = vec![NONE; n];
         for j in 0..nk {
             let s = col_ptr[j + 1] as usize - 1; // the diagonal block ends its column
@@ -170,9 +176,9 @@ impl Structure {
                 nk,
                 col_ptr,
                 row_blk,
-                val_pos,
                 diag_pos,
                 scatter,
+                slot_start,
                 chol,
             },
             slots,
@@ -210,6 +216,8 @@ pub(crate) struct BlockNormal {
     map: Option<RowMap>,
     /// Per slot: the kept part `A` of `JᵀJ` (row-major 4 x 4, padded).
     acc: Vec<[f64; 16]>,
+    /// Per block: its part of the gradient `Jᵀr` (padded).
+    gblk: Vec<[f64; MAX_BLOCK]>,
     /// Per local block: `C_e`, and `(C_e + μD_e)⁻¹` of the last factorisation.
     c: Vec<Block>,
     inv: Vec<Block>,
@@ -427,6 +435,8 @@ impl BlockNormal {
         let mut g = vec![0.0; n];
         let mut diag = vec![0.0; n];
         self.acc.fill([0.0; 16]);
+        self.gblk.clear();
+        self.gblk.resize(layout.num_blocks(), [0.0; MAX_BLOCK]);
         self.c.fill(Block::zeros());
         self.b.fill(Block::zeros());
         let mut entry = 0usize;
@@ -436,9 +446,8 @@ impl BlockNormal {
             let slots = &map.pair_slot[map.pair_start[r] as usize..map.pair_start[r + 1] as usize];
             let mut p = 0;
             for (i, a) in row.iter().enumerate() {
-                let o = layout.offset(a.block as usize);
-                for k in 0..layout.size(a.block as usize) {
-                    g[o + k] += a.grad[k] * res;
+                for (gk, ak) in self.gblk[a.block as usize].iter_mut().zip(a.grad) {
+                    *gk += ak * res;
                 }
                 if a.block as usize >= nk {
                     continue;
@@ -469,6 +478,10 @@ impl BlockNormal {
                 }
             }
             entry += row.len();
+        }
+        for (b, gb) in self.gblk.iter().enumerate() {
+            let o = layout.offset(b);
+            g[o..o + layout.size(b)].copy_from_slice(&gb[..layout.size(b)]);
         }
         for (b, &s) in map.diag_slot.iter().enumerate() {
             let o = layout.offset(b);
@@ -539,12 +552,12 @@ impl BlockNormal {
                 for bj in &bs[i..] {
                     let slot = map.e_pair[q] as usize;
                     q += 1;
-                    let prod = yi * bj.transpose();
-                    let pos = &st.val_pos[slot * 16..slot * 16 + 16];
-                    for (w, &at) in pos.iter().enumerate() {
-                        if at != NONE {
-                            self.values[at as usize] -= prod[(w / 4, w % 4)];
-                        }
+                    // (Y_i B_jᵀ)ᵀ in nalgebra's column-major order is Y_i B_jᵀ row-major.
+                    let prod = bj * yi.transpose();
+                    let prod = prod.as_slice();
+                    let range = st.slot_start[slot] as usize..st.slot_start[slot + 1] as usize;
+                    for &(q, at) in &st.scatter[range] {
+                        self.values[at as usize] -= prod[q as usize & 15];
                     }
                 }
             }

@@ -75,6 +75,8 @@ pub(crate) struct BlockSystem {
     /// Row `r` owns `entries[row_end[r - 1]..row_end[r]]` (`row_end[-1]` = 0).
     row_end: Vec<u32>,
     entries: Vec<BlockEntry>,
+    /// Number of entries of the current (last) row.
+    current_len: usize,
 }
 
 impl BlockSystem {
@@ -83,6 +85,7 @@ impl BlockSystem {
         self.residuals.clear();
         self.row_end.clear();
         self.entries.clear();
+        self.current_len = 0;
     }
 
     /// Starts a new residual row with the given value.
@@ -90,18 +93,24 @@ impl BlockSystem {
     pub(crate) fn push_row(&mut self, value: f64) {
         self.residuals.push(value);
         self.row_end.push(self.entries.len() as u32);
+        self.current_len = 0;
     }
 
     /// Adds `grad` to the gradient of the current row with respect to `block`.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn add(&mut self, block: u32, grad: [f64; MAX_BLOCK]) {
-        let start = self.row_start(self.row_end.len() - 1);
-        if let Some(e) = self.entries[start..].iter_mut().find(|e| e.block == block) {
+        let start = self.row_end.last().map_or(0, |&e| e as usize) - self.current_len;
+        if let Some(e) = self.entries[start..]
+            .iter_mut()
+            .rev()
+            .find(|e| e.block == block)
+        {
             for (a, b) in e.grad.iter_mut().zip(grad) {
                 *a += b;
             }
         } else {
             self.entries.push(BlockEntry { block, grad });
+            self.current_len += 1;
             *self.row_end.last_mut().expect("a row was started") += 1;
         }
     }
@@ -143,12 +152,15 @@ impl BlockSystem {
 
     /// Checks that every value is finite and every block exists in `layout`.
     pub(crate) fn validate(&self, layout: &BlockLayout) -> Result<(), SolverError> {
-        if !self.residuals.iter().all(|r| r.is_finite())
-            || !self
-                .entries
-                .iter()
-                .all(|e| e.grad.iter().all(|g| g.is_finite()))
-        {
+        // v * 0 is 0 for finite v and NaN otherwise: one branch-free pass over the values.
+        let mut zero = 0.0;
+        for r in &self.residuals {
+            zero += r * 0.0;
+        }
+        for e in &self.entries {
+            zero += e.grad[0] * 0.0 + e.grad[1] * 0.0 + e.grad[2] * 0.0 + e.grad[3] * 0.0;
+        }
+        if zero != 0.0 {
             return Err(SolverError::NonFinite);
         }
         let nb = layout.num_blocks();
@@ -218,6 +230,7 @@ impl BlockSystem {
                     grad[comp as usize] = e.value;
                     seen[b as usize] = (r as u32, self.entries.len() as u32 - row_start);
                     self.entries.push(BlockEntry { block: b, grad });
+                    self.current_len += 1;
                     *self.row_end.last_mut().expect("row pushed") += 1;
                 }
             }
