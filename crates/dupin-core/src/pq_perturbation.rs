@@ -261,6 +261,11 @@ struct Problem<'a> {
 trait Rows {
     /// Starts a row with the given value.
     fn row(&mut self, value: f64);
+    /// Starts a row whose vertex gradients all point along coordinate `axis`.
+    fn axis_row(&mut self, value: f64, axis: u8) {
+        let _ = axis;
+        self.row(value);
+    }
     /// Sets the value of the current row.
     fn set_value(&mut self, value: f64);
     /// Adds `g` (3 components for a vertex, 4 for a plane) to the current row's gradient
@@ -277,6 +282,10 @@ impl Rows for BlockRows<'_> {
     #[inline(always)]
     fn row(&mut self, value: f64) {
         self.sys.push_row(value);
+    }
+    #[inline(always)]
+    fn axis_row(&mut self, value: f64, axis: u8) {
+        self.sys.push_axis_row(value, axis);
     }
     #[inline(always)]
     fn set_value(&mut self, value: f64) {
@@ -444,7 +453,7 @@ impl Problem<'_> {
                     val += c * self.pos(x, v);
                 }
                 for k in 0..3 {
-                    out.row(s * val[k]);
+                    out.axis_row(s * val[k], k as u8);
                     for &(v, c) in st {
                         let mut g = Vec3::zeros();
                         g[k] = s * c;

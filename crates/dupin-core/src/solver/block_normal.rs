@@ -444,6 +444,7 @@ impl BlockNormal {
             let row = sys.row(r);
             let res = sys.residuals[r];
             let slots = &map.pair_slot[map.pair_start[r] as usize..map.pair_start[r + 1] as usize];
+            let axis = sys.row_axis(r) as usize;
             let mut p = 0;
             for (i, a) in row.iter().enumerate() {
                 for (gk, ak) in self.gblk[a.block as usize].iter_mut().zip(a.grad) {
@@ -458,7 +459,11 @@ impl BlockNormal {
                     }
                     let s = slots[p];
                     p += 1;
-                    if s & TRANSPOSED != 0 {
+                    if axis < MAX_BLOCK {
+                        // Only component (axis, axis) of the product is nonzero.
+                        self.acc[(s & !TRANSPOSED) as usize][5 * axis] +=
+                            a.grad[axis] * b.grad[axis];
+                    } else if s & TRANSPOSED != 0 {
                         add_outer(&mut self.acc[(s & !TRANSPOSED) as usize], &b.grad, &a.grad);
                     } else {
                         add_outer(&mut self.acc[s as usize], &a.grad, &b.grad);

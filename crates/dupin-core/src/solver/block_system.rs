@@ -14,6 +14,9 @@ use super::{SolverError, SparseSystem};
 /// Largest block size (a face plane: unit normal and offset).
 pub(crate) const MAX_BLOCK: usize = 4;
 
+/// [`BlockSystem::row_axis`] of a row with general gradients.
+pub(crate) const ANY_AXIS: u8 = u8::MAX;
+
 /// Sizes and positions of the variable blocks: block `b` holds the variables
 /// `offset(b)..offset(b) + size(b)` of the flat unknown vector.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -75,6 +78,9 @@ pub(crate) struct BlockSystem {
     /// Row `r` owns `entries[row_end[r - 1]..row_end[r]]` (`row_end[-1]` = 0).
     row_end: Vec<u32>,
     entries: Vec<BlockEntry>,
+    /// Per row: `k` if every gradient of the row has only component `k` (a coordinate row of
+    /// a Laplacian-type term), else [`ANY_AXIS`]; lets the assembly skip the zero products.
+    row_axis: Vec<u8>,
     /// Number of entries of the current (last) row.
     current_len: usize,
 }
@@ -85,15 +91,30 @@ impl BlockSystem {
         self.residuals.clear();
         self.row_end.clear();
         self.entries.clear();
+        self.row_axis.clear();
         self.current_len = 0;
     }
 
     /// Starts a new residual row with the given value.
     #[inline]
     pub(crate) fn push_row(&mut self, value: f64) {
+        self.push_axis_row(value, ANY_AXIS);
+    }
+
+    /// Starts a row whose gradients will all have only component `axis` nonzero (the
+    /// caller's promise; [`ANY_AXIS`] for none).
+    #[inline]
+    pub(crate) fn push_axis_row(&mut self, value: f64, axis: u8) {
         self.residuals.push(value);
         self.row_end.push(self.entries.len() as u32);
+        self.row_axis.push(axis);
         self.current_len = 0;
+    }
+
+    /// See [`Self::push_axis_row`].
+    #[inline]
+    pub(crate) fn row_axis(&self, r: usize) -> u8 {
+        self.row_axis[r]
     }
 
     /// Adds `grad` to the gradient of the current row with respect to `block`.
