@@ -27,7 +27,7 @@
 //!
 //! Cost: the rules are pure functions of the hierarchy, evaluated per hexagon in O(1) expected
 //! hash look-ups. After a wave of splits the next pass evaluates only the hexagons the splits
-//! can affect (found from the splits, and an index of occupied hexagons by lattice block), so
+//! can affect (found from the splits, and the refinement's tiled set of occupied cells), so
 //! the passes together cost O(S) for S splits; a full pass over all leaves, O(T) for T
 //! triangles, starts and ends the run (a few in all: one more each time it finds something
 //! the incremental passes left).
@@ -36,7 +36,7 @@ use super::dual::{Key, pack};
 use super::error::HexDelaunayError;
 use super::fin_vertices::{FinPatch, Run, run_patch, top_new};
 use super::hierarchy::{Cell, HexSet, Hierarchy};
-use super::lattice::{Axial, DIRS, add, hex_norm, in_domain, on_boundary, parents_of_midpoint};
+use super::lattice::{Axial, DIRS, add, in_domain, on_boundary};
 use super::simple_refinement::Refinement;
 use crate::math::Vec2;
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -44,30 +44,28 @@ use std::sync::Mutex;
 
 const SQRT3: f64 = 1.732_050_807_568_877_2;
 
-/// Calls `f(level, v)` for every leaf full hexagon.
-fn for_each_leaf(h: &Hierarchy, mut f: impl FnMut(u32, Axial)) {
-    if h.depth() == 0 {
-        f(0, (0, 0));
-        return;
-    }
-    for k in 0..h.depth() {
+/// Calls `f(level, v)` once for every leaf full hexagon with a fin (an unsplit full hexagon
+/// with a split neighbour of its level), found from the split hexagons: balancing makes every
+/// neighbour of a split hexagon present, so the unsplit ones are these leaves. Each is reported
+/// from its first split neighbour in `DIRS` order. Only these leaves can be marked or moved by
+/// a fin (a leaf without fins moves only in a ring or as a run's top), and they are about a
+/// tenth of all leaves on the uniform sets.
+fn for_each_fin_leaf(h: &Hierarchy, mut f: impl FnMut(u32, Axial)) {
+    // Level 0 is the root alone: no neighbours.
+    for k in 1..h.depth() {
         for x in h.split_at(k) {
-            let c = (2 * x.0, 2 * x.1);
-            if !h.is_split(k + 1, c) {
-                f(k + 1, c);
-            }
-            // `c + d` is the midpoint of `x` (split) and `x + d`: present when `x + d` is split
-            // or outside Ω, read for all six from one tile (what `is_present` would ask).
             let split = h.split_neighbours(k, x);
+            if split == 0x3f {
+                continue;
+            }
             for (j, d) in DIRS.iter().enumerate() {
-                let m = add(c, *d);
-                let present = split & (1 << j) != 0 || !in_domain(k, add(x, *d));
-                if !in_domain(k + 1, m) || !present || h.is_split(k + 1, m) {
+                let y = add(x, *d);
+                if split & (1 << j) != 0 || !in_domain(k, y) {
                     continue;
                 }
-                let (a, _) = parents_of_midpoint(m);
-                if a == x || !in_domain(k, a) {
-                    f(k + 1, m);
+                // `x` is `y + DIRS[j + 3]`.
+                if h.split_neighbours(k, y).trailing_zeros() as usize == (j + 3) % 6 {
+                    f(k, y);
                 }
             }
         }
@@ -234,6 +232,17 @@ enum Leaf {
     Fins,
 }
 
+/// The ring roles of a pass's analysed occupied hexagons.
+#[derive(Default)]
+struct Rings {
+    /// The hexagons in the 1-ring of an occupied hexagon or the 2-ring of an OCCUPIED_2 (and
+    /// the occupied ones), tiled: most queries are for hexagons in no ring.
+    member: HexSet,
+    /// The shift of each hexagon in the moved 1-ring of an OCCUPIED_2 (moved 1-rings never
+    /// overlap: two OCCUPIED_2 two steps apart are split).
+    moved: FxHashMap<(u32, Axial), Vec2>,
+}
+
 /// Hexagons as (level, centre).
 type Hexes = Vec<(u32, Axial)>;
 
@@ -249,9 +258,9 @@ struct Pass<'a> {
     /// The PSLG's segments (point index pairs); runs stay away from them (section 7.2).
     segments: &'a [[u32; 2]],
     occupied: FxHashMap<(u32, Axial), Occupied>,
-    /// In a full pass, once every occupied hexagon is analysed: the ring hexagons, with the
-    /// shift of a moved 1-ring (so a leaf asks one map instead of its 18 neighbours).
-    rings: Option<FxHashMap<(u32, Axial), Option<Vec2>>>,
+    /// Once the pass's occupied hexagons are analysed: the ring hexagons, with the shift of a
+    /// moved 1-ring (so a leaf asks one tile instead of its 18 neighbours).
+    rings: Option<Rings>,
     split: FxHashSet<(u32, Axial)>,
     present: FxHashSet<(u32, Axial)>,
     /// The verdicts on MOVED_CENTER_3 runs, by top, and the accepted runs' patches.
@@ -360,7 +369,10 @@ impl<'a> Pass<'a> {
     /// The shift of `v` at level `k` if it lies in the moved 1-ring of an OCCUPIED_2.
     fn ring1_moved(&mut self, k: u32, v: Axial) -> Option<Vec2> {
         if let Some(rings) = &self.rings {
-            return rings.get(&(k, v)).copied().flatten();
+            if !rings.member.contains(k, v) {
+                return None;
+            }
+            return rings.moved.get(&(k, v)).copied();
         }
         for z in ring(v, 1) {
             if let Some(Occupied::Rings {
@@ -380,7 +392,7 @@ impl<'a> Pass<'a> {
             return true;
         }
         if let Some(rings) = &self.rings {
-            return rings.contains_key(&(k, v));
+            return rings.member.contains(k, v);
         }
         for dist in 1..=2 {
             for z in ring(v, dist) {
@@ -633,12 +645,9 @@ impl<'a> Pass<'a> {
         Leaf::Moved(c + (target - c) * w)
     }
 
-    /// Visits the leaf `v` at level `k`: marks it when a rule splits it. Without `position`,
-    /// a leaf without fins (which no rule splits) is not looked at further.
-    fn visit(&mut self, k: u32, v: Axial, position: bool) -> Leaf {
-        if !position && fin_mask(&self.r.hierarchy, k, v) == 0 {
-            return Leaf::Fixed;
-        }
+    /// Visits the leaf `v` at level `k` (one with fins: no rule splits the others): marks it
+    /// when a rule splits it.
+    fn visit(&mut self, k: u32, v: Axial) -> Leaf {
         let l = self.leaf(k, v);
         if l == Leaf::Split {
             self.split.insert((k, v));
@@ -698,19 +707,15 @@ impl<'a> Pass<'a> {
     /// a full pass; in an incremental pass those near the changes, so a role may be missed:
     /// that only keeps a leaf from being marked, which a later pass catches).
     fn freeze_rings(&mut self) {
-        let mut rings: FxHashMap<(u32, Axial), Option<Vec2>> = FxHashMap::default();
+        let mut rings = Rings::default();
         for (&(k, x), o) in &self.occupied {
             if let Occupied::Rings { occ2, shift, .. } = *o {
-                for z in ring(x, 1) {
-                    // A moved 1-ring's shift wins over a fixed ring membership.
-                    let e = rings.entry((k, z)).or_insert(None);
-                    if occ2 {
-                        *e = Some(shift);
-                    }
-                }
+                // `x` itself is occupied: in a ring for `in_some_ring` anyway, and in no moved
+                // 1-ring (occupied hexagons are never adjacent).
+                rings.member.insert_disc(k, x, if occ2 { 2 } else { 1 });
                 if occ2 {
-                    for z in ring(x, 2) {
-                        rings.entry((k, z)).or_insert(None);
+                    for z in ring(x, 1) {
+                        rings.moved.insert((k, z), shift);
                     }
                 }
             }
@@ -728,7 +733,8 @@ impl<'a> Pass<'a> {
     }
 }
 
-/// A full pass: every occupied hexagon and every leaf. Returns the marks and the relocations.
+/// A full pass: every occupied hexagon and every leaf with fins (no rule marks a leaf without
+/// fins). Returns the marks and the relocations (meaningful when nothing is marked).
 fn full_pass(r: &Refinement, segments: &[[u32; 2]]) -> (Marks, Relocation) {
     let mut pass = Pass::new(r, segments);
     for c in &r.cell_of {
@@ -738,11 +744,18 @@ fn full_pass(r: &Refinement, segments: &[[u32; 2]]) -> (Marks, Relocation) {
     }
     pass.freeze_rings();
     let mut moved: FxHashMap<Key, Vec2> = FxHashMap::default();
-    for_each_leaf(&r.hierarchy, |k, v| {
-        if let Leaf::Moved(p) = pass.visit(k, v, true) {
+    for_each_fin_leaf(&r.hierarchy, |k, v| {
+        if let Leaf::Moved(p) = pass.visit(k, v) {
             moved.insert(pack(k, v), p);
         }
     });
+    // The leaves without fins that move: the moved 1-rings of the OCCUPIED_2 (with nothing
+    // marked these are leaves without fins: a ring leaf with fins is split) and the runs' tops
+    // (set from the patches below).
+    let f = &r.hierarchy.frame;
+    for (&(k, z), s) in &pass.rings.as_ref().expect("frozen rings").moved {
+        moved.insert(pack(k, z), f.position(k, z) + s);
+    }
     // The accepted runs, in the order of their tops (deterministic vertex numbering).
     let mut accepted: Vec<((u32, Axial), usize)> = pass
         .runs
@@ -778,65 +791,6 @@ pub struct Relocation {
     pub patches: Vec<FinPatch>,
 }
 
-/// Side of the square blocks of lattice coordinates (as a shift) that index the occupied
-/// hexagons of a level, to find those near a change without scanning all points.
-const BLOCK: u32 = 3;
-
-/// The occupied hexagons per level and block of lattice coordinates. Entries go stale when a
-/// point leaves its cell (dropped on use); new ones are added for the children of every split.
-#[derive(Debug, Clone, Default)]
-struct OccupiedIndex {
-    blocks: FxHashMap<(u32, Axial), Vec<Axial>>,
-}
-
-impl OccupiedIndex {
-    fn rebuild(&mut self, r: &Refinement) {
-        self.blocks.clear();
-        for c in &r.cell_of {
-            if let Cell::Full(k, x) = *c {
-                self.add(k, x);
-            }
-        }
-    }
-
-    fn add(&mut self, k: u32, x: Axial) {
-        let b = self
-            .blocks
-            .entry((k, (x.0 >> BLOCK, x.1 >> BLOCK)))
-            .or_default();
-        if !b.contains(&x) {
-            b.push(x);
-        }
-    }
-
-    /// Records the occupied children of the split hexagon `x` at level `k`.
-    fn after_split(&mut self, r: &Refinement, k: u32, x: Axial) {
-        for z in disc((2 * x.0, 2 * x.1), 1) {
-            if r.point_in(k + 1, z).is_some() {
-                self.add(k + 1, z);
-            }
-        }
-    }
-
-    /// Calls `f` for every occupied hexagon of level `k` within hexagonal distance `rad` of
-    /// `c` (dropping stale entries on the way).
-    fn near(&mut self, r: &Refinement, k: u32, c: Axial, rad: i64, mut f: impl FnMut(Axial)) {
-        for bx in (c.0 - rad) >> BLOCK..=(c.0 + rad) >> BLOCK {
-            for by in (c.1 - rad) >> BLOCK..=(c.1 + rad) >> BLOCK {
-                let Some(b) = self.blocks.get_mut(&(k, (bx, by))) else {
-                    continue;
-                };
-                b.retain(|&x| r.point_in(k, x).is_some());
-                for &x in b.iter() {
-                    if hex_norm((x.0 - c.0, x.1 - c.1)) <= rad {
-                        f(x);
-                    }
-                }
-            }
-        }
-    }
-}
-
 /// What an incremental pass visits after the splits `changes`.
 ///
 /// Leaves: only a leaf with fins can be marked, so a split of `(k, x)` matters to the leaves
@@ -850,12 +804,10 @@ impl OccupiedIndex {
 /// a waived ring conflict, the relocations of the 2-ring (fins one step further, fin-side
 /// hexagons one level finer); the leaves read their rings. Those within eight steps at levels
 /// `k` and `k + 1` (from `2x`) and six at level `k - 1` are re-run and give the ring roles.
-fn affected(r: &Refinement, index: &mut OccupiedIndex, changes: &[(u32, Axial)]) -> (Hexes, Hexes) {
+fn affected(r: &Refinement, changes: &[(u32, Axial)]) -> (HexSet, HexSet) {
     let mut leaves = HexSet::default();
-    let mut occupied: FxHashSet<(u32, Axial)> = FxHashSet::default();
-    for &(k, x) in changes {
-        index.after_split(r, k, x);
-    }
+    let mut occupied = HexSet::default();
+    let occ = r.occupied_full();
     for &(k, x) in changes {
         let c = (2 * x.0, 2 * x.1);
         leaves.insert_disc(k, x, 2);
@@ -863,52 +815,46 @@ fn affected(r: &Refinement, index: &mut OccupiedIndex, changes: &[(u32, Axial)])
         if k >= 1 {
             let half = (x.0.div_euclid(2), x.1.div_euclid(2));
             leaves.insert_disc(k - 1, half, 2);
-            index.near(r, k - 1, half, 6, |o| {
-                occupied.insert((k - 1, o));
+            occ.for_each_in_disc(k - 1, half, 6, |o| {
+                occupied.insert(k - 1, o);
             });
         }
-        index.near(r, k, x, 8, |o| {
-            occupied.insert((k, o));
+        occ.for_each_in_disc(k, x, 8, |o| {
+            occupied.insert(k, o);
         });
-        index.near(r, k + 1, c, 8, |o| {
-            occupied.insert((k + 1, o));
+        occ.for_each_in_disc(k + 1, c, 8, |o| {
+            occupied.insert(k + 1, o);
         });
     }
     // The order of the visits does not matter (the rules read the state, not the marks).
-    (leaves.iter().collect(), occupied.into_iter().collect())
+    (leaves, occupied)
 }
 
 /// An incremental pass over the given leaves and occupied hexagons.
-fn region_pass(
-    r: &Refinement,
-    segments: &[[u32; 2]],
-    leaves: &[(u32, Axial)],
-    occupied: &[(u32, Axial)],
-) -> Marks {
+fn region_pass(r: &Refinement, segments: &[[u32; 2]], leaves: &HexSet, occupied: &HexSet) -> Marks {
     let h = &r.hierarchy;
     let mut pass = Pass::new(r, segments);
-    for &(k, x) in occupied {
+    for (k, x) in occupied.iter() {
         pass.visit_occupied(k, x);
     }
     pass.freeze_rings();
-    for &(k, v) in leaves {
+    for (k, v) in leaves.iter() {
         // Only a leaf with fins can be marked; the fins are the cheapest test.
         if !h.is_split(k, v) && fin_mask(h, k, v) != 0 && h.is_present(k, v) {
-            pass.visit(k, v, true);
+            pass.visit(k, v);
         }
     }
     pass.marks()
 }
 
 /// The state between extended passes: the splits since the last pass (`None`: the next pass
-/// is a full one) and the index of occupied hexagons. After splits a pass classifies only the
-/// hexagons near them (a work queue of affected hexagons, one pass per wave of splits). A run
-/// ends only after a full pass finds nothing, so the result is a fixed point of the full
-/// rules, at O(changes) cost per incremental pass.
+/// is a full one). After splits a pass classifies only the hexagons near them (a work queue
+/// of affected hexagons, one pass per wave of splits). A run ends only after a full pass finds
+/// nothing, so the result is a fixed point of the full rules, at O(changes) cost per
+/// incremental pass.
 #[derive(Debug, Default)]
 pub struct ExtendedState {
     changes: Option<Vec<(u32, Axial)>>,
-    index: OccupiedIndex,
     /// The relocations of the last full pass that found nothing, with the split count and
     /// number of points it saw: the dual takes them instead of a further full pass. Taken
     /// from behind `&self` (a Mutex, not a RefCell, keeps the stepper `Sync`) so that they
@@ -920,7 +866,6 @@ impl Clone for ExtendedState {
     fn clone(&self) -> Self {
         ExtendedState {
             changes: self.changes.clone(),
-            index: self.index.clone(),
             relocation: Mutex::new(lock(&self.relocation).clone()),
         }
     }
@@ -967,11 +912,10 @@ pub fn extended_pass(
         let full = state.changes.is_none();
         let (split, present) = match state.changes.take() {
             Some(changes) => {
-                let (leaves, occupied) = affected(r, &mut state.index, &changes);
+                let (leaves, occupied) = affected(r, &changes);
                 region_pass(r, segments, &leaves, &occupied)
             }
             None => {
-                state.index.rebuild(r);
                 let (marks, relocation) = full_pass(r, segments);
                 if marks.0.is_empty() && marks.1.is_empty() {
                     // The fixed point: these are the dual's relocations.

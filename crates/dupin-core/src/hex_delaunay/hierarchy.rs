@@ -271,6 +271,14 @@ impl HexSet {
         }
     }
 
+    /// Calls `f` for every member of `level` within hexagonal distance `r` of `c`, a tile at a
+    /// time (a few tile reads instead of one query per lattice point).
+    pub fn for_each_in_disc(&self, level: u32, c: Axial, r: i64, f: impl FnMut(Axial)) {
+        if let Some(s) = self.levels.get(level as usize) {
+            s.for_each_in_disc(c, r, f);
+        }
+    }
+
     /// Removes `v` at `level`.
     pub fn remove(&mut self, level: u32, v: Axial) {
         if let Some(s) = self.levels.get_mut(level as usize)
@@ -465,6 +473,38 @@ impl TileSet {
         new
     }
 
+    /// Calls `f` for every member within hexagonal distance `r` of `c`: per tile of the disc's
+    /// bounding box, the disc's part of each row is one mask on the tile's row of 16 bits.
+    fn for_each_in_disc(&self, c: Axial, r: i64, mut f: impl FnMut(Axial)) {
+        let (a0, a1, b0, b1) = (c.0 - r, c.0 + r, c.1 - r, c.1 + r);
+        for ta in a0 >> TILE..=a1 >> TILE {
+            for tb in b0 >> TILE..=b1 >> TILE {
+                let i = self.tile((ta, tb));
+                if i == NONE {
+                    continue;
+                }
+                let w = &self.words[i as usize];
+                let (base_a, base_b) = (ta << TILE, tb << TILE);
+                for a in a0.max(base_a)..=a1.min(base_a | TILE_MASK) {
+                    // The disc's row `a`: b - c.1 in [max(-r, -i - r), min(r, -i + r)].
+                    let i = a - c.0;
+                    let lo = (c.1 + (-r).max(-i - r)).max(base_b);
+                    let hi = (c.1 + r.min(-i + r)).min(base_b | TILE_MASK);
+                    if lo > hi {
+                        continue;
+                    }
+                    let row = (a & TILE_MASK) as usize;
+                    let bits = (w[row >> 2] >> ((row & 3) << TILE)) & 0xffff;
+                    let mut m = bits & (((1u64 << (hi - lo + 1)) - 1) << (lo & TILE_MASK));
+                    while m != 0 {
+                        f((a, base_b | i64::from(m.trailing_zeros())));
+                        m &= m - 1;
+                    }
+                }
+            }
+        }
+    }
+
     /// Removes `v` (an emptied tile stays, as an all-zero entry); returns whether it was in.
     fn remove(&mut self, v: Axial) -> bool {
         let (key, bit) = Self::slot(v);
@@ -609,6 +649,27 @@ mod tests {
                     assert_eq!(t.contains(k, (a, b)), s.contains(&(k, (a, b))));
                 }
             }
+        }
+        // Disc queries find exactly the members within the distance.
+        for _ in 0..300 {
+            let (k, c, r) = (
+                rng.random_range(0u32..4),
+                (rng.random_range(-45i64..45), rng.random_range(-45i64..45)),
+                rng.random_range(0i64..10),
+            );
+            let mut got = Vec::new();
+            t.for_each_in_disc(k, c, r, |v| got.push(v));
+            got.sort_unstable();
+            let mut want: Vec<Axial> = s
+                .iter()
+                .filter(|h| {
+                    let d = (h.1.0 - c.0, h.1.1 - c.1);
+                    h.0 == k && d.0.abs().max(d.1.abs()).max((d.0 + d.1).abs()) <= r
+                })
+                .map(|h| h.1)
+                .collect();
+            want.sort_unstable();
+            assert_eq!(got, want, "{k} {c:?} {r}");
         }
         assert_eq!(t.iter().len(), s.len());
         let mut got: Vec<_> = t.iter().collect();

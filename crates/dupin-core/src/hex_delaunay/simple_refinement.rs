@@ -130,6 +130,11 @@ impl Refinement {
         self.occupants.get(c).map_or(0, Vec::len)
     }
 
+    /// The occupied full cells.
+    pub fn occupied_full(&self) -> &HexSet {
+        &self.occupied_full
+    }
+
     /// The last point located in the full hexagon `x` at level `k`, if any (one hash look-up;
     /// once the simple rules are done every occupied cell holds exactly one point).
     #[inline]
