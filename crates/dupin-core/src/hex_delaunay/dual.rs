@@ -16,7 +16,7 @@
 //! it holds only the front of the depth-first traversal, stays small and cache-resident, and
 //! the extraction's time per triangle does not grow with the mesh.
 
-use super::hierarchy::Hierarchy;
+use super::hierarchy::{HexSet, Hierarchy};
 use super::lattice::{Axial, DIRS, add, normalize, on_boundary};
 use crate::math::Vec2;
 use rustc_hash::FxHashMap;
@@ -32,10 +32,22 @@ pub fn pack(level: u32, v: Axial) -> Key {
     ((v.0 + (1 << 50)) | ((l as i64) << 56), v.1)
 }
 
+/// The `(level, v)` of a packed key.
+#[inline]
+pub fn unpack(key: Key) -> (u32, Axial) {
+    (
+        (key.0 >> 56) as u32,
+        ((key.0 & ((1 << 56) - 1)) - (1 << 50), key.1),
+    )
+}
+
 /// The dual triangles and vertex positions of a hexagon mesh.
 pub struct DualBuilder<'h> {
     h: &'h Hierarchy,
     moved: &'h FxHashMap<Key, Vec2>,
+    /// The keys of `moved`, tiled: most vertices are not moved, and a tile read (mostly of
+    /// the tile just read) is cheaper than a probe into the large `moved`.
+    is_moved: HexSet,
     /// Vertex index of the midpoints requested once so far.
     open: FxHashMap<Key, u32>,
     /// Vertex index of every relocated (occupied) centre.
@@ -52,9 +64,15 @@ impl<'h> DualBuilder<'h> {
     /// per leaf full hexagon, at most two triangles per vertex), so nothing is reallocated.
     pub fn build(h: &'h Hierarchy, moved: &'h FxHashMap<Key, Vec2>) -> Self {
         let leaves = h.leaf_count();
+        let mut is_moved = HexSet::default();
+        for &key in moved.keys() {
+            let (level, v) = unpack(key);
+            is_moved.insert(level, v);
+        }
         let mut b = DualBuilder {
             h,
             moved,
+            is_moved,
             open: FxHashMap::default(),
             moved_vertex: FxHashMap::default(),
             positions: Vec::with_capacity(leaves),
@@ -75,9 +93,15 @@ impl<'h> DualBuilder<'h> {
 
     fn new_vertex(&mut self, level: u32, v: Axial) -> u32 {
         let n = self.positions.len() as u32;
-        let key = pack(level, v);
-        let p = match self.moved.get(&key) {
-            Some(&p) => {
+        let (l, w) = normalize(level, v);
+        let moved = if self.is_moved.contains(l, w) {
+            let key = pack(level, v);
+            self.moved.get(&key).map(|&p| (key, p))
+        } else {
+            None
+        };
+        let p = match moved {
+            Some((key, p)) => {
                 self.moved_vertex.insert(key, n);
                 p
             }

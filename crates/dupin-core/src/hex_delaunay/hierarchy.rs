@@ -209,10 +209,11 @@ impl Hierarchy {
         for (k, set) in self.split.iter().enumerate() {
             let k = k as u32;
             for x in set.iter() {
-                for d in DIRS {
-                    let y = add(x, d);
+                let split = set.neighbours(x);
+                for (j, d) in DIRS.iter().enumerate() {
+                    let y = add(x, *d);
                     let boundary_join = !in_domain(k, y) && in_domain(k + 1, add(x, y));
-                    if boundary_join || (self.is_split(k, y) && x < y) {
+                    if boundary_join || (split & (1 << j) != 0 && x < y) {
                         n += 1;
                     }
                 }
