@@ -35,7 +35,7 @@
 use super::dual::{Key, pack};
 use super::error::HexDelaunayError;
 use super::fin_vertices::{FinPatch, Run, run_patch, top_new};
-use super::hierarchy::{Cell, HexSet, Hierarchy};
+use super::hierarchy::{Cell, HexSet, Hierarchy, window_bit};
 use super::lattice::{Axial, DIRS, add, in_domain, on_boundary};
 use super::simple_refinement::Refinement;
 use crate::math::Vec2;
@@ -96,21 +96,6 @@ fn three_consecutive(mask: u8) -> Option<usize> {
     (0..6).find(|&j| mask == (1 << j) | (1 << ((j + 1) % 6)) | (1 << ((j + 2) % 6)))
 }
 
-/// Position of the offset `dz` (hexagonal norm 2) in the order of `ring(_, 2)`.
-fn ring2_index(dz: Axial) -> usize {
-    // ring(v, 2) walks side j from 2·DIRS[j] along DIRS[j + 2], two steps per side.
-    for j in 0..6 {
-        let d = DIRS[j];
-        let e = DIRS[(j + 2) % 6];
-        for t in 0..2 {
-            if (2 * d.0 + t * e.0, 2 * d.1 + t * e.1) == dz {
-                return 2 * j + t as usize;
-            }
-        }
-    }
-    unreachable!("offset of hexagonal norm 2")
-}
-
 /// Lattice points at hexagonal distance exactly `r` from `v`.
 fn ring(v: Axial, r: i64) -> impl Iterator<Item = Axial> {
     (0..6).flat_map(move |j| {
@@ -119,6 +104,15 @@ fn ring(v: Axial, r: i64) -> impl Iterator<Item = Axial> {
         (0..r).map(move |t| (v.0 + r * d.0 + t * e.0, v.1 + r * d.1 + t * e.1))
     })
 }
+
+/// The window bits of a hexagon and its six neighbours.
+const WINDOW_DISC1: u32 = window_bit((0, 0))
+    | window_bit(DIRS[0])
+    | window_bit(DIRS[1])
+    | window_bit(DIRS[2])
+    | window_bit(DIRS[3])
+    | window_bit(DIRS[4])
+    | window_bit(DIRS[5]);
 
 /// Outward normals of the half-sized hexagon's edges (at 30° + 60° i).
 const EDGE_NORMALS: [(f64, f64); 6] = [
@@ -140,24 +134,37 @@ fn in_half_hexagon(p: Vec2, c: Vec2, r: f64) -> bool {
 
 /// The neighbours of the leaf `t` at level `k` that have three consecutive fins facing away
 /// from `t`, i.e. whose top neighbour (section 5.1) is `t`, as a bit mask over `DIRS`. Such a
-/// `t` is no FIXED_CENTER (it is a MOVED_CENTER_4). The middle fin of `y = t + d_i` is then
-/// `t + 2 d_i`, so a leaf with no split hexagon two steps out costs six look-ups.
+/// `t` is no FIXED_CENTER (it is a MOVED_CENTER_4).
 fn tops_mask(h: &Hierarchy, k: u32, t: Axial) -> u8 {
+    tops_in_window(h, k, t, h.split_window(k, t))
+}
+
+/// [`tops_mask`] from the split window `w` around `t`: the middle fin of `y = t + d_i` is
+/// `t + 2 d_i`, and `y`'s fins all lie in the window.
+fn tops_in_window(h: &Hierarchy, k: u32, t: Axial, w: u32) -> u8 {
     let mut m = 0;
     for (i, d) in DIRS.iter().enumerate() {
-        if !h.is_split(k, add(t, add(*d, *d))) {
+        if w & window_bit(add(*d, *d)) == 0 {
             continue;
         }
         let y = add(t, *d);
-        if !h.is_present(k, y) || h.is_split(k, y) {
+        if !h.is_present(k, y) || w & window_bit(*d) != 0 {
             continue;
         }
         // Fins j..j+2 with the middle one j+1 = i, i.e. j = i - 1.
-        if three_consecutive(fin_mask(h, k, y)) == Some((i + 5) % 6) {
+        if three_consecutive(window_fins(w, *d)) == Some((i + 5) % 6) {
             m |= 1 << i;
         }
     }
     m
+}
+
+/// The fin mask of `v + d` (`d` zero or a neighbour direction) from the split window `w`
+/// around `v`.
+fn window_fins(w: u32, d: Axial) -> u8 {
+    DIRS.iter().enumerate().fold(0u8, |m, (j, e)| {
+        m | (u8::from(w & window_bit(add(d, *e)) != 0) << j)
+    })
 }
 
 /// The first position and length of the single run of set bits of a top's mask (cyclic),
@@ -409,12 +416,15 @@ impl<'a> Pass<'a> {
     /// FIXED_CENTER_x: no fins, not occupied, not moved in a ring.
     fn fixed(&mut self, k: u32, v: Axial) -> bool {
         let h = &self.r.hierarchy;
-        h.is_present(k, v)
-            && !h.is_split(k, v)
-            && fin_mask(h, k, v) == 0
+        if !h.is_present(k, v) {
+            return false;
+        }
+        // Itself and its neighbours unsplit (no fins), then the rest in the same order.
+        let w = h.split_window(k, v);
+        w & WINDOW_DISC1 == 0
             && self.r.point_in(k, v).is_none()
             && self.ring1_moved(k, v).is_none()
-            && tops_mask(h, k, v) == 0
+            && tops_in_window(h, k, v, w) == 0
     }
 
     /// Whether a segment passes within `dist` of `c`. A scan of all segments: O(segments) per
@@ -609,34 +619,18 @@ impl<'a> Pass<'a> {
             }
             (f.position(k + 1, ab), 0.4)
         };
-        // Ours: opposite-facing fin strips. The neighbours' fins come from the split states of
-        // the 2-ring, each asked once (the ring's hexagons are shared by two neighbours).
+        // Ours: opposite-facing fin strips. The neighbours' fins come from one read of the
+        // split states around v.
         let adjacent_fins =
             mask | (mask << 1) | (mask >> 1) | ((mask & 1) << 5) | ((mask >> 5) & 1);
-        let ring2: [bool; 12] = {
-            let mut it = ring(v, 2);
-            std::array::from_fn(|_| h.is_split(k, it.next().expect("12 hexagons")))
-        };
+        let win = h.split_window(k, v);
         for (i, d) in DIRS.iter().enumerate() {
             let y = add(v, *d);
             if mask & (1 << i) != 0 || !h.is_present(k, y) {
                 continue;
             }
-            // Neighbours of y: v (unsplit), y + d_i = ring-2 corner 2i, its two ring-1 sides
-            // v + d_{i±1}, and the ring-2 hexagons 2i ± 1 between them.
-            let split_at = |j: usize| -> bool {
-                let e = DIRS[j];
-                let z = add(y, e);
-                let dz = (z.0 - v.0, z.1 - v.1);
-                if dz == (0, 0) {
-                    return false;
-                }
-                if let Some(m) = DIRS.iter().position(|&q| q == dz) {
-                    return mask & (1 << m) != 0;
-                }
-                ring2[ring2_index(dz)]
-            };
-            let my = (0..6).fold(0u8, |m, j| m | (u8::from(split_at(j)) << j));
+            // The fins of y (its neighbours lie in the window; v itself is unsplit).
+            let my = window_fins(win, *d);
             if my != 0 && my & adjacent_fins == 0 {
                 return Leaf::Split;
             }

@@ -85,6 +85,17 @@ impl Hierarchy {
         }
     }
 
+    /// The split states of the 5×5 lattice points around `v` at `level` (the disc of radius
+    /// 2 among them) as a bit mask: bit [`window_bit`]`(d)` is set when `v + d` is split. A few
+    /// tile rows instead of up to 19 queries.
+    #[inline]
+    pub fn split_window(&self, level: u32, v: Axial) -> u32 {
+        match self.split.get(level as usize) {
+            Some(s) => s.window(v),
+            None => 0,
+        }
+    }
+
     /// Whether the lattice point `v` at `level` is a full hexagon (leaf or split).
     pub fn is_present(&self, level: u32, v: Axial) -> bool {
         if level == 0 {
@@ -229,6 +240,12 @@ impl Hierarchy {
             .into_iter()
             .flat_map(TileSet::iter)
     }
+}
+
+/// The bit of the offset `d` (both coordinates in -2..=2) in [`Hierarchy::split_window`].
+#[inline]
+pub const fn window_bit(d: Axial) -> u32 {
+    1 << (5 * (d.0 + 2) + d.1 + 2)
 }
 
 /// A set of hexagons `(level, centre)` stored like the split sets (16×16 tiles of bits per
@@ -436,6 +453,37 @@ impl TileSet {
             | bit(1, -1) << 5
     }
 
+    /// The 5×5 window of bits around `v` (see [`Hierarchy::split_window`]): five rows of five
+    /// bits, from one tile column or, where the window crosses a tile edge in `b`, two (each
+    /// column's rows cross at most one tile edge in `a`, so the memo keeps probes rare).
+    #[inline]
+    fn window(&self, v: Axial) -> u32 {
+        let b0 = v.1 - 2;
+        let col = (b0 & TILE_MASK) as u32;
+        let mut win = 0u32;
+        for part in 0..=i64::from(col > 11) {
+            let tb = (b0 >> TILE) + part;
+            for dr in 0..5 {
+                let a = v.0 - 2 + dr;
+                let i = self.tile((a >> TILE, tb));
+                if i == NONE {
+                    continue;
+                }
+                let row = (a & TILE_MASK) as usize;
+                let bits =
+                    ((self.words[i as usize][row >> 2] >> ((row & 3) << TILE)) & 0xffff) as u32;
+                // The first tile holds columns col.., the second the rest from 0.
+                let five = if part == 0 {
+                    bits >> col
+                } else {
+                    bits << (16 - col)
+                } & 31;
+                win |= five << (5 * dr);
+            }
+        }
+        win
+    }
+
     /// The index of tile `key`, created empty if absent.
     #[inline(always)]
     fn tile_or_insert(&mut self, key: Axial) -> u32 {
@@ -590,6 +638,25 @@ mod tests {
                     m | u8::from(s.contains(&add((a, b), *d))) << j
                 });
                 assert_eq!(t.neighbours((a, b)), m, "{a} {b}");
+            }
+        }
+        let mut h = Hierarchy::new(
+            Frame {
+                origin: Vec2::zeros(),
+                root_radius: 1.0,
+            },
+            8,
+        );
+        h.split = vec![t.clone()];
+        for a in -45..45 {
+            for b in -45..45 {
+                let w = h.split_window(0, (a, b));
+                for da in -2..=2 {
+                    for db in -2..=2 {
+                        let want = s.contains(&(a + da, b + db));
+                        assert_eq!(w & window_bit((da, db)) != 0, want, "{a} {b} {da} {db}");
+                    }
+                }
             }
         }
         let mut got: Vec<Axial> = t.iter().collect();
