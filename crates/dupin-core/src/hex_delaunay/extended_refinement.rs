@@ -832,12 +832,12 @@ fn region_pass(r: &Refinement, segments: &[[u32; 2]], leaves: &HexSet, occupied:
         pass.visit_occupied(k, x);
     }
     pass.freeze_rings();
-    for (k, v) in leaves.iter() {
-        // Only a leaf with fins can be marked; the fins are the cheapest test.
-        if !h.is_split(k, v) && fin_mask(h, k, v) != 0 && h.is_present(k, v) {
+    // Only a leaf with fins can be marked; the fins are the cheapest test.
+    h.for_each_with_fins(leaves, |k, v| {
+        if h.is_present(k, v) {
             pass.visit(k, v);
         }
-    }
+    });
     pass.marks()
 }
 

@@ -233,6 +233,59 @@ impl Hierarchy {
         n
     }
 
+    /// Calls `f(level, v)` for every member `v` of `set` that is unsplit with a split neighbour
+    /// of its level (a leaf with fins if it is present), in `set`'s order. Per tile of `set`,
+    /// the fins of all 256 points come from the split tile and the edges of its eight
+    /// neighbours, a few shifts per row, instead of two queries per member.
+    pub fn for_each_with_fins(&self, set: &HexSet, mut f: impl FnMut(u32, Axial)) {
+        for (k, cand) in set.levels.iter().enumerate() {
+            let Some(split) = self.split.get(k) else {
+                break;
+            };
+            for (t, words) in cand.words.iter().enumerate() {
+                if *words == [0; 4] {
+                    continue;
+                }
+                let (ta, tb) = cand.keys[t];
+                // rows[a + 1], a in -1..=16: the split bits of row a, columns -1..=16 at bits
+                // 0..=17.
+                let mut rows = [0u32; 18];
+                for (da, r0, r1) in [(-1i64, 15usize, 15usize), (0, 0, 15), (1, 0, 0)] {
+                    for db in -1i64..=1 {
+                        let i = split.tile((ta + da, tb + db));
+                        if i == NONE {
+                            continue;
+                        }
+                        let w = &split.words[i as usize];
+                        for r in r0..=r1 {
+                            let bits = ((w[r >> 2] >> ((r & 3) << TILE)) & 0xffff) as u32;
+                            let part = match db {
+                                -1 => bits >> 15,
+                                0 => bits << 1,
+                                _ => (bits & 1) << 17,
+                            };
+                            // Row r of the tile above or below is row -1 or 16 here.
+                            let a = (da * 16 + r as i64 + 1) as usize;
+                            rows[a] |= part;
+                        }
+                    }
+                }
+                for a in 0..16usize {
+                    let (up, me, down) = (rows[a + 2], rows[a + 1], rows[a]);
+                    // Neighbours (1, 0), (1, -1), (0, 1), (0, -1), (-1, 1), (-1, 0).
+                    let fins = up | (up << 1) | (me >> 1) | (me << 1) | (down >> 1) | down;
+                    let c = ((words[a >> 2] >> ((a & 3) << TILE)) & 0xffff) as u32;
+                    let mut hits = (fins >> 1) & !(me >> 1) & c & 0xffff;
+                    while hits != 0 {
+                        let col = i64::from(hits.trailing_zeros());
+                        hits &= hits - 1;
+                        f(k as u32, ((ta << TILE) | a as i64, (tb << TILE) | col));
+                    }
+                }
+            }
+        }
+    }
+
     /// Iterates over the split hexagons of `level`, tile by tile (deterministic order).
     pub fn split_at(&self, level: u32) -> impl Iterator<Item = Axial> + '_ {
         self.split
@@ -277,14 +330,16 @@ impl HexSet {
                 .resize_with(level as usize + 1, TileSet::default);
         }
         let set = &mut self.levels[level as usize];
-        for i in -r..=r {
-            let a = c.0 + i;
-            let (mut b0, b1) = (c.1 + (-r).max(-i - r), c.1 + r.min(-i + r));
-            while b0 <= b1 {
-                // The part of the row inside one tile.
-                let end = b1.min(b0 | TILE_MASK);
-                self.len += set.insert_run(a, b0, end);
-                b0 = end + 1;
+        // A column of tiles at a time, so that consecutive rows mostly hit the memoised tile.
+        for tb in (c.1 - r) >> TILE..=(c.1 + r) >> TILE {
+            let (lo, hi) = (tb << TILE, (tb << TILE) | TILE_MASK);
+            for i in -r..=r {
+                // The part of the disc's row `c.0 + i` inside this tile column.
+                let b0 = (c.1 + (-r).max(-i - r)).max(lo);
+                let b1 = (c.1 + r.min(-i + r)).min(hi);
+                if b0 <= b1 {
+                    self.len += set.insert_run(c.0 + i, b0, b1);
+                }
             }
         }
     }
@@ -659,6 +714,21 @@ mod tests {
                 }
             }
         }
+        // The bulk fin test finds the members with fins that are not in the set themselves.
+        let mut cand = HexSet::default();
+        for _ in 0..3000 {
+            cand.insert(
+                0,
+                (rng.random_range(-45i64..45), rng.random_range(-45i64..45)),
+            );
+        }
+        let mut bulk = Vec::new();
+        h.for_each_with_fins(&cand, |k, v| bulk.push((k, v)));
+        let naive: Vec<(u32, Axial)> = cand
+            .iter()
+            .filter(|&(_, v)| !t.contains(v) && t.neighbours(v) != 0)
+            .collect();
+        assert_eq!(bulk, naive);
         let mut got: Vec<Axial> = t.iter().collect();
         let n = got.len();
         got.sort_unstable();
