@@ -272,6 +272,9 @@ struct Pass<'a> {
     present: FxHashSet<(u32, Axial)>,
     /// The verdicts on MOVED_CENTER_3 runs, by top, and the accepted runs' patches.
     runs: FxHashMap<(u32, Axial), RunVerdict>,
+    /// Leaf classes once the rings are frozen: a run's analysis asks for its top's other
+    /// neighbours, which the pass visits as leaves too.
+    leaves: FxHashMap<(u32, Axial), Leaf>,
     patches: Vec<FinPatch>,
 }
 
@@ -285,6 +288,7 @@ impl<'a> Pass<'a> {
             split: FxHashSet::default(),
             present: FxHashSet::default(),
             runs: FxHashMap::default(),
+            leaves: FxHashMap::default(),
             patches: Vec::new(),
         }
     }
@@ -524,7 +528,7 @@ impl<'a> Pass<'a> {
                         None => return Pending,
                     }
                 } else {
-                    match self.leaf(k, x) {
+                    match self.frozen_leaf(k, x) {
                         Leaf::Moved(p) => p,
                         Leaf::Fixed => f.position(k, x),
                         Leaf::Split => return Pending,
@@ -562,6 +566,20 @@ impl<'a> Pass<'a> {
         }
         self.patches.push(patch);
         Accepted(self.patches.len() - 1)
+    }
+
+    /// [`leaf`](Self::leaf), memoised while the rings are frozen (with exact ring roles, in
+    /// `verify`, the class may differ, so it is computed anew there).
+    fn frozen_leaf(&mut self, k: u32, v: Axial) -> Leaf {
+        if self.rings.is_none() {
+            return self.leaf(k, v);
+        }
+        if let Some(&l) = self.leaves.get(&(k, v)) {
+            return l;
+        }
+        let l = self.leaf(k, v);
+        self.leaves.insert((k, v), l);
+        l
     }
 
     /// Classifies the leaf full hexagon `v` at level `k` (5.1, 5.2, 5.4).
@@ -642,7 +660,7 @@ impl<'a> Pass<'a> {
     /// Visits the leaf `v` at level `k` (one with fins: no rule splits the others): marks it
     /// when a rule splits it.
     fn visit(&mut self, k: u32, v: Axial) -> Leaf {
-        let l = self.leaf(k, v);
+        let l = self.frozen_leaf(k, v);
         if l == Leaf::Split {
             self.split.insert((k, v));
         }
