@@ -820,21 +820,33 @@ fn affected(r: &Refinement, changes: &[(u32, Axial)]) -> (HexSet, HexSet) {
     let mut leaves = HexSet::default();
     let mut occupied = HexSet::default();
     let occ = r.occupied_full();
-    for &(k, x) in changes {
-        let c = (2 * x.0, 2 * x.1);
-        leaves.insert_disc(k, x, 2);
-        leaves.insert_disc(k + 1, c, 3);
+    // Changes in one lattice row with consecutive `b` are taken together: the union of their
+    // discs is one interval per row (a "stadium"), so overlapping discs cost one insert.
+    let mut sorted = changes.to_vec();
+    sorted.sort_unstable();
+    sorted.dedup();
+    let mut i = 0;
+    while i < sorted.len() {
+        let (k, (a, lo)) = sorted[i];
+        let mut hi = lo;
+        i += 1;
+        while i < sorted.len() && sorted[i] == (k, (a, hi + 1)) {
+            hi += 1;
+            i += 1;
+        }
+        leaves.insert_stadium(k, a, (lo, hi), 2);
+        leaves.insert_stadium(k + 1, 2 * a, (2 * lo, 2 * hi), 3);
         if k >= 1 {
-            let half = (x.0.div_euclid(2), x.1.div_euclid(2));
-            leaves.insert_disc(k - 1, half, 2);
-            occ.for_each_in_disc(k - 1, half, 6, |o| {
+            let half = (lo.div_euclid(2), hi.div_euclid(2));
+            leaves.insert_stadium(k - 1, a.div_euclid(2), half, 2);
+            occ.for_each_in_stadium(k - 1, a.div_euclid(2), half, 6, |o| {
                 occupied.insert(k - 1, o);
             });
         }
-        occ.for_each_in_disc(k, x, 8, |o| {
+        occ.for_each_in_stadium(k, a, (lo, hi), 8, |o| {
             occupied.insert(k, o);
         });
-        occ.for_each_in_disc(k + 1, c, 8, |o| {
+        occ.for_each_in_stadium(k + 1, 2 * a, (2 * lo, 2 * hi), 8, |o| {
             occupied.insert(k + 1, o);
         });
     }

@@ -325,30 +325,44 @@ impl HexSet {
     /// Inserts every lattice point within hexagonal distance `r` of `c` at `level` (the
     /// neighbourhood of a change), a row of bits at a time.
     pub fn insert_disc(&mut self, level: u32, c: Axial, r: i64) {
+        self.insert_stadium(level, c.0, (c.1, c.1), r);
+    }
+
+    /// Inserts the union of the discs of radius `r` around `(a, b)` for `b` in the range
+    /// `bs` (inclusive): per row one interval, as the discs of neighbouring centres overlap.
+    pub fn insert_stadium(&mut self, level: u32, a: i64, bs: (i64, i64), r: i64) {
         if self.levels.len() <= level as usize {
             self.levels
                 .resize_with(level as usize + 1, TileSet::default);
         }
         let set = &mut self.levels[level as usize];
         // A column of tiles at a time, so that consecutive rows mostly hit the memoised tile.
-        for tb in (c.1 - r) >> TILE..=(c.1 + r) >> TILE {
+        for tb in (bs.0 - r) >> TILE..=(bs.1 + r) >> TILE {
             let (lo, hi) = (tb << TILE, (tb << TILE) | TILE_MASK);
             for i in -r..=r {
-                // The part of the disc's row `c.0 + i` inside this tile column.
-                let b0 = (c.1 + (-r).max(-i - r)).max(lo);
-                let b1 = (c.1 + r.min(-i + r)).min(hi);
+                // The part of the row `a + i` inside this tile column.
+                let b0 = (bs.0 + (-r).max(-i - r)).max(lo);
+                let b1 = (bs.1 + r.min(-i + r)).min(hi);
                 if b0 <= b1 {
-                    self.len += set.insert_run(c.0 + i, b0, b1);
+                    self.len += set.insert_run(a + i, b0, b1);
                 }
             }
         }
     }
 
-    /// Calls `f` for every member of `level` within hexagonal distance `r` of `c`, a tile at a
-    /// time (a few tile reads instead of one query per lattice point).
-    pub fn for_each_in_disc(&self, level: u32, c: Axial, r: i64, f: impl FnMut(Axial)) {
+    /// Calls `f` for every member of `level` in the union of the discs of radius `r` around
+    /// `(a, b)`, `b` in the range `bs` (inclusive), a tile at a time (a few tile reads instead
+    /// of one query per lattice point).
+    pub fn for_each_in_stadium(
+        &self,
+        level: u32,
+        a: i64,
+        bs: (i64, i64),
+        r: i64,
+        f: impl FnMut(Axial),
+    ) {
         if let Some(s) = self.levels.get(level as usize) {
-            s.for_each_in_disc(c, r, f);
+            s.for_each_in_stadium(a, bs, r, f);
         }
     }
 
@@ -577,10 +591,11 @@ impl TileSet {
         new
     }
 
-    /// Calls `f` for every member within hexagonal distance `r` of `c`: per tile of the disc's
-    /// bounding box, the disc's part of each row is one mask on the tile's row of 16 bits.
-    fn for_each_in_disc(&self, c: Axial, r: i64, mut f: impl FnMut(Axial)) {
-        let (a0, a1, b0, b1) = (c.0 - r, c.0 + r, c.1 - r, c.1 + r);
+    /// Calls `f` for every member of the union of the discs of radius `r` around `(a, b)`,
+    /// `b` in `bs`: per tile of the bounding box, each row's interval is one mask on the
+    /// tile's row of 16 bits.
+    fn for_each_in_stadium(&self, a: i64, bs: (i64, i64), r: i64, mut f: impl FnMut(Axial)) {
+        let (a0, a1, b0, b1) = (a - r, a + r, bs.0 - r, bs.1 + r);
         for ta in a0 >> TILE..=a1 >> TILE {
             for tb in b0 >> TILE..=b1 >> TILE {
                 let i = self.tile((ta, tb));
@@ -589,19 +604,19 @@ impl TileSet {
                 }
                 let w = &self.words[i as usize];
                 let (base_a, base_b) = (ta << TILE, tb << TILE);
-                for a in a0.max(base_a)..=a1.min(base_a | TILE_MASK) {
-                    // The disc's row `a`: b - c.1 in [max(-r, -i - r), min(r, -i + r)].
-                    let i = a - c.0;
-                    let lo = (c.1 + (-r).max(-i - r)).max(base_b);
-                    let hi = (c.1 + r.min(-i + r)).min(base_b | TILE_MASK);
+                for row_a in a0.max(base_a)..=a1.min(base_a | TILE_MASK) {
+                    // The row's interval: b - bs in [max(-r, -i - r), min(r, -i + r)].
+                    let i = row_a - a;
+                    let lo = (bs.0 + (-r).max(-i - r)).max(base_b);
+                    let hi = (bs.1 + r.min(-i + r)).min(base_b | TILE_MASK);
                     if lo > hi {
                         continue;
                     }
-                    let row = (a & TILE_MASK) as usize;
+                    let row = (row_a & TILE_MASK) as usize;
                     let bits = (w[row >> 2] >> ((row & 3) << TILE)) & 0xffff;
                     let mut m = bits & (((1u64 << (hi - lo + 1)) - 1) << (lo & TILE_MASK));
                     while m != 0 {
-                        f((a, base_b | i64::from(m.trailing_zeros())));
+                        f((row_a, base_b | i64::from(m.trailing_zeros())));
                         m &= m - 1;
                     }
                 }
@@ -788,26 +803,43 @@ mod tests {
                 }
             }
         }
-        // Disc queries find exactly the members within the distance.
+        // Stadium queries find exactly the members within the distance of a centre, and
+        // stadium inserts insert exactly those points.
         for _ in 0..300 {
-            let (k, c, r) = (
+            let (k, a, b, len, r) = (
                 rng.random_range(0u32..4),
-                (rng.random_range(-45i64..45), rng.random_range(-45i64..45)),
+                rng.random_range(-45i64..45),
+                rng.random_range(-45i64..45),
+                rng.random_range(0i64..6),
                 rng.random_range(0i64..10),
             );
+            let near = |v: Axial| {
+                (b..=b + len).any(|bc| {
+                    let d = (v.0 - a, v.1 - bc);
+                    d.0.abs().max(d.1.abs()).max((d.0 + d.1).abs()) <= r
+                })
+            };
             let mut got = Vec::new();
-            t.for_each_in_disc(k, c, r, |v| got.push(v));
+            t.for_each_in_stadium(k, a, (b, b + len), r, |v| got.push(v));
             got.sort_unstable();
             let mut want: Vec<Axial> = s
                 .iter()
-                .filter(|h| {
-                    let d = (h.1.0 - c.0, h.1.1 - c.1);
-                    h.0 == k && d.0.abs().max(d.1.abs()).max((d.0 + d.1).abs()) <= r
-                })
+                .filter(|h| h.0 == k && near(h.1))
                 .map(|h| h.1)
                 .collect();
             want.sort_unstable();
-            assert_eq!(got, want, "{k} {c:?} {r}");
+            assert_eq!(got, want, "{k} {a} {b} {len} {r}");
+            let mut u = HexSet::default();
+            u.insert_stadium(k, a, (b, b + len), r);
+            let mut got: Vec<Axial> = u.iter().map(|h| h.1).collect();
+            got.sort_unstable();
+            let mut want: Vec<Axial> = (a - r..=a + r)
+                .flat_map(|x| (b - r..=b + len + r).map(move |y| (x, y)))
+                .filter(|&v| near(v))
+                .collect();
+            want.sort_unstable();
+            assert_eq!(got, want, "{a} {b} {len} {r}");
+            assert_eq!(u.iter().len(), want.len());
         }
         assert_eq!(t.iter().len(), s.len());
         let mut got: Vec<_> = t.iter().collect();
