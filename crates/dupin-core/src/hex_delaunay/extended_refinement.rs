@@ -36,7 +36,7 @@ use super::dual::{Key, pack};
 use super::error::HexDelaunayError;
 use super::fin_vertices::{FinPatch, Run, run_patch, top_new};
 use super::hierarchy::{Cell, HexSet, Hierarchy, window_bit};
-use super::lattice::{Axial, DIRS, add, in_domain, on_boundary};
+use super::lattice::{Axial, DIRS, add, hex_norm, in_domain, on_boundary};
 use super::simple_refinement::Refinement;
 use crate::math::Vec2;
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -320,21 +320,31 @@ impl<'a> Pass<'a> {
         // pair would put the points in cells too small for section 6.3's edge bound. Four
         // steps apart the rings only share fixed 2-ring hexagons (the paper's Fig. 7).
         let mut verify: f64 = 0.0;
-        for dist in 2..=3 {
-            for z in ring(x, dist) {
-                if let Some(q) = self.r.point_in(k, z) {
-                    let other = !in_half_hexagon(q, f.position(k, z), rad);
-                    match (dist, occ2, other) {
-                        (2, true, true) => {
-                            self.split.insert((k, x));
-                            return Occupied::Split;
-                        }
-                        (2, true, false) | (2, false, true) | (3, true, true) => {
-                            verify = verify.max((p - q).norm());
-                        }
-                        _ => {}
-                    }
+        // The occupied hexagons two or three steps away, from one read of the occupied tiles
+        // (the verdict does not depend on their order).
+        let mut near = [(0i64, (0i64, 0i64)); 37];
+        let mut count = 0;
+        self.r
+            .occupied_full()
+            .for_each_in_stadium(k, x.0, (x.1, x.1), 3, |z| {
+                let dist = hex_norm((z.0 - x.0, z.1 - x.1));
+                if dist >= 2 {
+                    near[count] = (dist, z);
+                    count += 1;
                 }
+            });
+        for &(dist, z) in &near[..count] {
+            let q = self.r.point_in(k, z).expect("an occupied full cell has a point");
+            let other = !in_half_hexagon(q, f.position(k, z), rad);
+            match (dist, occ2, other) {
+                (2, true, true) => {
+                    self.split.insert((k, x));
+                    return Occupied::Split;
+                }
+                (2, true, false) | (2, false, true) | (3, true, true) => {
+                    verify = verify.max((p - q).norm());
+                }
+                _ => {}
             }
         }
         // Ours: an OCCUPIED_2's moved 1-ring must not touch Ω's boundary (tiling).
@@ -345,16 +355,18 @@ impl<'a> Pass<'a> {
         // Ours: the 2-ring must be unsplit full hexagons of this level (rules 4 and 5 one ring
         // further out): a finer one splits the occupied hexagon, a coarser one is made present.
         let mut rough = None;
-        for z in ring(x, 2) {
+        let win = h.split_window(k, x);
+        for (z, d) in ring(x, 2).zip(ring((0, 0), 2)) {
             if !in_domain(k, z) {
                 continue;
             }
-            if !h.is_present(k, z) {
-                self.present.insert((k, z));
-                rough.get_or_insert(Occupied::Rough);
-            } else if h.is_split(k, z) {
+            // A split hexagon is present.
+            if win & window_bit(d) != 0 {
                 self.split.insert((k, x));
                 rough = Some(Occupied::Split);
+            } else if !h.is_present(k, z) {
+                self.present.insert((k, z));
+                rough.get_or_insert(Occupied::Rough);
             }
         }
         if let Some(o) = rough {
