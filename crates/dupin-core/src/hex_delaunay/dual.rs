@@ -16,7 +16,7 @@
 //! it holds only the front of the depth-first traversal, stays small and cache-resident, and
 //! the extraction's time per triangle does not grow with the mesh.
 
-use super::hierarchy::{HexSet, Hierarchy};
+use super::hierarchy::{HexSet, Hierarchy, window_bit};
 use super::lattice::{Axial, DIRS, add, normalize, on_boundary};
 use crate::math::Vec2;
 use rustc_hash::FxHashMap;
@@ -80,9 +80,16 @@ impl<'h> DualBuilder<'h> {
         };
         let o = b.new_vertex(1, (0, 0));
         let corners: [u32; 6] = std::array::from_fn(|i| b.new_vertex(1, DIRS[i]));
+        let split: [bool; 6] = std::array::from_fn(|i| h.is_split(1, DIRS[i]));
+        let centre = h.is_split(1, (0, 0));
         for i in 0..6 {
             let j = (i + 1) % 6;
-            b.emit(1, [(0, 0), DIRS[i], DIRS[j]], [o, corners[i], corners[j]]);
+            b.emit(
+                1,
+                [(0, 0), DIRS[i], DIRS[j]],
+                [o, corners[i], corners[j]],
+                [centre, split[i], split[j]],
+            );
         }
         debug_assert!(
             b.open.is_empty(),
@@ -128,15 +135,11 @@ impl<'h> DualBuilder<'h> {
     }
 
     /// Emits the lattice triangle `t` at level `k` (counter-clockwise) whose corner vertex
-    /// indices `ids` are known: only new midpoints are looked up, about one hash look-up per
-    /// output triangle.
-    fn emit(&mut self, k: u32, t: [Axial; 3], ids: [u32; 3]) {
+    /// indices `ids` and split states `split` are known: only new midpoints are looked up,
+    /// about one hash look-up per output triangle, and the children's six corners' split
+    /// states are one window read.
+    fn emit(&mut self, k: u32, t: [Axial; 3], ids: [u32; 3], split: [bool; 3]) {
         let [a, b, c] = t;
-        let split = [
-            self.h.is_split(k, a),
-            self.h.is_split(k, b),
-            self.h.is_split(k, c),
-        ];
         match split {
             [true, true, true] => {
                 let (ab, bc, ca) = (add(a, b), add(b, c), add(c, a));
@@ -146,11 +149,15 @@ impl<'h> DualBuilder<'h> {
                     self.midpoint(k + 1, ca),
                 );
                 let (a2, b2, c2) = ((2 * a.0, 2 * a.1), (2 * b.0, 2 * b.1), (2 * c.0, 2 * c.1));
+                // All six lie within two steps of `ab` (a, b, c are mutual neighbours).
+                let w = self.h.split_window(k + 1, ab);
+                let s = |v: Axial| w & window_bit((v.0 - ab.0, v.1 - ab.1)) != 0;
+                let (sa, sb, sc, sab, sbc, sca) = (s(a2), s(b2), s(c2), s(ab), s(bc), s(ca));
                 let [ia, ib, ic] = ids;
-                self.emit(k + 1, [a2, ab, ca], [ia, iab, ica]);
-                self.emit(k + 1, [ab, b2, bc], [iab, ib, ibc]);
-                self.emit(k + 1, [ca, bc, c2], [ica, ibc, ic]);
-                self.emit(k + 1, [ab, bc, ca], [iab, ibc, ica]);
+                self.emit(k + 1, [a2, ab, ca], [ia, iab, ica], [sa, sab, sca]);
+                self.emit(k + 1, [ab, b2, bc], [iab, ib, ibc], [sab, sb, sbc]);
+                self.emit(k + 1, [ca, bc, c2], [ica, ibc, ic], [sca, sbc, sc]);
+                self.emit(k + 1, [ab, bc, ca], [iab, ibc, ica], [sab, sbc, sca]);
             }
             [true, true, false] => self.bisect(k, a, b, [ids[0], ids[1], ids[2]]),
             [false, true, true] => self.bisect(k, b, c, [ids[1], ids[2], ids[0]]),
