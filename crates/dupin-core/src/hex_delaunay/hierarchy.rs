@@ -97,6 +97,7 @@ impl Hierarchy {
     }
 
     /// Whether the lattice point `v` at `level` is a full hexagon (leaf or split).
+    #[inline]
     pub fn is_present(&self, level: u32, v: Axial) -> bool {
         if level == 0 {
             return v == (0, 0);
@@ -104,13 +105,15 @@ impl Hierarchy {
         if !in_domain(level, v) {
             return false;
         }
+        // One look-up of the parents' level (this is the most frequent query).
+        let parents = self.split.get(level as usize - 1);
+        let split = |e: Axial| parents.is_some_and(|s| s.contains(e));
         if is_even(v) {
-            return self.is_split(level - 1, (v.0 >> 1, v.1 >> 1));
+            return split((v.0 >> 1, v.1 >> 1));
         }
         let (a, b) = parents_of_midpoint(v);
-        [a, b]
-            .into_iter()
-            .all(|e| !in_domain(level - 1, e) || self.is_split(level - 1, e))
+        // The domain test only for a parent that is not split (most parents are inside).
+        (split(a) || !in_domain(level - 1, a)) && (split(b) || !in_domain(level - 1, b))
     }
 
     /// Makes `v` at `level` a full hexagon, splitting what lies on it. New splits are appended
@@ -527,6 +530,22 @@ impl TileSet {
     /// column's rows cross at most one tile edge in `a`, so the memo keeps probes rare).
     #[inline]
     fn window(&self, v: Axial) -> u32 {
+        let (row, col) = (v.0 & TILE_MASK, v.1 & TILE_MASK);
+        if (2..=TILE_MASK - 2).contains(&row) && (2..=TILE_MASK - 2).contains(&col) {
+            // Inside one tile (the common case): one look-up.
+            let i = self.tile((v.0 >> TILE, v.1 >> TILE));
+            if i == NONE {
+                return 0;
+            }
+            let w = &self.words[i as usize];
+            let mut win = 0u32;
+            for dr in 0..5 {
+                let r = (row - 2 + dr) as usize;
+                let bits = ((w[r >> 2] >> ((r & 3) << TILE)) & 0xffff) as u32;
+                win |= ((bits >> (col - 2)) & 31) << (5 * dr);
+            }
+            return win;
+        }
         let b0 = v.1 - 2;
         let col = (b0 & TILE_MASK) as u32;
         let mut win = 0u32;
