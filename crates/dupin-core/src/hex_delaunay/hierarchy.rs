@@ -116,6 +116,30 @@ impl Hierarchy {
         (split(a) || !in_domain(level - 1, a)) && (split(b) || !in_domain(level - 1, b))
     }
 
+    /// Whether `v` (in Ω) and its neighbours in Ω at `level >= 1` are all present, read from
+    /// one window of the parents' split states: the parents of these points lie within two
+    /// steps of `v / 2` (rounded down).
+    fn disc1_present(&self, level: u32, v: Axial) -> bool {
+        let u = (v.0 >> 1, v.1 >> 1);
+        let w = self.split_window(level - 1, u);
+        let split = |e: Axial| {
+            let d = (e.0 - u.0, e.1 - u.1);
+            debug_assert!(d.0.abs() <= 2 && d.1.abs() <= 2, "{d:?} outside the window");
+            w & window_bit(d) != 0
+        };
+        std::iter::once((0, 0)).chain(DIRS).all(|d| {
+            let z = add(v, d);
+            if !in_domain(level, z) {
+                return d != (0, 0);
+            }
+            if is_even(z) {
+                return split((z.0 >> 1, z.1 >> 1));
+            }
+            let (a, b) = parents_of_midpoint(z);
+            (split(a) || !in_domain(level - 1, a)) && (split(b) || !in_domain(level - 1, b))
+        })
+    }
+
     /// Makes `v` at `level` a full hexagon, splitting what lies on it. New splits are appended
     /// to `out` in the order they happen.
     pub fn ensure_present(
@@ -155,11 +179,14 @@ impl Hierarchy {
                 max_level: self.max_level,
             });
         }
-        self.ensure_present(level, v, out)?;
-        for d in DIRS {
-            let y = add(v, d);
-            if in_domain(level, y) {
-                self.ensure_present(level, y, out)?;
+        // Usually `v` and its neighbours are present already: one window read says so.
+        if level == 0 || !self.disc1_present(level, v) {
+            self.ensure_present(level, v, out)?;
+            for d in DIRS {
+                let y = add(v, d);
+                if in_domain(level, y) {
+                    self.ensure_present(level, y, out)?;
+                }
             }
         }
         if self.split.len() <= level as usize {

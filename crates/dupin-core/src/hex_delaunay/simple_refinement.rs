@@ -44,6 +44,9 @@ pub struct Refinement {
     /// The occupied full cells, tiled like the split sets: most occupancy queries (rings
     /// around occupied hexagons) find an empty cell here without probing `occupants`.
     occupied_full: HexSet,
+    /// The occupied semi-hexagons (by the centre of their absent full hexagon), so that a split
+    /// asks `occupants` only about its neighbours' semi-hexagons that hold points.
+    occupied_semi: HexSet,
     queue: VecDeque<u32>,
     queued: Vec<bool>,
     scratch: Vec<(u32, Axial)>,
@@ -63,11 +66,13 @@ impl Refinement {
         let mut occupants: FxHashMap<Cell, Vec<u32>> = FxHashMap::default();
         let cell_of: Vec<Cell> = points.iter().map(|p| hierarchy.locate(*p)).collect();
         let mut occupied_full = HexSet::default();
+        let mut occupied_semi = HexSet::default();
         for (i, c) in cell_of.iter().enumerate() {
             occupants.entry(*c).or_default().push(i as u32);
-            if let Cell::Full(k, x) = *c {
-                occupied_full.insert(k, x);
-            }
+            match *c {
+                Cell::Full(k, x) => occupied_full.insert(k, x),
+                Cell::Semi(k, m) => occupied_semi.insert(k, m),
+            };
         }
         let n = points.len();
         Refinement {
@@ -76,6 +81,7 @@ impl Refinement {
             cell_of,
             occupants,
             occupied_full,
+            occupied_semi,
             queue: (0..n as u32).collect(),
             queued: vec![true; n],
             scratch: Vec::new(),
@@ -91,9 +97,7 @@ impl Refinement {
         let c = self.hierarchy.locate(p);
         self.cell_of.push(c);
         self.occupants.entry(c).or_default().push(i);
-        if let Cell::Full(k, x) = c {
-            self.occupied_full.insert(k, x);
-        }
+        self.mark_occupied(c);
         self.queued.push(false);
         self.push(i);
         i
@@ -245,17 +249,28 @@ impl Refinement {
     fn relocate(&mut self, i: u32, c: Cell) {
         self.cell_of[i as usize] = c;
         self.occupants.entry(c).or_default().push(i);
-        if let Cell::Full(k, x) = c {
-            self.occupied_full.insert(k, x);
-        }
+        self.mark_occupied(c);
         self.push(i);
+    }
+
+    /// Records that the cell `c` holds a point (the tiled filters in front of `occupants`).
+    fn mark_occupied(&mut self, c: Cell) {
+        match c {
+            Cell::Full(k, x) => self.occupied_full.insert(k, x),
+            Cell::Semi(k, m) => self.occupied_semi.insert(k, m),
+        };
     }
 
     /// Re-locates the points displaced by splitting `x` at level `k` and queues the points whose
     /// rules may now fire.
     fn after_split(&mut self, k: u32, x: Axial) {
-        let moved = self.occupants.remove(&Cell::Full(k, x)).unwrap_or_default();
-        self.occupied_full.remove(k, x);
+        // Most split hexagons hold no point: the tiled filter answers without a probe.
+        let moved = if self.occupied_full.contains(k, x) {
+            self.occupied_full.remove(k, x);
+            self.occupants.remove(&Cell::Full(k, x)).unwrap_or_default()
+        } else {
+            Vec::new()
+        };
         for i in moved {
             let c = self.hierarchy.locate_from(self.points[i as usize], k, x);
             self.relocate(i, c);
@@ -263,6 +278,10 @@ impl Refinement {
         for d in DIRS {
             // Semi-hexagons of split neighbours towards x are now joined into full hexagons.
             let m = add(x, add(x, d));
+            if !self.occupied_semi.contains(k + 1, m) {
+                continue;
+            }
+            self.occupied_semi.remove(k + 1, m);
             if let Some(v) = self.occupants.remove(&Cell::Semi(k + 1, m)) {
                 for i in v {
                     self.relocate(i, Cell::Full(k + 1, m));
