@@ -19,7 +19,7 @@
 use super::hierarchy::{HexSet, Hierarchy, window_bit};
 use super::lattice::{Axial, DIRS, add, normalize, on_boundary};
 use crate::math::Vec2;
-use rustc_hash::FxHashMap;
+use rustc_hash::{FxHashMap, FxHashSet};
 
 /// A normalised lattice position packed into 16 bytes: `(a + 2^50 | level << 56, b)`, the
 /// coordinates' low bits kept low for the locality-preserving hash.
@@ -56,13 +56,25 @@ pub struct DualBuilder<'h> {
     pub positions: Vec<Vec2>,
     /// Triangles, counter-clockwise.
     pub triangles: Vec<[u32; 3]>,
+    /// Keys whose fans are not emitted (the MOVED_CENTER_3 run centres that `fin_vertices.rs`
+    /// re-triangulates), their vertices as a bit set, and how many triangles were left out.
+    drop: &'h FxHashSet<Key>,
+    dropped: Vec<u64>,
+    /// Number of triangles left out because they touch a vertex of `drop`.
+    pub removed: usize,
 }
 
 impl<'h> DualBuilder<'h> {
     /// Extracts the dual triangulation of the hierarchy's current hexagon mesh; `moved` gives
     /// the new positions of occupied centres. Storage is reserved exactly up front (one vertex
     /// per leaf full hexagon, at most two triangles per vertex), so nothing is reallocated.
-    pub fn build(h: &'h Hierarchy, moved: &'h FxHashMap<Key, Vec2>) -> Self {
+    /// Triangles with a vertex whose key is in `drop` are left out (their fans are replaced;
+    /// leaving them out here saves a pass over all triangles).
+    pub fn build(
+        h: &'h Hierarchy,
+        moved: &'h FxHashMap<Key, Vec2>,
+        drop: &'h FxHashSet<Key>,
+    ) -> Self {
         let leaves = h.leaf_count();
         let mut is_moved = HexSet::default();
         for &key in moved.keys() {
@@ -74,9 +86,17 @@ impl<'h> DualBuilder<'h> {
             moved,
             is_moved,
             open: FxHashMap::default(),
-            moved_vertex: FxHashMap::default(),
+            // Every moved key is a vertex (sized once: growing would rehash a large map).
+            moved_vertex: FxHashMap::with_capacity_and_hasher(moved.len(), Default::default()),
             positions: Vec::with_capacity(leaves),
             triangles: Vec::with_capacity(2 * leaves),
+            drop,
+            dropped: if drop.is_empty() {
+                Vec::new()
+            } else {
+                vec![0; leaves.div_ceil(64)]
+            },
+            removed: 0,
         };
         let o = b.new_vertex(1, (0, 0));
         let corners: [u32; 6] = std::array::from_fn(|i| b.new_vertex(1, DIRS[i]));
@@ -110,6 +130,9 @@ impl<'h> DualBuilder<'h> {
         let p = match moved {
             Some((key, p)) => {
                 self.moved_vertex.insert(key, n);
+                if !self.dropped.is_empty() && self.drop.contains(&key) {
+                    self.dropped[n as usize / 64] |= 1 << (n % 64);
+                }
                 p
             }
             None => self.h.frame.position(level, v),
@@ -162,8 +185,21 @@ impl<'h> DualBuilder<'h> {
             [true, true, false] => self.bisect(k, a, b, [ids[0], ids[1], ids[2]]),
             [false, true, true] => self.bisect(k, b, c, [ids[1], ids[2], ids[0]]),
             [true, false, true] => self.bisect(k, c, a, [ids[2], ids[0], ids[1]]),
-            _ => self.triangles.push(ids),
+            _ => self.push(ids),
         }
+    }
+
+    /// Appends a triangle unless it has a vertex in `drop`.
+    #[inline]
+    fn push(&mut self, t: [u32; 3]) {
+        if !self.dropped.is_empty()
+            && t.iter()
+                .any(|&v| self.dropped[v as usize / 64] >> (v % 64) & 1 != 0)
+        {
+            self.removed += 1;
+            return;
+        }
+        self.triangles.push(t);
     }
 
     /// Corners `a`, `b` split, the third not (counter-clockwise a, b, c; `ids` in that order):
@@ -171,7 +207,7 @@ impl<'h> DualBuilder<'h> {
     fn bisect(&mut self, k: u32, a: Axial, b: Axial, ids: [u32; 3]) {
         let m = self.midpoint(k + 1, add(a, b));
         let [va, vb, vc] = ids;
-        self.triangles.push([va, m, vc]);
-        self.triangles.push([m, vb, vc]);
+        self.push([va, m, vc]);
+        self.push([m, vb, vc]);
     }
 }

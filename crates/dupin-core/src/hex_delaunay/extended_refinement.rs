@@ -334,7 +334,10 @@ impl<'a> Pass<'a> {
                 }
             });
         for &(dist, z) in &near[..count] {
-            let q = self.r.point_in(k, z).expect("an occupied full cell has a point");
+            let q = self
+                .r
+                .point_in(k, z)
+                .expect("an occupied full cell has a point");
             let other = !in_half_hexagon(q, f.position(k, z), rad);
             match (dist, occ2, other) {
                 (2, true, true) => {
@@ -761,25 +764,20 @@ impl<'a> Pass<'a> {
 /// fins). Returns the marks and the relocations (meaningful when nothing is marked).
 fn full_pass(r: &Refinement, segments: &[[u32; 2]]) -> (Marks, Relocation) {
     let mut pass = Pass::new(r, segments);
+    // Every occupied hexagon is analysed: one map of known size instead of repeated growth.
+    pass.occupied.reserve(r.points.len());
     for c in &r.cell_of {
         if let Cell::Full(k, x) = *c {
             pass.visit_occupied(k, x);
         }
     }
     pass.freeze_rings();
-    let mut moved: FxHashMap<Key, Vec2> = FxHashMap::default();
+    let mut fin_moved = Vec::new();
     for_each_fin_leaf(&r.hierarchy, |k, v| {
         if let Leaf::Moved(p) = pass.visit(k, v) {
-            moved.insert(pack(k, v), p);
+            fin_moved.push((pack(k, v), p));
         }
     });
-    // The leaves without fins that move: the moved 1-rings of the OCCUPIED_2 (with nothing
-    // marked these are leaves without fins: a ring leaf with fins is split) and the runs' tops
-    // (set from the patches below).
-    let f = &r.hierarchy.frame;
-    for (&(k, z), s) in &pass.rings.as_ref().expect("frozen rings").moved {
-        moved.insert(pack(k, z), f.position(k, z) + s);
-    }
     // The accepted runs, in the order of their tops (deterministic vertex numbering).
     let mut accepted: Vec<((u32, Axial), usize)> = pass
         .runs
@@ -790,6 +788,26 @@ fn full_pass(r: &Refinement, segments: &[[u32; 2]]) -> (Marks, Relocation) {
         })
         .collect();
     accepted.sort_unstable();
+    let ring_moved = &pass.rings.as_ref().expect("frozen rings").moved;
+    // Sized once (with room for the points the dual adds): growing a map of this size
+    // rehashes it into fresh memory several times.
+    let n = fin_moved.len()
+        + ring_moved.len()
+        + accepted
+            .iter()
+            .map(|&(_, i)| pass.patches[i].moved.len() + pass.patches[i].uses.len())
+            .sum::<usize>()
+        + r.points.len();
+    let mut moved: FxHashMap<Key, Vec2> =
+        FxHashMap::with_capacity_and_hasher(n, Default::default());
+    moved.extend(fin_moved);
+    // The leaves without fins that move: the moved 1-rings of the OCCUPIED_2 (with nothing
+    // marked these are leaves without fins: a ring leaf with fins is split) and the runs' tops
+    // (set from the patches below).
+    let f = &r.hierarchy.frame;
+    for (&(k, z), s) in ring_moved {
+        moved.insert(pack(k, z), f.position(k, z) + s);
+    }
     let mut patches = Vec::with_capacity(accepted.len());
     for (_, i) in accepted {
         let p = std::mem::take(&mut pass.patches[i]);

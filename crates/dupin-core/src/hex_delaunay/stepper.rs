@@ -390,13 +390,14 @@ impl HexDelaunayStepper {
             }
             point_key.push(key);
         }
-        let mut dual = DualBuilder::build(h, &moved);
+        let mut dual = DualBuilder::build(h, &moved, &centres);
         debug_assert_eq!(dual.positions.len(), h.leaf_count());
         apply_fin_patches(
             &mut dual.positions,
             &mut dual.triangles,
             &dual.moved_vertex,
             &patches,
+            dual.removed,
         );
         let unique_vertex: Vec<u32> = point_key
             .iter()
