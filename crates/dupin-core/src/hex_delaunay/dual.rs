@@ -69,11 +69,13 @@ impl<'h> DualBuilder<'h> {
     /// the new positions of occupied centres. Storage is reserved exactly up front (one vertex
     /// per leaf full hexagon, at most two triangles per vertex), so nothing is reallocated.
     /// Triangles with a vertex whose key is in `drop` are left out (their fans are replaced;
-    /// leaving them out here saves a pass over all triangles).
+    /// leaving them out here saves a pass over all triangles). `extra` vertices (and two
+    /// triangles each) are reserved beyond the leaves, for what the caller appends.
     pub fn build(
         h: &'h Hierarchy,
         moved: &'h FxHashMap<Key, Vec2>,
         drop: &'h FxHashSet<Key>,
+        extra: usize,
     ) -> Self {
         let leaves = h.leaf_count();
         let mut is_moved = HexSet::default();
@@ -88,8 +90,8 @@ impl<'h> DualBuilder<'h> {
             open: FxHashMap::default(),
             // Every moved key is a vertex (sized once: growing would rehash a large map).
             moved_vertex: FxHashMap::with_capacity_and_hasher(moved.len(), Default::default()),
-            positions: Vec::with_capacity(leaves),
-            triangles: Vec::with_capacity(2 * leaves),
+            positions: Vec::with_capacity(leaves + extra),
+            triangles: Vec::with_capacity(2 * (leaves + extra)),
             drop,
             dropped: if drop.is_empty() {
                 Vec::new()

@@ -390,7 +390,9 @@ impl HexDelaunayStepper {
             }
             point_key.push(key);
         }
-        let mut dual = DualBuilder::build(h, &moved, &centres);
+        // The patches' new vertices are appended: reserved up front, not reallocated.
+        let extra = patches.iter().map(|p| p.new.len()).sum();
+        let mut dual = DualBuilder::build(h, &moved, &centres, extra);
         debug_assert_eq!(dual.positions.len(), h.leaf_count());
         apply_fin_patches(
             &mut dual.positions,
