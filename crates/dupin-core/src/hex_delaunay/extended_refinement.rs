@@ -446,6 +446,16 @@ impl<'a> Pass<'a> {
             && tops_in_window(h, k, v, w) == 0
     }
 
+    /// Whether an occupied full hexagon of level `k` lies within `r` steps of `y` (one read
+    /// of the occupied tiles).
+    fn occupied_within(&self, k: u32, y: Axial, r: i64) -> bool {
+        let mut any = false;
+        self.r
+            .occupied_full()
+            .for_each_in_stadium(k, y.0, (y.1, y.1), r, |_| any = true);
+        any
+    }
+
     /// Whether a segment passes within `dist` of `c`. A scan of all segments: O(segments) per
     /// run, only with a PSLG (a spatial index would make it O(1); not needed for our inputs).
     fn near_segment(&self, c: Vec2, dist: f64) -> bool {
@@ -506,7 +516,7 @@ impl<'a> Pass<'a> {
             // MOVED_CENTER hexagon at or next to a met one; measured: a run's fin vertices
             // next to a segment broke its insertion on the IMR letters).
             if on_boundary(k, y)
-                || disc(y, 2).any(|z| self.r.point_in(k, z).is_some())
+                || self.occupied_within(k, y, 2)
                 || self.near_segment(f.position(k, y), 3.0 * f.radius(k))
             {
                 return Rejected;
