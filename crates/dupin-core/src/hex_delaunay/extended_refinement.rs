@@ -762,11 +762,7 @@ impl<'a> Pass<'a> {
 
     /// The marks, sorted (deterministic order of the splits).
     fn marks(self) -> Marks {
-        let mut split: Vec<_> = self.split.into_iter().collect();
-        split.sort_unstable();
-        let mut present: Vec<_> = self.present.into_iter().collect();
-        present.sort_unstable();
-        (split, present)
+        (sorted_hexes(self.split), sorted_hexes(self.present))
     }
 }
 
@@ -862,8 +858,7 @@ fn affected(r: &Refinement, changes: &[(u32, Axial)]) -> (HexSet, HexSet) {
     let occ = r.occupied_full();
     // Changes in one lattice row with consecutive `b` are taken together: the union of their
     // discs is one interval per row (a "stadium"), so overlapping discs cost one insert.
-    let mut sorted = changes.to_vec();
-    sorted.sort_unstable();
+    let mut sorted = sorted_hexes(changes.iter().copied());
     sorted.dedup();
     let mut i = 0;
     while i < sorted.len() {
@@ -956,6 +951,29 @@ impl ExtendedState {
             c.extend_from_slice(made);
         }
     }
+}
+
+/// The hexagons in the order of `(level, a, b)`, sorted as one 128-bit key each (the order
+/// of the tuples; cheaper to compare). Coordinates are below 2^59 in magnitude (levels are
+/// capped at 48).
+fn sorted_hexes(hexes: impl IntoIterator<Item = (u32, Axial)>) -> Hexes {
+    const OFF: i64 = 1 << 59;
+    let mut keys: Vec<u128> = hexes
+        .into_iter()
+        .map(|(k, (a, b))| {
+            debug_assert!(a.abs() < OFF && b.abs() < OFF && k < 256);
+            (u128::from(k) << 120) | (((a + OFF) as u128) << 60) | (b + OFF) as u128
+        })
+        .collect();
+    keys.sort_unstable();
+    let mask = (1u128 << 60) - 1;
+    keys.into_iter()
+        .map(|x| {
+            let a = ((x >> 60) & mask) as i64 - OFF;
+            let b = (x & mask) as i64 - OFF;
+            ((x >> 120) as u32, (a, b))
+        })
+        .collect()
 }
 
 /// Lattice points within hexagonal distance `r` of `v`.
