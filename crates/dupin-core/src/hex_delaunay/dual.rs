@@ -20,6 +20,7 @@ use super::hierarchy::{HexSet, Hierarchy, window_bit};
 use super::lattice::{Axial, DIRS, add, normalize, on_boundary};
 use crate::math::Vec2;
 use rustc_hash::{FxHashMap, FxHashSet};
+use std::collections::hash_map::Entry;
 
 /// A normalised lattice position packed into 16 bytes: `(a + 2^50 | level << 56, b)`, the
 /// coordinates' low bits kept low for the locality-preserving hash.
@@ -149,11 +150,15 @@ impl<'h> DualBuilder<'h> {
             return self.new_vertex(level, v);
         }
         let key = pack(level, v);
-        match self.open.remove(&key) {
-            Some(i) => i,
-            None => {
+        // One hash per request: the first inserts the id the vertex is about to get, the
+        // second removes it.
+        let next = self.positions.len() as u32;
+        match self.open.entry(key) {
+            Entry::Occupied(e) => e.remove(),
+            Entry::Vacant(e) => {
+                e.insert(next);
                 let i = self.new_vertex(level, v);
-                self.open.insert(key, i);
+                debug_assert_eq!(i, next);
                 i
             }
         }

@@ -58,13 +58,15 @@ fn for_each_fin_leaf(h: &Hierarchy, mut f: impl FnMut(u32, Axial)) {
             if split == 0x3f {
                 continue;
             }
+            // The unsplit neighbours' fins lie within two steps of `x`: one window.
+            let w = h.split_window(k, x);
             for (j, d) in DIRS.iter().enumerate() {
                 let y = add(x, *d);
                 if split & (1 << j) != 0 || !in_domain(k, y) {
                     continue;
                 }
                 // `x` is `y + DIRS[j + 3]`.
-                if h.split_neighbours(k, y).trailing_zeros() as usize == (j + 3) % 6 {
+                if window_fins(w, *d).trailing_zeros() as usize == (j + 3) % 6 {
                     f(k, y);
                 }
             }
