@@ -27,7 +27,7 @@
 //!
 //! Cost: the rules are pure functions of the hierarchy, evaluated per hexagon in O(1) expected
 //! hash look-ups. After a wave of splits the next pass evaluates only the hexagons the splits
-//! can affect (found from the splits, and an index of occupied hexagons by lattice block), so
+//! can affect (found from the splits, and the refinement's tiled set of occupied cells), so
 //! the passes together cost O(S) for S splits; a full pass over all leaves, O(T) for T
 //! triangles, starts and ends the run (a few in all: one more each time it finds something
 //! the incremental passes left).
@@ -35,8 +35,8 @@
 use super::dual::{Key, pack};
 use super::error::HexDelaunayError;
 use super::fin_vertices::{FinPatch, Run, run_patch, top_new};
-use super::hierarchy::{Cell, HexSet, Hierarchy};
-use super::lattice::{Axial, DIRS, add, hex_norm, in_domain, on_boundary, parents_of_midpoint};
+use super::hierarchy::{Cell, HexSet, Hierarchy, window_bit};
+use super::lattice::{Axial, DIRS, add, hex_norm, in_domain, on_boundary};
 use super::simple_refinement::Refinement;
 use crate::math::Vec2;
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -44,30 +44,30 @@ use std::sync::Mutex;
 
 const SQRT3: f64 = 1.732_050_807_568_877_2;
 
-/// Calls `f(level, v)` for every leaf full hexagon.
-fn for_each_leaf(h: &Hierarchy, mut f: impl FnMut(u32, Axial)) {
-    if h.depth() == 0 {
-        f(0, (0, 0));
-        return;
-    }
-    for k in 0..h.depth() {
+/// Calls `f(level, v)` once for every leaf full hexagon with a fin (an unsplit full hexagon
+/// with a split neighbour of its level), found from the split hexagons: balancing makes every
+/// neighbour of a split hexagon present, so the unsplit ones are these leaves. Each is reported
+/// from its first split neighbour in `DIRS` order. Only these leaves can be marked or moved by
+/// a fin (a leaf without fins moves only in a ring or as a run's top), and they are about a
+/// tenth of all leaves on the uniform sets.
+fn for_each_fin_leaf(h: &Hierarchy, mut f: impl FnMut(u32, Axial)) {
+    // Level 0 is the root alone: no neighbours.
+    for k in 1..h.depth() {
         for x in h.split_at(k) {
-            let c = (2 * x.0, 2 * x.1);
-            if !h.is_split(k + 1, c) {
-                f(k + 1, c);
-            }
-            // `c + d` is the midpoint of `x` (split) and `x + d`: present when `x + d` is split
-            // or outside Ω, read for all six from one tile (what `is_present` would ask).
             let split = h.split_neighbours(k, x);
+            if split == 0x3f {
+                continue;
+            }
+            // The unsplit neighbours' fins lie within two steps of `x`: one window.
+            let w = h.split_window(k, x);
             for (j, d) in DIRS.iter().enumerate() {
-                let m = add(c, *d);
-                let present = split & (1 << j) != 0 || !in_domain(k, add(x, *d));
-                if !in_domain(k + 1, m) || !present || h.is_split(k + 1, m) {
+                let y = add(x, *d);
+                if split & (1 << j) != 0 || !in_domain(k, y) {
                     continue;
                 }
-                let (a, _) = parents_of_midpoint(m);
-                if a == x || !in_domain(k, a) {
-                    f(k + 1, m);
+                // `x` is `y + DIRS[j + 3]`.
+                if window_fins(w, *d).trailing_zeros() as usize == (j + 3) % 6 {
+                    f(k, y);
                 }
             }
         }
@@ -98,21 +98,6 @@ fn three_consecutive(mask: u8) -> Option<usize> {
     (0..6).find(|&j| mask == (1 << j) | (1 << ((j + 1) % 6)) | (1 << ((j + 2) % 6)))
 }
 
-/// Position of the offset `dz` (hexagonal norm 2) in the order of `ring(_, 2)`.
-fn ring2_index(dz: Axial) -> usize {
-    // ring(v, 2) walks side j from 2·DIRS[j] along DIRS[j + 2], two steps per side.
-    for j in 0..6 {
-        let d = DIRS[j];
-        let e = DIRS[(j + 2) % 6];
-        for t in 0..2 {
-            if (2 * d.0 + t * e.0, 2 * d.1 + t * e.1) == dz {
-                return 2 * j + t as usize;
-            }
-        }
-    }
-    unreachable!("offset of hexagonal norm 2")
-}
-
 /// Lattice points at hexagonal distance exactly `r` from `v`.
 fn ring(v: Axial, r: i64) -> impl Iterator<Item = Axial> {
     (0..6).flat_map(move |j| {
@@ -121,6 +106,15 @@ fn ring(v: Axial, r: i64) -> impl Iterator<Item = Axial> {
         (0..r).map(move |t| (v.0 + r * d.0 + t * e.0, v.1 + r * d.1 + t * e.1))
     })
 }
+
+/// The window bits of a hexagon and its six neighbours.
+const WINDOW_DISC1: u32 = window_bit((0, 0))
+    | window_bit(DIRS[0])
+    | window_bit(DIRS[1])
+    | window_bit(DIRS[2])
+    | window_bit(DIRS[3])
+    | window_bit(DIRS[4])
+    | window_bit(DIRS[5]);
 
 /// Outward normals of the half-sized hexagon's edges (at 30° + 60° i).
 const EDGE_NORMALS: [(f64, f64); 6] = [
@@ -142,24 +136,37 @@ fn in_half_hexagon(p: Vec2, c: Vec2, r: f64) -> bool {
 
 /// The neighbours of the leaf `t` at level `k` that have three consecutive fins facing away
 /// from `t`, i.e. whose top neighbour (section 5.1) is `t`, as a bit mask over `DIRS`. Such a
-/// `t` is no FIXED_CENTER (it is a MOVED_CENTER_4). The middle fin of `y = t + d_i` is then
-/// `t + 2 d_i`, so a leaf with no split hexagon two steps out costs six look-ups.
+/// `t` is no FIXED_CENTER (it is a MOVED_CENTER_4).
 fn tops_mask(h: &Hierarchy, k: u32, t: Axial) -> u8 {
+    tops_in_window(h, k, t, h.split_window(k, t))
+}
+
+/// [`tops_mask`] from the split window `w` around `t`: the middle fin of `y = t + d_i` is
+/// `t + 2 d_i`, and `y`'s fins all lie in the window.
+fn tops_in_window(h: &Hierarchy, k: u32, t: Axial, w: u32) -> u8 {
     let mut m = 0;
     for (i, d) in DIRS.iter().enumerate() {
-        if !h.is_split(k, add(t, add(*d, *d))) {
+        if w & window_bit(add(*d, *d)) == 0 {
             continue;
         }
         let y = add(t, *d);
-        if !h.is_present(k, y) || h.is_split(k, y) {
+        if !h.is_present(k, y) || w & window_bit(*d) != 0 {
             continue;
         }
         // Fins j..j+2 with the middle one j+1 = i, i.e. j = i - 1.
-        if three_consecutive(fin_mask(h, k, y)) == Some((i + 5) % 6) {
+        if three_consecutive(window_fins(w, *d)) == Some((i + 5) % 6) {
             m |= 1 << i;
         }
     }
     m
+}
+
+/// The fin mask of `v + d` (`d` zero or a neighbour direction) from the split window `w`
+/// around `v`.
+fn window_fins(w: u32, d: Axial) -> u8 {
+    DIRS.iter().enumerate().fold(0u8, |m, (j, e)| {
+        m | (u8::from(w & window_bit(add(d, *e)) != 0) << j)
+    })
 }
 
 /// The first position and length of the single run of set bits of a top's mask (cyclic),
@@ -234,6 +241,17 @@ enum Leaf {
     Fins,
 }
 
+/// The ring roles of a pass's analysed occupied hexagons.
+#[derive(Default)]
+struct Rings {
+    /// The hexagons in the 1-ring of an occupied hexagon or the 2-ring of an OCCUPIED_2 (and
+    /// the occupied ones), tiled: most queries are for hexagons in no ring.
+    member: HexSet,
+    /// The shift of each hexagon in the moved 1-ring of an OCCUPIED_2 (moved 1-rings never
+    /// overlap: two OCCUPIED_2 two steps apart are split).
+    moved: FxHashMap<(u32, Axial), Vec2>,
+}
+
 /// Hexagons as (level, centre).
 type Hexes = Vec<(u32, Axial)>;
 
@@ -249,13 +267,16 @@ struct Pass<'a> {
     /// The PSLG's segments (point index pairs); runs stay away from them (section 7.2).
     segments: &'a [[u32; 2]],
     occupied: FxHashMap<(u32, Axial), Occupied>,
-    /// In a full pass, once every occupied hexagon is analysed: the ring hexagons, with the
-    /// shift of a moved 1-ring (so a leaf asks one map instead of its 18 neighbours).
-    rings: Option<FxHashMap<(u32, Axial), Option<Vec2>>>,
+    /// Once the pass's occupied hexagons are analysed: the ring hexagons, with the shift of a
+    /// moved 1-ring (so a leaf asks one tile instead of its 18 neighbours).
+    rings: Option<Rings>,
     split: FxHashSet<(u32, Axial)>,
     present: FxHashSet<(u32, Axial)>,
     /// The verdicts on MOVED_CENTER_3 runs, by top, and the accepted runs' patches.
     runs: FxHashMap<(u32, Axial), RunVerdict>,
+    /// Leaf classes once the rings are frozen: a run's analysis asks for its top's other
+    /// neighbours, which the pass visits as leaves too.
+    leaves: FxHashMap<(u32, Axial), Leaf>,
     patches: Vec<FinPatch>,
 }
 
@@ -269,6 +290,7 @@ impl<'a> Pass<'a> {
             split: FxHashSet::default(),
             present: FxHashSet::default(),
             runs: FxHashMap::default(),
+            leaves: FxHashMap::default(),
             patches: Vec::new(),
         }
     }
@@ -300,21 +322,34 @@ impl<'a> Pass<'a> {
         // pair would put the points in cells too small for section 6.3's edge bound. Four
         // steps apart the rings only share fixed 2-ring hexagons (the paper's Fig. 7).
         let mut verify: f64 = 0.0;
-        for dist in 2..=3 {
-            for z in ring(x, dist) {
-                if let Some(q) = self.r.point_in(k, z) {
-                    let other = !in_half_hexagon(q, f.position(k, z), rad);
-                    match (dist, occ2, other) {
-                        (2, true, true) => {
-                            self.split.insert((k, x));
-                            return Occupied::Split;
-                        }
-                        (2, true, false) | (2, false, true) | (3, true, true) => {
-                            verify = verify.max((p - q).norm());
-                        }
-                        _ => {}
-                    }
+        // The occupied hexagons two or three steps away, from one read of the occupied tiles
+        // (the verdict does not depend on their order).
+        let mut near = [(0i64, (0i64, 0i64)); 37];
+        let mut count = 0;
+        self.r
+            .occupied_full()
+            .for_each_in_stadium(k, x.0, (x.1, x.1), 3, |z| {
+                let dist = hex_norm((z.0 - x.0, z.1 - x.1));
+                if dist >= 2 {
+                    near[count] = (dist, z);
+                    count += 1;
                 }
+            });
+        for &(dist, z) in &near[..count] {
+            let q = self
+                .r
+                .point_in(k, z)
+                .expect("an occupied full cell has a point");
+            let other = !in_half_hexagon(q, f.position(k, z), rad);
+            match (dist, occ2, other) {
+                (2, true, true) => {
+                    self.split.insert((k, x));
+                    return Occupied::Split;
+                }
+                (2, true, false) | (2, false, true) | (3, true, true) => {
+                    verify = verify.max((p - q).norm());
+                }
+                _ => {}
             }
         }
         // Ours: an OCCUPIED_2's moved 1-ring must not touch Ω's boundary (tiling).
@@ -325,16 +360,18 @@ impl<'a> Pass<'a> {
         // Ours: the 2-ring must be unsplit full hexagons of this level (rules 4 and 5 one ring
         // further out): a finer one splits the occupied hexagon, a coarser one is made present.
         let mut rough = None;
-        for z in ring(x, 2) {
+        let win = h.split_window(k, x);
+        for (z, d) in ring(x, 2).zip(ring((0, 0), 2)) {
             if !in_domain(k, z) {
                 continue;
             }
-            if !h.is_present(k, z) {
-                self.present.insert((k, z));
-                rough.get_or_insert(Occupied::Rough);
-            } else if h.is_split(k, z) {
+            // A split hexagon is present.
+            if win & window_bit(d) != 0 {
                 self.split.insert((k, x));
                 rough = Some(Occupied::Split);
+            } else if !h.is_present(k, z) {
+                self.present.insert((k, z));
+                rough.get_or_insert(Occupied::Rough);
             }
         }
         if let Some(o) = rough {
@@ -360,7 +397,10 @@ impl<'a> Pass<'a> {
     /// The shift of `v` at level `k` if it lies in the moved 1-ring of an OCCUPIED_2.
     fn ring1_moved(&mut self, k: u32, v: Axial) -> Option<Vec2> {
         if let Some(rings) = &self.rings {
-            return rings.get(&(k, v)).copied().flatten();
+            if !rings.member.contains(k, v) {
+                return None;
+            }
+            return rings.moved.get(&(k, v)).copied();
         }
         for z in ring(v, 1) {
             if let Some(Occupied::Rings {
@@ -380,7 +420,7 @@ impl<'a> Pass<'a> {
             return true;
         }
         if let Some(rings) = &self.rings {
-            return rings.contains_key(&(k, v));
+            return rings.member.contains(k, v);
         }
         for dist in 1..=2 {
             for z in ring(v, dist) {
@@ -397,12 +437,25 @@ impl<'a> Pass<'a> {
     /// FIXED_CENTER_x: no fins, not occupied, not moved in a ring.
     fn fixed(&mut self, k: u32, v: Axial) -> bool {
         let h = &self.r.hierarchy;
-        h.is_present(k, v)
-            && !h.is_split(k, v)
-            && fin_mask(h, k, v) == 0
+        if !h.is_present(k, v) {
+            return false;
+        }
+        // Itself and its neighbours unsplit (no fins), then the rest in the same order.
+        let w = h.split_window(k, v);
+        w & WINDOW_DISC1 == 0
             && self.r.point_in(k, v).is_none()
             && self.ring1_moved(k, v).is_none()
-            && tops_mask(h, k, v) == 0
+            && tops_in_window(h, k, v, w) == 0
+    }
+
+    /// Whether an occupied full hexagon of level `k` lies within `r` steps of `y` (one read
+    /// of the occupied tiles).
+    fn occupied_within(&self, k: u32, y: Axial, r: i64) -> bool {
+        let mut any = false;
+        self.r
+            .occupied_full()
+            .for_each_in_stadium(k, y.0, (y.1, y.1), r, |_| any = true);
+        any
     }
 
     /// Whether a segment passes within `dist` of `c`. A scan of all segments: O(segments) per
@@ -465,7 +518,7 @@ impl<'a> Pass<'a> {
             // MOVED_CENTER hexagon at or next to a met one; measured: a run's fin vertices
             // next to a segment broke its insertion on the IMR letters).
             if on_boundary(k, y)
-                || disc(y, 2).any(|z| self.r.point_in(k, z).is_some())
+                || self.occupied_within(k, y, 2)
                 || self.near_segment(f.position(k, y), 3.0 * f.radius(k))
             {
                 return Rejected;
@@ -502,7 +555,7 @@ impl<'a> Pass<'a> {
                         None => return Pending,
                     }
                 } else {
-                    match self.leaf(k, x) {
+                    match self.frozen_leaf(k, x) {
                         Leaf::Moved(p) => p,
                         Leaf::Fixed => f.position(k, x),
                         Leaf::Split => return Pending,
@@ -540,6 +593,20 @@ impl<'a> Pass<'a> {
         }
         self.patches.push(patch);
         Accepted(self.patches.len() - 1)
+    }
+
+    /// [`leaf`](Self::leaf), memoised while the rings are frozen (with exact ring roles, in
+    /// `verify`, the class may differ, so it is computed anew there).
+    fn frozen_leaf(&mut self, k: u32, v: Axial) -> Leaf {
+        if self.rings.is_none() {
+            return self.leaf(k, v);
+        }
+        if let Some(&l) = self.leaves.get(&(k, v)) {
+            return l;
+        }
+        let l = self.leaf(k, v);
+        self.leaves.insert((k, v), l);
+        l
     }
 
     /// Classifies the leaf full hexagon `v` at level `k` (5.1, 5.2, 5.4).
@@ -597,34 +664,18 @@ impl<'a> Pass<'a> {
             }
             (f.position(k + 1, ab), 0.4)
         };
-        // Ours: opposite-facing fin strips. The neighbours' fins come from the split states of
-        // the 2-ring, each asked once (the ring's hexagons are shared by two neighbours).
+        // Ours: opposite-facing fin strips. The neighbours' fins come from one read of the
+        // split states around v.
         let adjacent_fins =
             mask | (mask << 1) | (mask >> 1) | ((mask & 1) << 5) | ((mask >> 5) & 1);
-        let ring2: [bool; 12] = {
-            let mut it = ring(v, 2);
-            std::array::from_fn(|_| h.is_split(k, it.next().expect("12 hexagons")))
-        };
+        let win = h.split_window(k, v);
         for (i, d) in DIRS.iter().enumerate() {
             let y = add(v, *d);
             if mask & (1 << i) != 0 || !h.is_present(k, y) {
                 continue;
             }
-            // Neighbours of y: v (unsplit), y + d_i = ring-2 corner 2i, its two ring-1 sides
-            // v + d_{i±1}, and the ring-2 hexagons 2i ± 1 between them.
-            let split_at = |j: usize| -> bool {
-                let e = DIRS[j];
-                let z = add(y, e);
-                let dz = (z.0 - v.0, z.1 - v.1);
-                if dz == (0, 0) {
-                    return false;
-                }
-                if let Some(m) = DIRS.iter().position(|&q| q == dz) {
-                    return mask & (1 << m) != 0;
-                }
-                ring2[ring2_index(dz)]
-            };
-            let my = (0..6).fold(0u8, |m, j| m | (u8::from(split_at(j)) << j));
+            // The fins of y (its neighbours lie in the window; v itself is unsplit).
+            let my = window_fins(win, *d);
             if my != 0 && my & adjacent_fins == 0 {
                 return Leaf::Split;
             }
@@ -633,13 +684,10 @@ impl<'a> Pass<'a> {
         Leaf::Moved(c + (target - c) * w)
     }
 
-    /// Visits the leaf `v` at level `k`: marks it when a rule splits it. Without `position`,
-    /// a leaf without fins (which no rule splits) is not looked at further.
-    fn visit(&mut self, k: u32, v: Axial, position: bool) -> Leaf {
-        if !position && fin_mask(&self.r.hierarchy, k, v) == 0 {
-            return Leaf::Fixed;
-        }
-        let l = self.leaf(k, v);
+    /// Visits the leaf `v` at level `k` (one with fins: no rule splits the others): marks it
+    /// when a rule splits it.
+    fn visit(&mut self, k: u32, v: Axial) -> Leaf {
+        let l = self.frozen_leaf(k, v);
         if l == Leaf::Split {
             self.split.insert((k, v));
         }
@@ -698,19 +746,15 @@ impl<'a> Pass<'a> {
     /// a full pass; in an incremental pass those near the changes, so a role may be missed:
     /// that only keeps a leaf from being marked, which a later pass catches).
     fn freeze_rings(&mut self) {
-        let mut rings: FxHashMap<(u32, Axial), Option<Vec2>> = FxHashMap::default();
+        let mut rings = Rings::default();
         for (&(k, x), o) in &self.occupied {
             if let Occupied::Rings { occ2, shift, .. } = *o {
-                for z in ring(x, 1) {
-                    // A moved 1-ring's shift wins over a fixed ring membership.
-                    let e = rings.entry((k, z)).or_insert(None);
-                    if occ2 {
-                        *e = Some(shift);
-                    }
-                }
+                // `x` itself is occupied: in a ring for `in_some_ring` anyway, and in no moved
+                // 1-ring (occupied hexagons are never adjacent).
+                rings.member.insert_disc(k, x, if occ2 { 2 } else { 1 });
                 if occ2 {
-                    for z in ring(x, 2) {
-                        rings.entry((k, z)).or_insert(None);
+                    for z in ring(x, 1) {
+                        rings.moved.insert((k, z), shift);
                     }
                 }
             }
@@ -720,27 +764,26 @@ impl<'a> Pass<'a> {
 
     /// The marks, sorted (deterministic order of the splits).
     fn marks(self) -> Marks {
-        let mut split: Vec<_> = self.split.into_iter().collect();
-        split.sort_unstable();
-        let mut present: Vec<_> = self.present.into_iter().collect();
-        present.sort_unstable();
-        (split, present)
+        (sorted_hexes(self.split), sorted_hexes(self.present))
     }
 }
 
-/// A full pass: every occupied hexagon and every leaf. Returns the marks and the relocations.
+/// A full pass: every occupied hexagon and every leaf with fins (no rule marks a leaf without
+/// fins). Returns the marks and the relocations (meaningful when nothing is marked).
 fn full_pass(r: &Refinement, segments: &[[u32; 2]]) -> (Marks, Relocation) {
     let mut pass = Pass::new(r, segments);
+    // Every occupied hexagon is analysed: one map of known size instead of repeated growth.
+    pass.occupied.reserve(r.points.len());
     for c in &r.cell_of {
         if let Cell::Full(k, x) = *c {
             pass.visit_occupied(k, x);
         }
     }
     pass.freeze_rings();
-    let mut moved: FxHashMap<Key, Vec2> = FxHashMap::default();
-    for_each_leaf(&r.hierarchy, |k, v| {
-        if let Leaf::Moved(p) = pass.visit(k, v, true) {
-            moved.insert(pack(k, v), p);
+    let mut fin_moved = Vec::new();
+    for_each_fin_leaf(&r.hierarchy, |k, v| {
+        if let Leaf::Moved(p) = pass.visit(k, v) {
+            fin_moved.push((pack(k, v), p));
         }
     });
     // The accepted runs, in the order of their tops (deterministic vertex numbering).
@@ -753,6 +796,26 @@ fn full_pass(r: &Refinement, segments: &[[u32; 2]]) -> (Marks, Relocation) {
         })
         .collect();
     accepted.sort_unstable();
+    let ring_moved = &pass.rings.as_ref().expect("frozen rings").moved;
+    // Sized once (with room for the points the dual adds): growing a map of this size
+    // rehashes it into fresh memory several times.
+    let n = fin_moved.len()
+        + ring_moved.len()
+        + accepted
+            .iter()
+            .map(|&(_, i)| pass.patches[i].moved.len() + pass.patches[i].uses.len())
+            .sum::<usize>()
+        + r.points.len();
+    let mut moved: FxHashMap<Key, Vec2> =
+        FxHashMap::with_capacity_and_hasher(n, Default::default());
+    moved.extend(fin_moved);
+    // The leaves without fins that move: the moved 1-rings of the OCCUPIED_2 (with nothing
+    // marked these are leaves without fins: a ring leaf with fins is split) and the runs' tops
+    // (set from the patches below).
+    let f = &r.hierarchy.frame;
+    for (&(k, z), s) in ring_moved {
+        moved.insert(pack(k, z), f.position(k, z) + s);
+    }
     let mut patches = Vec::with_capacity(accepted.len());
     for (_, i) in accepted {
         let p = std::mem::take(&mut pass.patches[i]);
@@ -778,65 +841,6 @@ pub struct Relocation {
     pub patches: Vec<FinPatch>,
 }
 
-/// Side of the square blocks of lattice coordinates (as a shift) that index the occupied
-/// hexagons of a level, to find those near a change without scanning all points.
-const BLOCK: u32 = 3;
-
-/// The occupied hexagons per level and block of lattice coordinates. Entries go stale when a
-/// point leaves its cell (dropped on use); new ones are added for the children of every split.
-#[derive(Debug, Clone, Default)]
-struct OccupiedIndex {
-    blocks: FxHashMap<(u32, Axial), Vec<Axial>>,
-}
-
-impl OccupiedIndex {
-    fn rebuild(&mut self, r: &Refinement) {
-        self.blocks.clear();
-        for c in &r.cell_of {
-            if let Cell::Full(k, x) = *c {
-                self.add(k, x);
-            }
-        }
-    }
-
-    fn add(&mut self, k: u32, x: Axial) {
-        let b = self
-            .blocks
-            .entry((k, (x.0 >> BLOCK, x.1 >> BLOCK)))
-            .or_default();
-        if !b.contains(&x) {
-            b.push(x);
-        }
-    }
-
-    /// Records the occupied children of the split hexagon `x` at level `k`.
-    fn after_split(&mut self, r: &Refinement, k: u32, x: Axial) {
-        for z in disc((2 * x.0, 2 * x.1), 1) {
-            if r.point_in(k + 1, z).is_some() {
-                self.add(k + 1, z);
-            }
-        }
-    }
-
-    /// Calls `f` for every occupied hexagon of level `k` within hexagonal distance `rad` of
-    /// `c` (dropping stale entries on the way).
-    fn near(&mut self, r: &Refinement, k: u32, c: Axial, rad: i64, mut f: impl FnMut(Axial)) {
-        for bx in (c.0 - rad) >> BLOCK..=(c.0 + rad) >> BLOCK {
-            for by in (c.1 - rad) >> BLOCK..=(c.1 + rad) >> BLOCK {
-                let Some(b) = self.blocks.get_mut(&(k, (bx, by))) else {
-                    continue;
-                };
-                b.retain(|&x| r.point_in(k, x).is_some());
-                for &x in b.iter() {
-                    if hex_norm((x.0 - c.0, x.1 - c.1)) <= rad {
-                        f(x);
-                    }
-                }
-            }
-        }
-    }
-}
-
 /// What an incremental pass visits after the splits `changes`.
 ///
 /// Leaves: only a leaf with fins can be marked, so a split of `(k, x)` matters to the leaves
@@ -850,65 +854,68 @@ impl OccupiedIndex {
 /// a waived ring conflict, the relocations of the 2-ring (fins one step further, fin-side
 /// hexagons one level finer); the leaves read their rings. Those within eight steps at levels
 /// `k` and `k + 1` (from `2x`) and six at level `k - 1` are re-run and give the ring roles.
-fn affected(r: &Refinement, index: &mut OccupiedIndex, changes: &[(u32, Axial)]) -> (Hexes, Hexes) {
+fn affected(r: &Refinement, changes: &[(u32, Axial)]) -> (HexSet, HexSet) {
     let mut leaves = HexSet::default();
-    let mut occupied: FxHashSet<(u32, Axial)> = FxHashSet::default();
-    for &(k, x) in changes {
-        index.after_split(r, k, x);
-    }
-    for &(k, x) in changes {
-        let c = (2 * x.0, 2 * x.1);
-        leaves.insert_disc(k, x, 2);
-        leaves.insert_disc(k + 1, c, 3);
+    let mut occupied = HexSet::default();
+    let occ = r.occupied_full();
+    // Changes in one lattice row with consecutive `b` are taken together: the union of their
+    // discs is one interval per row (a "stadium"), so overlapping discs cost one insert.
+    let mut sorted = sorted_hexes(changes.iter().copied());
+    sorted.dedup();
+    let mut i = 0;
+    while i < sorted.len() {
+        let (k, (a, lo)) = sorted[i];
+        let mut hi = lo;
+        i += 1;
+        while i < sorted.len() && sorted[i] == (k, (a, hi + 1)) {
+            hi += 1;
+            i += 1;
+        }
+        leaves.insert_stadium(k, a, (lo, hi), 2);
+        leaves.insert_stadium(k + 1, 2 * a, (2 * lo, 2 * hi), 3);
         if k >= 1 {
-            let half = (x.0.div_euclid(2), x.1.div_euclid(2));
-            leaves.insert_disc(k - 1, half, 2);
-            index.near(r, k - 1, half, 6, |o| {
-                occupied.insert((k - 1, o));
+            let half = (lo.div_euclid(2), hi.div_euclid(2));
+            leaves.insert_stadium(k - 1, a.div_euclid(2), half, 2);
+            occ.for_each_in_stadium(k - 1, a.div_euclid(2), half, 6, |o| {
+                occupied.insert(k - 1, o);
             });
         }
-        index.near(r, k, x, 8, |o| {
-            occupied.insert((k, o));
+        occ.for_each_in_stadium(k, a, (lo, hi), 8, |o| {
+            occupied.insert(k, o);
         });
-        index.near(r, k + 1, c, 8, |o| {
-            occupied.insert((k + 1, o));
+        occ.for_each_in_stadium(k + 1, 2 * a, (2 * lo, 2 * hi), 8, |o| {
+            occupied.insert(k + 1, o);
         });
     }
     // The order of the visits does not matter (the rules read the state, not the marks).
-    (leaves.iter().collect(), occupied.into_iter().collect())
+    (leaves, occupied)
 }
 
 /// An incremental pass over the given leaves and occupied hexagons.
-fn region_pass(
-    r: &Refinement,
-    segments: &[[u32; 2]],
-    leaves: &[(u32, Axial)],
-    occupied: &[(u32, Axial)],
-) -> Marks {
+fn region_pass(r: &Refinement, segments: &[[u32; 2]], leaves: &HexSet, occupied: &HexSet) -> Marks {
     let h = &r.hierarchy;
     let mut pass = Pass::new(r, segments);
-    for &(k, x) in occupied {
+    for (k, x) in occupied.iter() {
         pass.visit_occupied(k, x);
     }
     pass.freeze_rings();
-    for &(k, v) in leaves {
-        // Only a leaf with fins can be marked; the fins are the cheapest test.
-        if !h.is_split(k, v) && fin_mask(h, k, v) != 0 && h.is_present(k, v) {
-            pass.visit(k, v, true);
+    // Only a leaf with fins can be marked; the fins are the cheapest test.
+    h.for_each_with_fins(leaves, |k, v| {
+        if h.is_present(k, v) {
+            pass.visit(k, v);
         }
-    }
+    });
     pass.marks()
 }
 
 /// The state between extended passes: the splits since the last pass (`None`: the next pass
-/// is a full one) and the index of occupied hexagons. After splits a pass classifies only the
-/// hexagons near them (a work queue of affected hexagons, one pass per wave of splits). A run
-/// ends only after a full pass finds nothing, so the result is a fixed point of the full
-/// rules, at O(changes) cost per incremental pass.
+/// is a full one). After splits a pass classifies only the hexagons near them (a work queue
+/// of affected hexagons, one pass per wave of splits). A run ends only after a full pass finds
+/// nothing, so the result is a fixed point of the full rules, at O(changes) cost per
+/// incremental pass.
 #[derive(Debug, Default)]
 pub struct ExtendedState {
     changes: Option<Vec<(u32, Axial)>>,
-    index: OccupiedIndex,
     /// The relocations of the last full pass that found nothing, with the split count and
     /// number of points it saw: the dual takes them instead of a further full pass. Taken
     /// from behind `&self` (a Mutex, not a RefCell, keeps the stepper `Sync`) so that they
@@ -920,7 +927,6 @@ impl Clone for ExtendedState {
     fn clone(&self) -> Self {
         ExtendedState {
             changes: self.changes.clone(),
-            index: self.index.clone(),
             relocation: Mutex::new(lock(&self.relocation).clone()),
         }
     }
@@ -949,6 +955,29 @@ impl ExtendedState {
     }
 }
 
+/// The hexagons in the order of `(level, a, b)`, sorted as one 128-bit key each (the order
+/// of the tuples; cheaper to compare). Coordinates are below 2^59 in magnitude (levels are
+/// capped at 48).
+fn sorted_hexes(hexes: impl IntoIterator<Item = (u32, Axial)>) -> Hexes {
+    const OFF: i64 = 1 << 59;
+    let mut keys: Vec<u128> = hexes
+        .into_iter()
+        .map(|(k, (a, b))| {
+            debug_assert!(a.abs() < OFF && b.abs() < OFF && k < 256);
+            (u128::from(k) << 120) | (((a + OFF) as u128) << 60) | (b + OFF) as u128
+        })
+        .collect();
+    keys.sort_unstable();
+    let mask = (1u128 << 60) - 1;
+    keys.into_iter()
+        .map(|x| {
+            let a = ((x >> 60) & mask) as i64 - OFF;
+            let b = (x & mask) as i64 - OFF;
+            ((x >> 120) as u32, (a, b))
+        })
+        .collect()
+}
+
 /// Lattice points within hexagonal distance `r` of `v`.
 fn disc(v: Axial, r: i64) -> impl Iterator<Item = Axial> {
     (-r..=r).flat_map(move |a| ((-r).max(-a - r)..=r.min(-a + r)).map(move |b| (v.0 + a, v.1 + b)))
@@ -967,11 +996,10 @@ pub fn extended_pass(
         let full = state.changes.is_none();
         let (split, present) = match state.changes.take() {
             Some(changes) => {
-                let (leaves, occupied) = affected(r, &mut state.index, &changes);
+                let (leaves, occupied) = affected(r, &changes);
                 region_pass(r, segments, &leaves, &occupied)
             }
             None => {
-                state.index.rebuild(r);
                 let (marks, relocation) = full_pass(r, segments);
                 if marks.0.is_empty() && marks.1.is_empty() {
                     // The fixed point: these are the dual's relocations.

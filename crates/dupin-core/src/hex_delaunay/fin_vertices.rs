@@ -239,27 +239,20 @@ pub fn run_patch(run: &Run) -> Option<FinPatch> {
     Some(p)
 }
 
-/// Applies the patches to the plain dual: sets the moved positions, appends the new
-/// vertices, and replaces every triangle at a run centre by the patch's triangles.
-/// `vertex_of` gives the vertex of every key a patch names.
+/// Applies the patches to a plain dual built without the triangles at the run centres
+/// (`DualBuilder::build` leaves out the fans of the keys it is given; `removed` of them): sets
+/// the moved positions, appends the new vertices and the patches' triangles. `vertex_of`
+/// gives the vertex of every key a patch names.
 pub fn apply_fin_patches(
     positions: &mut Vec<Vec2>,
     triangles: &mut Vec<[u32; 3]>,
     vertex_of: &FxHashMap<Key, u32>,
     patches: &[FinPatch],
+    removed: usize,
 ) {
     if patches.is_empty() {
         return;
     }
-    let mut centre = vec![false; positions.len()];
-    for p in patches {
-        for k in &p.centres {
-            centre[vertex_of[k] as usize] = true;
-        }
-    }
-    let old = triangles.len();
-    triangles.retain(|t| !t.iter().any(|&v| centre[v as usize]));
-    let removed = old - triangles.len();
     let mut added = 0;
     for p in patches {
         for &(k, q) in &p.moved {

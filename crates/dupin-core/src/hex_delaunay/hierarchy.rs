@@ -85,7 +85,19 @@ impl Hierarchy {
         }
     }
 
+    /// The split states of the 5×5 lattice points around `v` at `level` (the disc of radius
+    /// 2 among them) as a bit mask: bit [`window_bit`]`(d)` is set when `v + d` is split. A few
+    /// tile rows instead of up to 19 queries.
+    #[inline]
+    pub fn split_window(&self, level: u32, v: Axial) -> u32 {
+        match self.split.get(level as usize) {
+            Some(s) => s.window(v),
+            None => 0,
+        }
+    }
+
     /// Whether the lattice point `v` at `level` is a full hexagon (leaf or split).
+    #[inline]
     pub fn is_present(&self, level: u32, v: Axial) -> bool {
         if level == 0 {
             return v == (0, 0);
@@ -93,13 +105,39 @@ impl Hierarchy {
         if !in_domain(level, v) {
             return false;
         }
+        // One look-up of the parents' level (this is the most frequent query).
+        let parents = self.split.get(level as usize - 1);
+        let split = |e: Axial| parents.is_some_and(|s| s.contains(e));
         if is_even(v) {
-            return self.is_split(level - 1, (v.0 >> 1, v.1 >> 1));
+            return split((v.0 >> 1, v.1 >> 1));
         }
         let (a, b) = parents_of_midpoint(v);
-        [a, b]
-            .into_iter()
-            .all(|e| !in_domain(level - 1, e) || self.is_split(level - 1, e))
+        // The domain test only for a parent that is not split (most parents are inside).
+        (split(a) || !in_domain(level - 1, a)) && (split(b) || !in_domain(level - 1, b))
+    }
+
+    /// Whether `v` (in Ω) and its neighbours in Ω at `level >= 1` are all present, read from
+    /// one window of the parents' split states: the parents of these points lie within two
+    /// steps of `v / 2` (rounded down).
+    fn disc1_present(&self, level: u32, v: Axial) -> bool {
+        let u = (v.0 >> 1, v.1 >> 1);
+        let w = self.split_window(level - 1, u);
+        let split = |e: Axial| {
+            let d = (e.0 - u.0, e.1 - u.1);
+            debug_assert!(d.0.abs() <= 2 && d.1.abs() <= 2, "{d:?} outside the window");
+            w & window_bit(d) != 0
+        };
+        std::iter::once((0, 0)).chain(DIRS).all(|d| {
+            let z = add(v, d);
+            if !in_domain(level, z) {
+                return d != (0, 0);
+            }
+            if is_even(z) {
+                return split((z.0 >> 1, z.1 >> 1));
+            }
+            let (a, b) = parents_of_midpoint(z);
+            (split(a) || !in_domain(level - 1, a)) && (split(b) || !in_domain(level - 1, b))
+        })
     }
 
     /// Makes `v` at `level` a full hexagon, splitting what lies on it. New splits are appended
@@ -141,11 +179,14 @@ impl Hierarchy {
                 max_level: self.max_level,
             });
         }
-        self.ensure_present(level, v, out)?;
-        for d in DIRS {
-            let y = add(v, d);
-            if in_domain(level, y) {
-                self.ensure_present(level, y, out)?;
+        // Usually `v` and its neighbours are present already: one window read says so.
+        if level == 0 || !self.disc1_present(level, v) {
+            self.ensure_present(level, v, out)?;
+            for d in DIRS {
+                let y = add(v, d);
+                if in_domain(level, y) {
+                    self.ensure_present(level, y, out)?;
+                }
             }
         }
         if self.split.len() <= level as usize {
@@ -209,16 +250,70 @@ impl Hierarchy {
         for (k, set) in self.split.iter().enumerate() {
             let k = k as u32;
             for x in set.iter() {
-                for d in DIRS {
-                    let y = add(x, d);
+                let split = set.neighbours(x);
+                for (j, d) in DIRS.iter().enumerate() {
+                    let y = add(x, *d);
                     let boundary_join = !in_domain(k, y) && in_domain(k + 1, add(x, y));
-                    if boundary_join || (self.is_split(k, y) && x < y) {
+                    if boundary_join || (split & (1 << j) != 0 && x < y) {
                         n += 1;
                     }
                 }
             }
         }
         n
+    }
+
+    /// Calls `f(level, v)` for every member `v` of `set` that is unsplit with a split neighbour
+    /// of its level (a leaf with fins if it is present), in `set`'s order. Per tile of `set`,
+    /// the fins of all 256 points come from the split tile and the edges of its eight
+    /// neighbours, a few shifts per row, instead of two queries per member.
+    pub fn for_each_with_fins(&self, set: &HexSet, mut f: impl FnMut(u32, Axial)) {
+        for (k, cand) in set.levels.iter().enumerate() {
+            let Some(split) = self.split.get(k) else {
+                break;
+            };
+            for (t, words) in cand.words.iter().enumerate() {
+                if *words == [0; 4] {
+                    continue;
+                }
+                let (ta, tb) = cand.keys[t];
+                // rows[a + 1], a in -1..=16: the split bits of row a, columns -1..=16 at bits
+                // 0..=17.
+                let mut rows = [0u32; 18];
+                for (da, r0, r1) in [(-1i64, 15usize, 15usize), (0, 0, 15), (1, 0, 0)] {
+                    for db in -1i64..=1 {
+                        let i = split.tile((ta + da, tb + db));
+                        if i == NONE {
+                            continue;
+                        }
+                        let w = &split.words[i as usize];
+                        for r in r0..=r1 {
+                            let bits = ((w[r >> 2] >> ((r & 3) << TILE)) & 0xffff) as u32;
+                            let part = match db {
+                                -1 => bits >> 15,
+                                0 => bits << 1,
+                                _ => (bits & 1) << 17,
+                            };
+                            // Row r of the tile above or below is row -1 or 16 here.
+                            let a = (da * 16 + r as i64 + 1) as usize;
+                            rows[a] |= part;
+                        }
+                    }
+                }
+                for a in 0..16usize {
+                    let (up, me, down) = (rows[a + 2], rows[a + 1], rows[a]);
+                    // Neighbours (1, 0), (1, -1), (0, 1), (0, -1), (-1, 1), (-1, 0).
+                    let fins = up | (up << 1) | (me >> 1) | (me << 1) | (down >> 1) | down;
+                    let c = ((words[a >> 2] >> ((a & 3) << TILE)) & 0xffff) as u32;
+                    let mut hits = (fins >> 1) & !(me >> 1) & c & 0xffff;
+                    while hits != 0 {
+                        let col = i64::from(hits.trailing_zeros());
+                        hits &= hits - 1;
+                        f(k as u32, ((ta << TILE) | a as i64, (tb << TILE) | col));
+                    }
+                }
+            }
+        }
     }
 
     /// Iterates over the split hexagons of `level`, tile by tile (deterministic order).
@@ -228,6 +323,12 @@ impl Hierarchy {
             .into_iter()
             .flat_map(TileSet::iter)
     }
+}
+
+/// The bit of the offset `d` (both coordinates in -2..=2) in [`Hierarchy::split_window`].
+#[inline]
+pub const fn window_bit(d: Axial) -> u32 {
+    1 << (5 * (d.0 + 2) + d.1 + 2)
 }
 
 /// A set of hexagons `(level, centre)` stored like the split sets (16×16 tiles of bits per
@@ -254,20 +355,44 @@ impl HexSet {
     /// Inserts every lattice point within hexagonal distance `r` of `c` at `level` (the
     /// neighbourhood of a change), a row of bits at a time.
     pub fn insert_disc(&mut self, level: u32, c: Axial, r: i64) {
+        self.insert_stadium(level, c.0, (c.1, c.1), r);
+    }
+
+    /// Inserts the union of the discs of radius `r` around `(a, b)` for `b` in the range
+    /// `bs` (inclusive): per row one interval, as the discs of neighbouring centres overlap.
+    pub fn insert_stadium(&mut self, level: u32, a: i64, bs: (i64, i64), r: i64) {
         if self.levels.len() <= level as usize {
             self.levels
                 .resize_with(level as usize + 1, TileSet::default);
         }
         let set = &mut self.levels[level as usize];
-        for i in -r..=r {
-            let a = c.0 + i;
-            let (mut b0, b1) = (c.1 + (-r).max(-i - r), c.1 + r.min(-i + r));
-            while b0 <= b1 {
-                // The part of the row inside one tile.
-                let end = b1.min(b0 | TILE_MASK);
-                self.len += set.insert_run(a, b0, end);
-                b0 = end + 1;
+        // A column of tiles at a time, so that consecutive rows mostly hit the memoised tile.
+        for tb in (bs.0 - r) >> TILE..=(bs.1 + r) >> TILE {
+            let (lo, hi) = (tb << TILE, (tb << TILE) | TILE_MASK);
+            for i in -r..=r {
+                // The part of the row `a + i` inside this tile column.
+                let b0 = (bs.0 + (-r).max(-i - r)).max(lo);
+                let b1 = (bs.1 + r.min(-i + r)).min(hi);
+                if b0 <= b1 {
+                    self.len += set.insert_run(a + i, b0, b1);
+                }
             }
+        }
+    }
+
+    /// Calls `f` for every member of `level` in the union of the discs of radius `r` around
+    /// `(a, b)`, `b` in the range `bs` (inclusive), a tile at a time (a few tile reads instead
+    /// of one query per lattice point).
+    pub fn for_each_in_stadium(
+        &self,
+        level: u32,
+        a: i64,
+        bs: (i64, i64),
+        r: i64,
+        f: impl FnMut(Axial),
+    ) {
+        if let Some(s) = self.levels.get(level as usize) {
+            s.for_each_in_stadium(a, bs, r, f);
         }
     }
 
@@ -427,6 +552,53 @@ impl TileSet {
             | bit(1, -1) << 5
     }
 
+    /// The 5×5 window of bits around `v` (see [`Hierarchy::split_window`]): five rows of five
+    /// bits, from one tile column or, where the window crosses a tile edge in `b`, two (each
+    /// column's rows cross at most one tile edge in `a`, so the memo keeps probes rare).
+    #[inline]
+    fn window(&self, v: Axial) -> u32 {
+        let (row, col) = (v.0 & TILE_MASK, v.1 & TILE_MASK);
+        if (2..=TILE_MASK - 2).contains(&row) && (2..=TILE_MASK - 2).contains(&col) {
+            // Inside one tile (the common case): one look-up.
+            let i = self.tile((v.0 >> TILE, v.1 >> TILE));
+            if i == NONE {
+                return 0;
+            }
+            let w = &self.words[i as usize];
+            let mut win = 0u32;
+            for dr in 0..5 {
+                let r = (row - 2 + dr) as usize;
+                let bits = ((w[r >> 2] >> ((r & 3) << TILE)) & 0xffff) as u32;
+                win |= ((bits >> (col - 2)) & 31) << (5 * dr);
+            }
+            return win;
+        }
+        let b0 = v.1 - 2;
+        let col = (b0 & TILE_MASK) as u32;
+        let mut win = 0u32;
+        for part in 0..=i64::from(col > 11) {
+            let tb = (b0 >> TILE) + part;
+            for dr in 0..5 {
+                let a = v.0 - 2 + dr;
+                let i = self.tile((a >> TILE, tb));
+                if i == NONE {
+                    continue;
+                }
+                let row = (a & TILE_MASK) as usize;
+                let bits =
+                    ((self.words[i as usize][row >> 2] >> ((row & 3) << TILE)) & 0xffff) as u32;
+                // The first tile holds columns col.., the second the rest from 0.
+                let five = if part == 0 {
+                    bits >> col
+                } else {
+                    bits << (16 - col)
+                } & 31;
+                win |= five << (5 * dr);
+            }
+        }
+        win
+    }
+
     /// The index of tile `key`, created empty if absent.
     #[inline(always)]
     fn tile_or_insert(&mut self, key: Axial) -> u32 {
@@ -463,6 +635,39 @@ impl TileSet {
         let new = (m & !*w).count_ones() as usize;
         *w |= m;
         new
+    }
+
+    /// Calls `f` for every member of the union of the discs of radius `r` around `(a, b)`,
+    /// `b` in `bs`: per tile of the bounding box, each row's interval is one mask on the
+    /// tile's row of 16 bits.
+    fn for_each_in_stadium(&self, a: i64, bs: (i64, i64), r: i64, mut f: impl FnMut(Axial)) {
+        let (a0, a1, b0, b1) = (a - r, a + r, bs.0 - r, bs.1 + r);
+        for ta in a0 >> TILE..=a1 >> TILE {
+            for tb in b0 >> TILE..=b1 >> TILE {
+                let i = self.tile((ta, tb));
+                if i == NONE {
+                    continue;
+                }
+                let w = &self.words[i as usize];
+                let (base_a, base_b) = (ta << TILE, tb << TILE);
+                for row_a in a0.max(base_a)..=a1.min(base_a | TILE_MASK) {
+                    // The row's interval: b - bs in [max(-r, -i - r), min(r, -i + r)].
+                    let i = row_a - a;
+                    let lo = (bs.0 + (-r).max(-i - r)).max(base_b);
+                    let hi = (bs.1 + r.min(-i + r)).min(base_b | TILE_MASK);
+                    if lo > hi {
+                        continue;
+                    }
+                    let row = (row_a & TILE_MASK) as usize;
+                    let bits = (w[row >> 2] >> ((row & 3) << TILE)) & 0xffff;
+                    let mut m = bits & (((1u64 << (hi - lo + 1)) - 1) << (lo & TILE_MASK));
+                    while m != 0 {
+                        f((row_a, base_b | i64::from(m.trailing_zeros())));
+                        m &= m - 1;
+                    }
+                }
+            }
+        }
     }
 
     /// Removes `v` (an emptied tile stays, as an all-zero entry); returns whether it was in.
@@ -551,6 +756,40 @@ mod tests {
                 assert_eq!(t.neighbours((a, b)), m, "{a} {b}");
             }
         }
+        let mut h = Hierarchy::new(
+            Frame {
+                origin: Vec2::zeros(),
+                root_radius: 1.0,
+            },
+            8,
+        );
+        h.split = vec![t.clone()];
+        for a in -45..45 {
+            for b in -45..45 {
+                let w = h.split_window(0, (a, b));
+                for da in -2..=2 {
+                    for db in -2..=2 {
+                        let want = s.contains(&(a + da, b + db));
+                        assert_eq!(w & window_bit((da, db)) != 0, want, "{a} {b} {da} {db}");
+                    }
+                }
+            }
+        }
+        // The bulk fin test finds the members with fins that are not in the set themselves.
+        let mut cand = HexSet::default();
+        for _ in 0..3000 {
+            cand.insert(
+                0,
+                (rng.random_range(-45i64..45), rng.random_range(-45i64..45)),
+            );
+        }
+        let mut bulk = Vec::new();
+        h.for_each_with_fins(&cand, |k, v| bulk.push((k, v)));
+        let naive: Vec<(u32, Axial)> = cand
+            .iter()
+            .filter(|&(_, v)| !t.contains(v) && t.neighbours(v) != 0)
+            .collect();
+        assert_eq!(bulk, naive);
         let mut got: Vec<Axial> = t.iter().collect();
         let n = got.len();
         got.sort_unstable();
@@ -609,6 +848,44 @@ mod tests {
                     assert_eq!(t.contains(k, (a, b)), s.contains(&(k, (a, b))));
                 }
             }
+        }
+        // Stadium queries find exactly the members within the distance of a centre, and
+        // stadium inserts insert exactly those points.
+        for _ in 0..300 {
+            let (k, a, b, len, r) = (
+                rng.random_range(0u32..4),
+                rng.random_range(-45i64..45),
+                rng.random_range(-45i64..45),
+                rng.random_range(0i64..6),
+                rng.random_range(0i64..10),
+            );
+            let near = |v: Axial| {
+                (b..=b + len).any(|bc| {
+                    let d = (v.0 - a, v.1 - bc);
+                    d.0.abs().max(d.1.abs()).max((d.0 + d.1).abs()) <= r
+                })
+            };
+            let mut got = Vec::new();
+            t.for_each_in_stadium(k, a, (b, b + len), r, |v| got.push(v));
+            got.sort_unstable();
+            let mut want: Vec<Axial> = s
+                .iter()
+                .filter(|h| h.0 == k && near(h.1))
+                .map(|h| h.1)
+                .collect();
+            want.sort_unstable();
+            assert_eq!(got, want, "{k} {a} {b} {len} {r}");
+            let mut u = HexSet::default();
+            u.insert_stadium(k, a, (b, b + len), r);
+            let mut got: Vec<Axial> = u.iter().map(|h| h.1).collect();
+            got.sort_unstable();
+            let mut want: Vec<Axial> = (a - r..=a + r)
+                .flat_map(|x| (b - r..=b + len + r).map(move |y| (x, y)))
+                .filter(|&v| near(v))
+                .collect();
+            want.sort_unstable();
+            assert_eq!(got, want, "{a} {b} {len} {r}");
+            assert_eq!(u.iter().len(), want.len());
         }
         assert_eq!(t.iter().len(), s.len());
         let mut got: Vec<_> = t.iter().collect();

@@ -83,6 +83,17 @@ pub fn normalize(mut level: u32, mut v: Axial) -> (u32, Axial) {
     (level, v)
 }
 
+/// `HALF_POWERS[i]` = 2^-i, exactly.
+const HALF_POWERS: [f64; 64] = {
+    let mut t = [1.0; 64];
+    let mut i = 1;
+    while i < 64 {
+        t[i] = t[i - 1] * 0.5;
+        i += 1;
+    }
+    t
+};
+
 /// Placement of the lattice in the plane: the root hexagon's centre and circumradius.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Frame {
@@ -96,7 +107,11 @@ impl Frame {
     /// Circumradius of the full hexagons of `level`.
     #[inline]
     pub fn radius(&self, level: u32) -> f64 {
-        self.root_radius * 0.5f64.powi(level as i32)
+        // 2^-level from a table (exact either way; `powi` is a call on this hot path).
+        match HALF_POWERS.get(level as usize) {
+            Some(&s) => self.root_radius * s,
+            None => self.root_radius * 0.5f64.powi(level as i32),
+        }
     }
 
     /// Position of the centre `v` at `level`.

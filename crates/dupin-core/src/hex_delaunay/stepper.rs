@@ -1,7 +1,7 @@
 //! The stepper: the refinement one observable subdivision step at a time, for the page's 2D
 //! view, plus the input checks and bounding-hexagon set-up shared with the one-shot function.
 
-use super::dual::{DualBuilder, Key, pack};
+use super::dual::{DualBuilder, Key, pack, unpack};
 use super::error::HexDelaunayError;
 use super::extended_refinement::{ExtendedState, Relocation, extended_pass, relocated_centres};
 use super::fin_vertices::apply_fin_patches;
@@ -390,13 +390,16 @@ impl HexDelaunayStepper {
             }
             point_key.push(key);
         }
-        let mut dual = DualBuilder::build(h, &moved);
+        // The patches' new vertices are appended: reserved up front, not reallocated.
+        let extra = patches.iter().map(|p| p.new.len()).sum();
+        let mut dual = DualBuilder::build(h, &moved, &centres, extra);
         debug_assert_eq!(dual.positions.len(), h.leaf_count());
         apply_fin_patches(
             &mut dual.positions,
             &mut dual.triangles,
             &dual.moved_vertex,
             &patches,
+            dual.removed,
         );
         let unique_vertex: Vec<u32> = point_key
             .iter()
@@ -432,9 +435,8 @@ impl HexDelaunayStepper {
 
 /// The lattice position of a packed dual key.
 fn lattice_position(h: &Hierarchy, key: Key) -> Vec2 {
-    let level = (key.0 >> 56) as u32;
-    let a = (key.0 & ((1 << 56) - 1)) - (1 << 50);
-    h.frame.position(level, (a, key.1))
+    let (level, v) = unpack(key);
+    h.frame.position(level, v)
 }
 
 fn bits(p: &Vec2) -> (u64, u64) {
