@@ -38,9 +38,15 @@ const TRANSPOSED: u32 = 1 << 31;
 
 type Block = Matrix4<f64>;
 
-#[inline]
-fn vec4(g: &[f64; MAX_BLOCK]) -> Vector4<f64> {
-    Vector4::new(g[0], g[1], g[2], g[3])
+/// `m += a bᵀ` on a nalgebra (column-major) 4 x 4 matrix, as plain array arithmetic.
+#[inline(always)]
+fn add_outer_matrix(m: &mut Block, a: &[f64; MAX_BLOCK], b: &[f64; MAX_BLOCK]) {
+    let m = m.as_mut_slice();
+    for l in 0..4 {
+        for k in 0..4 {
+            m[4 * l + k] += a[k] * b[l];
+        }
+    }
 }
 
 /// `acc += a bᵀ` on a row-major 4 x 4 block (plain arrays: the compiler vectorises this,
@@ -473,12 +479,11 @@ impl BlockNormal {
             let local = map.row_elim[r];
             if local != NONE {
                 let le = &row[local as usize];
-                let ge = vec4(&le.grad);
-                self.c[le.block as usize - nk].ger(1.0, &ge, &ge, 1.0);
+                add_outer_matrix(&mut self.c[le.block as usize - nk], &le.grad, &le.grad);
                 for (i, a) in row.iter().enumerate() {
                     let bi = map.b_index[entry + i];
                     if bi != NONE {
-                        self.b[bi as usize].ger(1.0, &vec4(&a.grad), &ge, 1.0);
+                        add_outer_matrix(&mut self.b[bi as usize], &a.grad, &le.grad);
                     }
                 }
             }
