@@ -1,12 +1,15 @@
 //! The toolkit's key guarantees, run natively and on wasm32 (through wasm-bindgen-test): the
-//! core must behave identically in the browser (P-Hex paper, sections 3 to 5.1).
+//! core must behave identically in the browser (P-Hex paper, sections 3 to 5.1; the sparse
+//! Gauss-Newton engine of the conical paper's PQ perturbation).
 
 #[cfg(target_arch = "wasm32")]
 use wasm_bindgen_test::wasm_bindgen_test as test;
 
 use dupin_core::{
-    DupinIndicatrix, TriangleStar, Vec2, dupin_center, ideal_triangle,
-    is_affine_quasi_regular_hexagon, is_affine_regular_hexagon, surface_by_name, surface_catalog,
+    DupinIndicatrix, MeshTopology, PqMode, PqOptions, SurfaceOfRevolution, TriangleStar, Vec2,
+    conical_residual, dupin_center, ideal_triangle, is_affine_quasi_regular_hexagon,
+    is_affine_regular_hexagon, max_planarity, pq_perturb, principal_quad_mesh, skew_quad_grid,
+    surface_by_name, surface_catalog, torus_centroid_dual,
 };
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -81,4 +84,36 @@ fn ideal_triangles_are_ideal() {
             assert!(is_affine_quasi_regular_hexagon(&h.vertices, &a, 1e-9));
         }
     }
+}
+
+/// The block Gauss-Newton engine (plane elimination for quads, planes kept for hexagons,
+/// second-order correction in the exact phase) reaches the exact constraints on wasm32 as
+/// natively: planar quads and hexagons, and a conical mesh.
+#[test]
+fn pq_perturbation_reaches_the_exact_constraints() {
+    for m in [
+        skew_quad_grid(10, 30.0),
+        torus_centroid_dual(16, 8, 3.0, 1.0),
+    ] {
+        assert!(max_planarity(&m) > 1e-3);
+        let r = pq_perturb(&m, PqOptions::default()).unwrap();
+        assert!(r.converged, "{:?}", r.reason);
+        assert!(max_planarity(&r.mesh) <= 1e-10);
+    }
+    let mut m = principal_quad_mesh(&SurfaceOfRevolution::vase(), (0.0, 6.0), (-0.9, 0.9), 8, 8);
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    for p in &mut m.positions {
+        for k in 0..3 {
+            p[k] += 0.01 * (rng.random::<f64>() - 0.5);
+        }
+    }
+    let conical = PqOptions {
+        mode: PqMode::Conical,
+        ..PqOptions::default()
+    };
+    let r = pq_perturb(&m, conical).unwrap();
+    assert!(r.converged, "{:?}", r.reason);
+    let topo = MeshTopology::new(&r.mesh).unwrap();
+    assert!(max_planarity(&r.mesh) <= 1e-10);
+    assert!(conical_residual(&r.mesh, &topo) <= 1e-10);
 }
