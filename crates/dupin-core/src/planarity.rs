@@ -8,7 +8,7 @@ use nalgebra::{Matrix3, SymmetricEigen};
 /// Planarity error of face `i` of `mesh` (0 for a triangle, up to rounding).
 ///
 /// The least-squares plane passes through the centroid, with normal the eigenvector of the
-/// smallest eigenvalue of the vertices' covariance matrix ([`least_squares_normal`]).
+/// smallest eigenvalue of the vertices' covariance matrix (`least_squares_normal`).
 pub fn face_planarity(mesh: &PolyMesh, i: usize) -> f64 {
     let f = mesh.face(i);
     let n = f.len();
