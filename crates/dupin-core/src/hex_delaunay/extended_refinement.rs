@@ -99,7 +99,7 @@ fn three_consecutive(mask: u8) -> Option<usize> {
 }
 
 /// Lattice points at hexagonal distance exactly `r` from `v`.
-fn ring(v: Axial, r: i64) -> impl Iterator<Item = Axial> {
+pub(super) fn ring(v: Axial, r: i64) -> impl Iterator<Item = Axial> {
     (0..6).flat_map(move |j| {
         let d = DIRS[j];
         let e = DIRS[(j + 2) % 6];
@@ -127,7 +127,7 @@ const EDGE_NORMALS: [(f64, f64); 6] = [
 ];
 
 /// Whether `p` lies in the half-sized hexagon of the hexagon with centre `c`, circumradius `r`.
-fn in_half_hexagon(p: Vec2, c: Vec2, r: f64) -> bool {
+pub(super) fn in_half_hexagon(p: Vec2, c: Vec2, r: f64) -> bool {
     let q = p - c;
     EDGE_NORMALS
         .iter()
@@ -137,7 +137,7 @@ fn in_half_hexagon(p: Vec2, c: Vec2, r: f64) -> bool {
 /// The neighbours of the leaf `t` at level `k` that have three consecutive fins facing away
 /// from `t`, i.e. whose top neighbour (section 5.1) is `t`, as a bit mask over `DIRS`. Such a
 /// `t` is no FIXED_CENTER (it is a MOVED_CENTER_4).
-fn tops_mask(h: &Hierarchy, k: u32, t: Axial) -> u8 {
+pub(super) fn tops_mask(h: &Hierarchy, k: u32, t: Axial) -> u8 {
     tops_in_window(h, k, t, h.split_window(k, t))
 }
 
@@ -817,7 +817,9 @@ fn full_pass(r: &Refinement, segments: &[[u32; 2]]) -> (Marks, Relocation) {
         moved.insert(pack(k, z), f.position(k, z) + s);
     }
     let mut patches = Vec::with_capacity(accepted.len());
-    for (_, i) in accepted {
+    let mut tops = Vec::with_capacity(accepted.len());
+    for (t, i) in accepted {
+        tops.push(t);
         let p = std::mem::take(&mut pass.patches[i]);
         // The dual builder reports the vertex of every key in `moved`.
         for &(key, q) in &p.moved {
@@ -828,7 +830,14 @@ fn full_pass(r: &Refinement, segments: &[[u32; 2]]) -> (Marks, Relocation) {
         }
         patches.push(p);
     }
-    (pass.marks(), Relocation { moved, patches })
+    (
+        pass.marks(),
+        Relocation {
+            moved,
+            patches,
+            tops,
+        },
+    )
 }
 
 /// The relocations of section 5.4 for the dual of a finished extended refinement.
@@ -839,6 +848,24 @@ pub struct Relocation {
     pub moved: FxHashMap<Key, Vec2>,
     /// The MOVED_CENTER_3 hexagons, whose centre vertex the fins' vertices replace.
     pub patches: Vec<FinPatch>,
+    /// The top of each patch's run, sorted (the patches' order, which numbers the vertices).
+    pub tops: Vec<(u32, Axial)>,
+}
+
+impl Relocation {
+    /// Adds an accepted run's patch (its vertices' positions and the patch, at its top's
+    /// place in the order).
+    fn add_patch(&mut self, top: (u32, Axial), p: FinPatch) {
+        for &(key, q) in &p.moved {
+            self.moved.insert(key, q);
+        }
+        for &(key, q) in &p.uses {
+            self.moved.entry(key).or_insert(q);
+        }
+        let at = self.tops.partition_point(|&t| t < top);
+        self.tops.insert(at, top);
+        self.patches.insert(at, p);
+    }
 }
 
 /// What an incremental pass visits after the splits `changes`.
@@ -906,6 +933,60 @@ fn region_pass(r: &Refinement, segments: &[[u32; 2]], leaves: &HexSet, occupied:
         }
     });
     pass.marks()
+}
+
+/// After the coarsening into blossoms (`coarsening.rs`) merged `merged`, forming blossoms
+/// around `tops`, right after a full pass that found nothing: verifies in an incremental pass
+/// over what the merges can affect (the same neighbourhoods as for splits: the rules read the
+/// split states there) that no rule fires and every blossom's run is accepted, and adds the
+/// blossoms' patches to that full pass's relocations, which stay valid elsewhere (the blossoms'
+/// 4-rings were FIXED_CENTER_REGULAR and stay fixed, nothing else changes class). Returns
+/// whether that held; if not (or without cached relocations), the next pass is a full one.
+/// Saves the second full pass over all leaves (O(T)): the check is O(blossoms).
+#[inline(never)] // called once per run; kept out of the stepper for profiles
+pub fn after_coarsening(
+    r: &Refinement,
+    state: &mut ExtendedState,
+    segments: &[[u32; 2]],
+    splits_before: usize,
+    merged: &[(u32, Axial)],
+    tops: &[(u32, Axial)],
+) -> bool {
+    state.changes = None;
+    let cached = lock(&state.relocation).take();
+    let Some((splits, points, mut relocation)) = cached else {
+        return false;
+    };
+    if splits != splits_before || points != r.points.len() {
+        return false;
+    }
+    let (leaves, occupied) = affected(r, merged);
+    let h = &r.hierarchy;
+    let mut pass = Pass::new(r, segments);
+    for (k, x) in occupied.iter() {
+        pass.visit_occupied(k, x);
+    }
+    pass.freeze_rings();
+    h.for_each_with_fins(&leaves, |k, v| {
+        if h.is_present(k, v) {
+            pass.visit(k, v);
+        }
+    });
+    let mut accepted = Vec::with_capacity(tops.len());
+    for &(k, t) in tops {
+        match pass.run(k, t) {
+            RunVerdict::Accepted(i) => accepted.push(((k, t), i)),
+            _ => return false,
+        }
+    }
+    if !pass.split.is_empty() || !pass.present.is_empty() {
+        return false;
+    }
+    for (top, i) in accepted {
+        relocation.add_patch(top, std::mem::take(&mut pass.patches[i]));
+    }
+    *lock(&state.relocation) = Some((h.split_count, r.points.len(), relocation));
+    true
 }
 
 /// The state between extended passes: the splits since the last pass (`None`: the next pass

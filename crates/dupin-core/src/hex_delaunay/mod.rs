@@ -29,6 +29,7 @@
 //! leaves, under a local check, see `extended_refinement.rs` and `fin_vertices.rs`).
 //! Incremental insertion is [`HexDelaunayStepper::insert`].
 
+mod coarsening;
 mod dual;
 mod error;
 mod extended_refinement;
