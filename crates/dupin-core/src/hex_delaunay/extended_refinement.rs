@@ -631,6 +631,9 @@ impl<'a> Pass<'a> {
         if !ok {
             return Rejected;
         }
+        // The moved top's triangles were only checked: not kept (memory at the dual's peak).
+        let mut patch = patch;
+        patch.around_top = Vec::new();
         self.patches.push(patch);
         Accepted(self.patches.len() - 1)
     }
@@ -879,7 +882,7 @@ fn full_pass(r: &Refinement, segments: &[[u32; 2]]) -> (Marks, Relocation) {
     let mut tops = Vec::with_capacity(accepted.len());
     for (t, i) in accepted {
         tops.push(t);
-        let p = std::mem::take(&mut pass.patches[i]);
+        let mut p = std::mem::take(&mut pass.patches[i]);
         // The dual builder reports the vertex of every key in `moved`.
         for &(key, q) in &p.moved {
             moved.insert(key, q);
@@ -887,6 +890,8 @@ fn full_pass(r: &Refinement, segments: &[[u32; 2]]) -> (Marks, Relocation) {
         for &(key, q) in &p.uses {
             moved.entry(key).or_insert(q);
         }
+        // Now in `moved`; not kept twice through the dual's peak.
+        p.uses = Vec::new();
         patches.push(p);
     }
     (
@@ -914,13 +919,14 @@ pub struct Relocation {
 impl Relocation {
     /// Adds an accepted run's patch (its vertices' positions and the patch, at its top's
     /// place in the order).
-    fn add_patch(&mut self, top: (u32, Axial), p: FinPatch) {
+    fn add_patch(&mut self, top: (u32, Axial), mut p: FinPatch) {
         for &(key, q) in &p.moved {
             self.moved.insert(key, q);
         }
         for &(key, q) in &p.uses {
             self.moved.entry(key).or_insert(q);
         }
+        p.uses = Vec::new();
         let at = self.tops.partition_point(|&t| t < top);
         self.tops.insert(at, top);
         self.patches.insert(at, p);
