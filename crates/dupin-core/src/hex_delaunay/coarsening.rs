@@ -64,20 +64,16 @@ fn blossom_fits(r: &Refinement, segments: &[[u32; 2]], k: u32, t: Axial) -> bool
     }
     let f = &h.frame;
     let occ = r.occupied_full();
-    let mut occupied_near = false;
-    occ.for_each_in_stadium(k, t.0, (t.1, t.1), 3, |_| occupied_near = true);
-    if occupied_near {
+    if occ.any_in_disc(k, t, 3) || occ.any_in_disc(fine, c, 5) {
         return false;
     }
+    // At distance 6 only an OCCUPIED_2 reaches the 4-ring (with its 2-ring).
     let rad = f.radius(fine);
+    let mut occupied_near = false;
     occ.for_each_in_stadium(fine, c.0, (c.1, c.1), 6, |z| {
-        let dist = hex_norm((z.0 - c.0, z.1 - c.1));
-        let occ2 = r
+        occupied_near |= r
             .point_in(fine, z)
             .is_some_and(|p| !in_half_hexagon(p, f.position(fine, z), rad));
-        if dist <= 5 || occ2 {
-            occupied_near = true;
-        }
     });
     if occupied_near || ring(c, 4).any(|z| tops_mask(h, fine, z) != 0) {
         return false;

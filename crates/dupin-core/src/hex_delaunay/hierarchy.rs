@@ -404,11 +404,9 @@ impl Hierarchy {
     /// Whether a hexagon of `level` within hexagonal distance `r` of `c` is split (a few tile
     /// reads).
     pub fn any_split_within(&self, level: u32, c: Axial, r: i64) -> bool {
-        let mut any = false;
-        if let Some(s) = self.split.get(level as usize) {
-            s.for_each_in_stadium(c.0, (c.1, c.1), r, |_| any = true);
-        }
-        any
+        self.split
+            .get(level as usize)
+            .is_some_and(|s| s.any_in_disc(c, r))
     }
 
     /// Calls `f(v)` for every split hexagon `v` of `level` whose six neighbours are split and
@@ -574,6 +572,14 @@ impl HexSet {
         if let Some(s) = self.levels.get(level as usize) {
             s.for_each_in_stadium(a, bs, r, f);
         }
+    }
+
+    /// Whether a member of `level` lies within hexagonal distance `r` of `c` (stops at the
+    /// first).
+    pub fn any_in_disc(&self, level: u32, c: Axial, r: i64) -> bool {
+        self.levels
+            .get(level as usize)
+            .is_some_and(|s| s.any_in_disc(c, r))
     }
 
     /// Removes `v` at `level`.
@@ -875,6 +881,36 @@ impl TileSet {
                 }
             }
         }
+    }
+
+    /// Whether a member lies within hexagonal distance `r` of `c`: the rows of
+    /// [`for_each_in_stadium`](Self::for_each_in_stadium), stopping at the first set bit.
+    fn any_in_disc(&self, c: Axial, r: i64) -> bool {
+        let (a0, a1, b0, b1) = (c.0 - r, c.0 + r, c.1 - r, c.1 + r);
+        for ta in a0 >> TILE..=a1 >> TILE {
+            for tb in b0 >> TILE..=b1 >> TILE {
+                let i = self.tile((ta, tb));
+                if i == NONE {
+                    continue;
+                }
+                let w = &self.words[i as usize];
+                let (base_a, base_b) = (ta << TILE, tb << TILE);
+                for row_a in a0.max(base_a)..=a1.min(base_a | TILE_MASK) {
+                    let i = row_a - c.0;
+                    let lo = (c.1 + (-r).max(-i - r)).max(base_b);
+                    let hi = (c.1 + r.min(-i + r)).min(base_b | TILE_MASK);
+                    if lo > hi {
+                        continue;
+                    }
+                    let row = (row_a & TILE_MASK) as usize;
+                    let bits = (w[row >> 2] >> ((row & 3) << TILE)) & 0xffff;
+                    if bits & (((1u64 << (hi - lo + 1)) - 1) << (lo & TILE_MASK)) != 0 {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
     }
 
     /// Removes `v` (an emptied tile stays, as an all-zero entry); returns whether it was in.
@@ -1297,6 +1333,13 @@ mod tests {
                 .collect();
             want.sort_unstable();
             assert_eq!(got, want, "{k} {a} {b} {len} {r}");
+            if len == 0 {
+                let any = t
+                    .levels
+                    .get(k as usize)
+                    .is_some_and(|s| s.any_in_disc((a, b), r));
+                assert_eq!(any, !want.is_empty(), "{k} {a} {b} {r}");
+            }
             let mut u = HexSet::default();
             u.insert_stadium(k, a, (b, b + len), r);
             let mut got: Vec<Axial> = u.iter().map(|h| h.1).collect();
