@@ -140,7 +140,8 @@ const EXTENDED_ASPECT: f64 = 1.207_87;
 /// K is made for a pair with d <= (3√3 + 2) r_K (rule 1: 2 r_K, rule 3: (√3 + 2) r_K, ring
 /// conflicts: two or three steps), so leaves have r >= d / (2 (3√3 + 2)), and every edge is at
 /// least Fig. 8's √7/2 r: bound √7 d / (4 (3√3 + 2)) ≈ 0.0919·d (measured minimum over the
-/// families: see docs/hexdelaunay.md).
+/// families: see docs/hexdelaunay.md). Section 6.3's own bound fails on
+/// `shortest_edge_counterexample`'s three points (0.0989·d).
 fn extended_min_edge(d: f64) -> f64 {
     d * 7f64.sqrt() / (4.0 * (3.0 * 3f64.sqrt() + 2.0))
 }
@@ -561,9 +562,9 @@ fn paper_data_sets_take_fewer_triangles_than_table_1() {
         println!("{name}: simple {simple}, extended {extended} triangles (paper: {paper})");
         assert!(simple < paper, "{name}: {simple} triangles, paper {paper}");
         // The extended mode still splits MOVED_CENTER_3 runs that fail its local check and
-        // coarsens nothing into blossoms (see extended_refinement.rs), so it is not below the
-        // paper's counts everywhere; its counts are reported in BENCHMARKS.md, its guarantees
-        // checked above.
+        // forms few blossoms (see extended_refinement.rs, coarsening.rs), so it is not below
+        // the paper's counts everywhere; its counts are reported in BENCHMARKS.md, its
+        // guarantees checked above.
     }
 }
 
