@@ -30,8 +30,9 @@
 //! edges at least √7/2 of the fin level's radius), so the guarantees are unchanged; the final
 //! extended passes confirm the fixed point (a blossom they reject would be split again).
 //!
-//! Cost: candidates are the split hexagons of each level whose 2-ring window (one read of the
-//! split tiles) is all split; each is checked with a few tile reads, so the pass is O(S) for S
+//! Cost: candidates come from a bit-parallel scan of the split tiles of each level (the
+//! 2-ring split, the next level unsplit within 5 steps of `2t`: `Hierarchy::
+//! for_each_blossom_top`), each then checked with a few tile reads, so the pass is O(S) for S
 //! split hexagons, with no search per candidate. Candidates are taken in order and checked on
 //! the current hierarchy, so two blossoms never overlap (their 5-discs are disjoint).
 
@@ -50,16 +51,21 @@ pub struct Coarsening {
     pub merged: Vec<(u32, Axial)>,
 }
 
-/// Whether a blossom can be formed around `t` at level `k` (see the module docs).
+/// Whether a blossom can be formed around `t` at level `k` (see the module docs), for a
+/// candidate `t` of [`Hierarchy::for_each_blossom_top`](super::hierarchy::Hierarchy).
 fn blossom_fits(r: &Refinement, segments: &[[u32; 2]], k: u32, t: Axial) -> bool {
     let h = &r.hierarchy;
+    // `t` comes from `for_each_blossom_top`; merges since (earlier blossoms of this level)
+    // only unsplit hexagons of level `k`, so the next level stays unsplit around `2t`, and
+    // the 2-ring is read again (all its children present then).
     if k == 0 || h.split_window(k, t) & WINDOW_DISC2 != WINDOW_DISC2 {
         return false;
     }
+    debug_assert!(!h.any_split_within(k + 1, (2 * t.0, 2 * t.1), 5));
     let fine = k + 1;
     let c = (2 * t.0, 2 * t.1);
     // Level-(k+1) boundary points have hexagonal norm 2^k: the 5-disc strictly inside.
-    if hex_norm(c) + 5 >= 1i64 << k || h.any_split_within(fine, c, 5) {
+    if hex_norm(c) + 5 >= 1i64 << k {
         return false;
     }
     let f = &h.frame;
@@ -110,18 +116,10 @@ pub fn coarsen(r: &mut Refinement, segments: &[[u32; 2]]) -> Coarsening {
     for k in (1..depth).rev() {
         // Candidates in the tiles' order (deterministic), each checked on the current state.
         let h = &r.hierarchy;
-        // From the tiles: split, six split neighbours, the central child a leaf (a few
-        // shifts per tile row); then the children's neighbours unsplit and the 2-ring split
-        // (one window each).
+        // From the tiles: the 2-ring split, the next level unsplit within 5 steps of `2t`
+        // (bit-parallel, a few shifts per tile row).
         let mut candidates = Vec::new();
-        h.for_each_split_parent_of_leaf(k, |t| {
-            let c = (2 * t.0, 2 * t.1);
-            if h.split_window(k + 1, c) & WINDOW_DISC2 == 0
-                && h.split_window(k, t) & WINDOW_DISC2 == WINDOW_DISC2
-            {
-                candidates.push(t);
-            }
-        });
+        h.for_each_blossom_top(k, |t| candidates.push(t));
         for t in candidates {
             if !blossom_fits(r, segments, k, t) {
                 continue;
