@@ -45,13 +45,15 @@ pub struct FinPatch {
     pub centres: Vec<Key>,
     /// Positions of existing vertices the patch sets (centres, the top).
     pub moved: Vec<(Key, Vec2)>,
-    /// Positions of every other existing vertex the patch uses.
+    /// Positions of every other existing vertex the patch uses (emptied once they are in
+    /// the relocation map).
     pub uses: Vec<(Key, Vec2)>,
     /// Positions of the new vertices.
     pub new: Vec<Vec2>,
     /// The triangles that replace the centres' fans, counter-clockwise.
     pub triangles: Vec<[VRef; 3]>,
-    /// Triangles around the top that stay but move with it (checked, not emitted).
+    /// Triangles around the top that stay but move with it (checked, not emitted; emptied
+    /// once checked).
     pub around_top: Vec<[Vec2; 3]>,
 }
 

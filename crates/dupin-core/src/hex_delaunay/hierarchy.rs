@@ -16,12 +16,20 @@
 //! neighbour present splits the full hexagon on the long edge of the semi-hexagon in the way
 //! (the paper's "opposite neighbour"), recursively.
 //!
-//! Split counters, merge and break (section 3.2) serve coarsening, which only the extended
-//! refinement's blossoms use; they are not implemented (see the module docs of `mod.rs`).
+//! Split counters, merge and break (section 3.2, the reverse operation). A full hexagon is
+//! either the central child `2v` of a split hexagon `v` (the split "scales it down": its counter
+//! is `v`'s plus one) or the join `2v + d` of two semi-hexagons (counter 0; a boundary
+//! semi-hexagon is a virtual full hexagon, also counter 0). Since the split sets determine which
+//! it is, the counter is a function of the position ([`Hierarchy::split_counter`]: the number of
+//! levels since the position first became a lattice point). [`Hierarchy::merge`] is the inverse
+//! of a split: it removes `v`'s split mark, so its central child is scaled up (counter minus
+//! one) and its joined children are broken into semi-hexagons (allowed only at counter 0, which
+//! every join has, and only for leaves). The local coarsening into blossoms (section 5.3,
+//! `coarsening.rs`) is made of merges.
 
 use super::error::HexDelaunayError;
 use super::lattice::{
-    Axial, DIRS, Frame, add, in_domain, is_even, on_boundary, parents_of_midpoint,
+    Axial, DIRS, Frame, add, in_domain, is_even, normalize, on_boundary, parents_of_midpoint,
 };
 use crate::math::Vec2;
 use rustc_hash::FxHashMap;
@@ -43,10 +51,41 @@ pub struct Hierarchy {
     /// Placement of the lattice.
     pub frame: Frame,
     split: Vec<TileSet>,
+    /// Number of split hexagons per level (so that merges can drop emptied deepest levels).
+    per_level: Vec<usize>,
     /// Deepest level a hexagon may be split at.
     pub max_level: u32,
     /// Number of split hexagons.
     pub split_count: usize,
+}
+
+/// Why [`Hierarchy::merge`] refused (section 3.2: a merge must leave a balanced hierarchy).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum MergeError {
+    /// The hexagon is not split.
+    #[error("hexagon {1:?} at level {0} is not split")]
+    NotSplit(u32, Axial),
+    /// The root stays split (Ω is covered by the seven level-1 hexagons).
+    #[error("the root hexagon cannot be merged")]
+    Root,
+    /// A hexagon of the next level within two steps of the central child is split: a child
+    /// is not a leaf (a joined one could not be broken), or merging would leave a split
+    /// hexagon next to a semi-hexagon (section 3.3's balancing).
+    #[error("hexagon {1:?} at level {0} is split")]
+    FinerNeighbour(u32, Axial),
+}
+
+/// What a merge did (section 3.2): the central child `2v` at `level + 1` was scaled up into
+/// `v` at `level`, and the joined children in `broken` (at `level + 1`) were broken into two
+/// semi-hexagons each (the other half stays with the split neighbour, or outside Ω).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Merge {
+    /// Level of the merged hexagon.
+    pub level: u32,
+    /// The merged hexagon.
+    pub v: Axial,
+    /// The joins broken, at `level + 1`, in `DIRS` order.
+    pub broken: Vec<Axial>,
 }
 
 impl Hierarchy {
@@ -57,9 +96,75 @@ impl Hierarchy {
         Hierarchy {
             frame,
             split: vec![root],
+            per_level: vec![1],
             max_level,
             split_count: 1,
         }
+    }
+
+    /// Section 3.2's split counter of the full hexagon `v` at `level` (None if it is not
+    /// present): 0 for a hexagon created by a join (or a boundary virtual hexagon, or the
+    /// root), plus one for every split that scaled it down since. Inputs: any lattice point.
+    /// Output: `level - l` for the coarsest level `l` where the same position is a lattice
+    /// point, since only a split's central child keeps its parent's position.
+    pub fn split_counter(&self, level: u32, v: Axial) -> Option<u32> {
+        if !self.is_present(level, v) {
+            return None;
+        }
+        Some(level - normalize(level, v).0)
+    }
+
+    /// Whether the full hexagon `m` at `level` may be broken into its two semi-hexagons
+    /// (section 3.2): it is a leaf whose split counter is 0 (a join, not a central child).
+    pub fn can_break(&self, level: u32, m: Axial) -> bool {
+        level >= 1 && self.split_counter(level, m) == Some(0) && !self.is_split(level, m)
+    }
+
+    /// Whether `v` at `level` can be merged ([`merge`](Self::merge) without changing anything).
+    pub fn can_merge(&self, level: u32, v: Axial) -> Result<(), MergeError> {
+        if level == 0 {
+            return Err(MergeError::Root);
+        }
+        if !self.is_split(level, v) {
+            return Err(MergeError::NotSplit(level, v));
+        }
+        // The children (disc of radius 1 around 2v) must be leaves, and their neighbours
+        // (radius 2) unsplit: a split one would need its neighbours present (balancing).
+        let c = (2 * v.0, 2 * v.1);
+        let w = self.split_window(level + 1, c);
+        if w & WINDOW_DISC2 != 0 {
+            let d = DISC2
+                .iter()
+                .find(|&&d| w & window_bit(d) != 0)
+                .expect("a set bit of the disc");
+            return Err(MergeError::FinerNeighbour(level + 1, add(c, *d)));
+        }
+        Ok(())
+    }
+
+    /// The reverse of a split (section 3.2): the central child of `v` at `level` is scaled up
+    /// (its split counter drops by one) and the joins among `v`'s children are broken (each at
+    /// counter 0, a leaf: [`can_break`](Self::can_break)). Refused, changing nothing, unless
+    /// [`can_merge`](Self::can_merge); the hierarchy stays balanced. Points in the children
+    /// are the caller's to re-locate (`Refinement::merge_now`). O(1) expected.
+    pub fn merge(&mut self, level: u32, v: Axial) -> Result<Merge, MergeError> {
+        self.can_merge(level, v)?;
+        let c = (2 * v.0, 2 * v.1);
+        let broken: Vec<Axial> = DIRS
+            .iter()
+            .map(|d| add(c, *d))
+            .filter(|&m| in_domain(level + 1, m) && self.is_present(level + 1, m))
+            .collect();
+        debug_assert!(broken.iter().all(|&m| self.can_break(level + 1, m)));
+        self.split[level as usize].remove(v);
+        self.per_level[level as usize] -= 1;
+        self.split_count -= 1;
+        // The deepest levels that lost their last split hexagon go (`depth` stays exact).
+        while self.per_level.last() == Some(&0) {
+            self.per_level.pop();
+            self.split.pop();
+        }
+        Ok(Merge { level, v, broken })
     }
 
     /// Deepest level that has a split hexagon.
@@ -191,8 +296,10 @@ impl Hierarchy {
         }
         if self.split.len() <= level as usize {
             self.split.resize_with(level as usize + 1, TileSet::default);
+            self.per_level.resize(level as usize + 1, 0);
         }
         self.split[level as usize].insert(v);
+        self.per_level[level as usize] += 1;
         self.split_count += 1;
         out.push((level, v));
         Ok(())
@@ -277,29 +384,7 @@ impl Hierarchy {
                     continue;
                 }
                 let (ta, tb) = cand.keys[t];
-                // rows[a + 1], a in -1..=16: the split bits of row a, columns -1..=16 at bits
-                // 0..=17.
-                let mut rows = [0u32; 18];
-                for (da, r0, r1) in [(-1i64, 15usize, 15usize), (0, 0, 15), (1, 0, 0)] {
-                    for db in -1i64..=1 {
-                        let i = split.tile((ta + da, tb + db));
-                        if i == NONE {
-                            continue;
-                        }
-                        let w = &split.words[i as usize];
-                        for r in r0..=r1 {
-                            let bits = ((w[r >> 2] >> ((r & 3) << TILE)) & 0xffff) as u32;
-                            let part = match db {
-                                -1 => bits >> 15,
-                                0 => bits << 1,
-                                _ => (bits & 1) << 17,
-                            };
-                            // Row r of the tile above or below is row -1 or 16 here.
-                            let a = (da * 16 + r as i64 + 1) as usize;
-                            rows[a] |= part;
-                        }
-                    }
-                }
+                let rows = split.rows_with_rim(ta, tb);
                 for a in 0..16usize {
                     let (up, me, down) = (rows[a + 2], rows[a + 1], rows[a]);
                     // Neighbours (1, 0), (1, -1), (0, 1), (0, -1), (-1, 1), (-1, 0).
@@ -316,6 +401,70 @@ impl Hierarchy {
         }
     }
 
+    /// Whether a hexagon of `level` within hexagonal distance `r` of `c` is split (a few tile
+    /// reads).
+    pub fn any_split_within(&self, level: u32, c: Axial, r: i64) -> bool {
+        self.split
+            .get(level as usize)
+            .is_some_and(|s| s.any_in_disc(c, r))
+    }
+
+    /// Calls `f(t)` for every `t` of `level` whose disc of radius 2 consists of split
+    /// hexagons none of whose seven children is split: the disc of radius 5 around `2t` one
+    /// level finer is unsplit (those are exactly the 19 hexagons' children). The candidates
+    /// for the top of a blossom (`coarsening.rs`). Bit-parallel: per split tile, the hexagons
+    /// whose children are all leaves come from the rows of the 4×4 finer tiles around its
+    /// children, then the disc condition is two erosions by the six neighbours (tile rows with
+    /// a rim of two). Tile by tile (deterministic order).
+    pub fn for_each_blossom_top(&self, level: u32, mut f: impl FnMut(Axial)) {
+        let Some(split) = self.split.get(level as usize) else {
+            return;
+        };
+        let fine = self.split.get(level as usize + 1);
+        // L: the split hexagons whose children are all unsplit.
+        let mut leafy = TileSet::default();
+        for (t, words) in split.words.iter().enumerate() {
+            if *words == [0; 4] {
+                continue;
+            }
+            let (ta, tb) = split.keys[t];
+            let children = match fine {
+                Some(fine) => fine.children_split(ta, tb),
+                None => [0; 16],
+            };
+            let i = leafy.tile_or_insert((ta, tb));
+            for (a, &c) in children.iter().enumerate() {
+                let bits = (words[a >> 2] >> ((a & 3) << TILE)) & 0xffff;
+                leafy.words[i as usize][a >> 2] |= (bits & !u64::from(c)) << ((a & 3) << TILE);
+            }
+        }
+        for (t, words) in leafy.words.iter().enumerate() {
+            if *words == [0; 4] {
+                continue;
+            }
+            let (ta, tb) = leafy.keys[t];
+            // rows[a + 2], a in -2..=17: row a, columns -2..=17 at bits 0..=19.
+            let rows = leafy.rows_with_rim2(ta, tb);
+            let erode = |up: u32, me: u32, down: u32| {
+                // Neighbours (1, 0), (1, -1), (0, 1), (0, -1), (-1, 1), (-1, 0) as in
+                // `for_each_with_fins`.
+                up & (up << 1) & (me >> 1) & (me << 1) & (down >> 1) & down & me
+            };
+            // e1[a + 1], a in -1..=16: the members with all six neighbours in L, at the bits
+            // of `rows` (columns -1..=16 meaningful).
+            let e1: [u32; 18] = std::array::from_fn(|i| erode(rows[i + 2], rows[i + 1], rows[i]));
+            for a in 0..16usize {
+                let all = erode(e1[a + 2], e1[a + 1], e1[a]);
+                let mut hits = (all >> 2) & 0xffff;
+                while hits != 0 {
+                    let col = i64::from(hits.trailing_zeros());
+                    hits &= hits - 1;
+                    f(((ta << TILE) | a as i64, (tb << TILE) | col));
+                }
+            }
+        }
+    }
+
     /// Iterates over the split hexagons of `level`, tile by tile (deterministic order).
     pub fn split_at(&self, level: u32) -> impl Iterator<Item = Axial> + '_ {
         self.split
@@ -324,6 +473,40 @@ impl Hierarchy {
             .flat_map(TileSet::iter)
     }
 }
+
+/// The offsets of the disc of radius 2 (19 lattice points).
+const DISC2: [Axial; 19] = [
+    (0, 0),
+    (1, 0),
+    (0, 1),
+    (-1, 1),
+    (-1, 0),
+    (0, -1),
+    (1, -1),
+    (2, 0),
+    (2, -1),
+    (2, -2),
+    (1, 1),
+    (1, -2),
+    (0, 2),
+    (0, -2),
+    (-1, 2),
+    (-1, -1),
+    (-2, 2),
+    (-2, 1),
+    (-2, 0),
+];
+
+/// The window bits of the disc of radius 2.
+pub const WINDOW_DISC2: u32 = {
+    let mut m = 0;
+    let mut i = 0;
+    while i < DISC2.len() {
+        m |= window_bit(DISC2[i]);
+        i += 1;
+    }
+    m
+};
 
 /// The bit of the offset `d` (both coordinates in -2..=2) in [`Hierarchy::split_window`].
 #[inline]
@@ -394,6 +577,14 @@ impl HexSet {
         if let Some(s) = self.levels.get(level as usize) {
             s.for_each_in_stadium(a, bs, r, f);
         }
+    }
+
+    /// Whether a member of `level` lies within hexagonal distance `r` of `c` (stops at the
+    /// first).
+    pub fn any_in_disc(&self, level: u32, c: Axial, r: i64) -> bool {
+        self.levels
+            .get(level as usize)
+            .is_some_and(|s| s.any_in_disc(c, r))
     }
 
     /// Removes `v` at `level`.
@@ -502,6 +693,99 @@ impl TileSet {
     fn slot(v: Axial) -> (Axial, usize) {
         let bit = (((v.0 & TILE_MASK) << TILE) | (v.1 & TILE_MASK)) as usize;
         ((v.0 >> TILE, v.1 >> TILE), bit)
+    }
+
+    /// The split bits of the tile `(ta, tb)` with a rim of one from its eight neighbours:
+    /// `rows[a + 1]` for `a` in -1..=16 holds row `a`, columns -1..=16 at bits 0..=17.
+    fn rows_with_rim(&self, ta: i64, tb: i64) -> [u32; 18] {
+        let mut rows = [0u32; 18];
+        for (da, r0, r1) in [(-1i64, 15usize, 15usize), (0, 0, 15), (1, 0, 0)] {
+            for db in -1i64..=1 {
+                let i = self.tile((ta + da, tb + db));
+                if i == NONE {
+                    continue;
+                }
+                let w = &self.words[i as usize];
+                for r in r0..=r1 {
+                    let bits = ((w[r >> 2] >> ((r & 3) << TILE)) & 0xffff) as u32;
+                    let part = match db {
+                        -1 => bits >> 15,
+                        0 => bits << 1,
+                        _ => (bits & 1) << 17,
+                    };
+                    // Row r of the tile above or below is row -1 or 16 here.
+                    let a = (da * 16 + r as i64 + 1) as usize;
+                    rows[a] |= part;
+                }
+            }
+        }
+        rows
+    }
+
+    /// The split bits of the tile `(ta, tb)` with a rim of two: `rows[a + 2]` for `a` in
+    /// -2..=17 holds row `a`, columns -2..=17 at bits 0..=19.
+    fn rows_with_rim2(&self, ta: i64, tb: i64) -> [u32; 20] {
+        let mut rows = [0u32; 20];
+        for (da, r0, r1) in [(-1i64, 14usize, 15usize), (0, 0, 15), (1, 0, 1)] {
+            for db in -1i64..=1 {
+                let i = self.tile((ta + da, tb + db));
+                if i == NONE {
+                    continue;
+                }
+                let w = &self.words[i as usize];
+                for r in r0..=r1 {
+                    let bits = ((w[r >> 2] >> ((r & 3) << TILE)) & 0xffff) as u32;
+                    let part = match db {
+                        -1 => bits >> 14,
+                        0 => bits << 2,
+                        _ => (bits & 3) << 18,
+                    };
+                    rows[(da * 16 + r as i64 + 2) as usize] |= part;
+                }
+            }
+        }
+        rows
+    }
+
+    /// For the coarser tile `(ta, tb)` (this set one level finer): bit `b` of entry `a` set
+    /// when a child of the coarse hexagon `(16 ta + a, 16 tb + b)` (its central child `2v` or
+    /// a join `2v + d`) is in this set. The children of row `a` lie in rows `2a - 1..=2a + 1`,
+    /// columns `2b - 1..=2b + 1`, within the 4×4 tiles around `(2 ta, 2 tb)`.
+    fn children_split(&self, ta: i64, tb: i64) -> [u16; 16] {
+        // tiles[i][j]: the tile (2 ta - 1 + i, 2 tb - 1 + j).
+        let tiles: [[u32; 4]; 4] = std::array::from_fn(|i| {
+            std::array::from_fn(|j| self.tile((2 * ta - 1 + i as i64, 2 * tb - 1 + j as i64)))
+        });
+        // Bit k of the result: column 32 tb - 1 + k of the fine row `r` (relative to 32 ta).
+        let wide = |r: i64| -> u64 {
+            let ti = ((r + 16) >> TILE) as usize; // tile row 2 ta - 1 + ti
+            let row = (r & TILE_MASK) as usize;
+            let mut out = 0u64;
+            for (j, &i) in tiles[ti].iter().enumerate() {
+                if i == NONE {
+                    continue;
+                }
+                let w = &self.words[i as usize];
+                let bits = (w[row >> 2] >> ((row & 3) << TILE)) & 0xffff;
+                // Tile column 2 tb - 1 + j starts at column 16 j - 16 of 32 tb, bit 16 j - 15.
+                out |= if j == 0 {
+                    bits >> 15
+                } else {
+                    bits << (16 * j - 15)
+                };
+            }
+            out
+        };
+        std::array::from_fn(|a| {
+            let r = 2 * a as i64;
+            let (mid, up, down) = (wide(r), wide(r + 1), wide(r - 1));
+            // At bit 2b: columns 2b - 1, 2b, 2b + 1 of row 2a; 2b - 1, 2b of row 2a + 1;
+            // 2b, 2b + 1 of row 2a - 1.
+            let m = mid | (mid >> 1) | (mid >> 2) | up | (up >> 1) | (down >> 1) | (down >> 2);
+            let lo = compress_even((m & 0xffff) as u32);
+            let hi = compress_even(((m >> 16) & 0xffff) as u32);
+            (lo | (hi << 8)) as u16
+        })
     }
 
     /// Index of the tile `key` (`NONE` if absent), remembered for the next query.
@@ -670,6 +954,36 @@ impl TileSet {
         }
     }
 
+    /// Whether a member lies within hexagonal distance `r` of `c`: the rows of
+    /// [`for_each_in_stadium`](Self::for_each_in_stadium), stopping at the first set bit.
+    fn any_in_disc(&self, c: Axial, r: i64) -> bool {
+        let (a0, a1, b0, b1) = (c.0 - r, c.0 + r, c.1 - r, c.1 + r);
+        for ta in a0 >> TILE..=a1 >> TILE {
+            for tb in b0 >> TILE..=b1 >> TILE {
+                let i = self.tile((ta, tb));
+                if i == NONE {
+                    continue;
+                }
+                let w = &self.words[i as usize];
+                let (base_a, base_b) = (ta << TILE, tb << TILE);
+                for row_a in a0.max(base_a)..=a1.min(base_a | TILE_MASK) {
+                    let i = row_a - c.0;
+                    let lo = (c.1 + (-r).max(-i - r)).max(base_b);
+                    let hi = (c.1 + r.min(-i + r)).min(base_b | TILE_MASK);
+                    if lo > hi {
+                        continue;
+                    }
+                    let row = (row_a & TILE_MASK) as usize;
+                    let bits = (w[row >> 2] >> ((row & 3) << TILE)) & 0xffff;
+                    if bits & (((1u64 << (hi - lo + 1)) - 1) << (lo & TILE_MASK)) != 0 {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
+    }
+
     /// Removes `v` (an emptied tile stays, as an all-zero entry); returns whether it was in.
     fn remove(&mut self, v: Axial) -> bool {
         let (key, bit) = Self::slot(v);
@@ -722,6 +1036,15 @@ impl Iterator for TileIter<'_> {
         let (row, col) = ((bit >> TILE) as i64, (bit as i64) & TILE_MASK);
         Some(((ta << TILE) | row, (tb << TILE) | col))
     }
+}
+
+/// The even bits 0, 2, .., 14 of `x` as bits 0..=7.
+#[inline]
+fn compress_even(x: u32) -> u32 {
+    let x = x & 0x5555;
+    let x = (x | (x >> 1)) & 0x3333;
+    let x = (x | (x >> 2)) & 0x0f0f;
+    (x | (x >> 4)) & 0x00ff
 }
 
 #[inline]
@@ -800,6 +1123,213 @@ mod tests {
         assert_eq!(got, want);
     }
 
+    fn test_hierarchy(max_level: u32) -> Hierarchy {
+        Hierarchy::new(
+            Frame {
+                origin: Vec2::zeros(),
+                root_radius: 1.0,
+            },
+            max_level,
+        )
+    }
+
+    /// The split hexagons, sorted (two hierarchies are the same iff these are).
+    fn splits(h: &Hierarchy) -> Vec<(u32, Axial)> {
+        let mut v: Vec<(u32, Axial)> = (0..h.depth())
+            .flat_map(|k| h.split_at(k).map(move |x| (k, x)))
+            .collect();
+        v.sort_unstable();
+        v
+    }
+
+    /// Every present full hexagon with its split counter (levels up to `depth`).
+    fn counters(h: &Hierarchy) -> FxHashMap<(u32, Axial), u32> {
+        let mut m = FxHashMap::default();
+        for k in 0..=h.depth() {
+            let n = 1i64 << k;
+            for a in -n..=n {
+                for b in -n..=n {
+                    if let Some(c) = h.split_counter(k, (a, b)) {
+                        m.insert((k, (a, b)), c);
+                    }
+                }
+            }
+        }
+        m
+    }
+
+    /// Fig. 1: the root's central child has counter 1 after one split, 2 after two; joins
+    /// (including the boundary's virtual full hexagons) have 0; a merge gives back the
+    /// counters before the split.
+    #[test]
+    fn split_counters_as_in_fig_1() {
+        let mut h = test_hierarchy(8);
+        assert_eq!(h.split_counter(0, (0, 0)), Some(0));
+        assert_eq!(h.split_counter(1, (0, 0)), Some(1));
+        for d in DIRS {
+            // Level-1 boundary hexagons: joins with the virtual outside.
+            assert_eq!(h.split_counter(1, d), Some(0));
+            assert!(h.can_break(1, d));
+        }
+        let mut out = Vec::new();
+        h.ensure_split(1, (0, 0), &mut out).unwrap();
+        assert_eq!(out, vec![(1, (0, 0))], "no balancing split needed");
+        assert_eq!(h.split_counter(2, (0, 0)), Some(2));
+        // The centre's semi-hexagons towards its unsplit neighbours: no full hexagon.
+        assert_eq!(h.split_counter(2, DIRS[0]), None);
+        let before = counters(&h);
+        h.ensure_split(1, DIRS[0], &mut out).unwrap();
+        // Split of a counter-0 hexagon: its child has 1; the join with the centre has 0.
+        assert_eq!(h.split_counter(2, (2, 0)), Some(1));
+        assert_eq!(h.split_counter(2, DIRS[0]), Some(0));
+        assert!(h.can_break(2, DIRS[0]));
+        assert!(!h.can_break(2, (2, 0)), "a central child is no join");
+        let m = h.merge(1, DIRS[0]).unwrap();
+        // Only the join with the centre: the children's other neighbours inside Ω are halves
+        // of unsplit level-1 hexagons (semi-hexagons), the rest lies outside Ω.
+        assert_eq!(m.broken, vec![DIRS[0]]);
+        assert_eq!(counters(&h), before);
+        assert_eq!(h.merge(0, (0, 0)), Err(MergeError::Root));
+        assert_eq!(h.merge(1, DIRS[1]), Err(MergeError::NotSplit(1, DIRS[1])));
+    }
+
+    /// Split then merge gives back the same hierarchy (also after the balancing splits a split
+    /// forces, merged in reverse order), and merges that would unbalance it are refused.
+    #[test]
+    fn split_then_merge_returns_the_same_hierarchy() {
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        for _ in 0..200 {
+            let mut h = test_hierarchy(7);
+            let mut out = Vec::new();
+            for _ in 0..rng.random_range(0..30) {
+                let k = rng.random_range(1u32..5);
+                let n = 1i64 << (k - 1);
+                let v = (rng.random_range(-n..=n), rng.random_range(-n..=n));
+                if in_domain(k, v) && h.is_present(k, v) {
+                    h.ensure_split(k, v, &mut out).unwrap();
+                }
+            }
+            let before = splits(&h);
+            let count = h.split_count;
+            let depth = h.depth();
+            let k = rng.random_range(1u32..6);
+            let n = 1i64 << (k - 1);
+            let v = (rng.random_range(-n..=n), rng.random_range(-n..=n));
+            if !in_domain(k, v) || h.is_split(k, v) {
+                continue;
+            }
+            out.clear();
+            h.ensure_split(k, v, &mut out).unwrap();
+            for &(l, x) in out.iter().rev() {
+                h.merge(l, x).unwrap();
+            }
+            assert_eq!(splits(&h), before);
+            assert_eq!((h.split_count, h.depth()), (count, depth));
+            // A merge under a split child or next to a split hexagon of the next level is
+            // refused and changes nothing.
+            for (l, x) in before {
+                if l == 0 {
+                    continue;
+                }
+                let c = (2 * x.0, 2 * x.1);
+                let finer = DISC2.iter().any(|d| h.is_split(l + 1, add(c, *d)));
+                let snapshot = splits(&h);
+                match h.can_merge(l, x) {
+                    Ok(()) => assert!(!finer),
+                    Err(e) => {
+                        assert!(finer);
+                        assert_eq!(h.merge(l, x), Err(e));
+                        assert_eq!(splits(&h), snapshot);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The split counter as the paper keeps it (section 3.2), tracked operation by operation
+    /// in a model (a split gives the central child its parent's counter plus one and every new
+    /// join 0; a merge checks the child's counter, scales it back and breaks the joins, each at
+    /// counter 0), equals `split_counter` after random splits and merges; joins and breaks
+    /// round-trip.
+    #[test]
+    fn split_counters_follow_splits_merges_joins_and_breaks() {
+        let mut rng = ChaCha8Rng::seed_from_u64(8);
+        for _ in 0..40 {
+            let mut h = test_hierarchy(6);
+            let mut model = counters(&h);
+            for _ in 0..120 {
+                let k = rng.random_range(1u32..5);
+                let n = 1i64 << (k - 1);
+                let v = (rng.random_range(-n..=n), rng.random_range(-n..=n));
+                if !in_domain(k, v) {
+                    continue;
+                }
+                if h.is_split(k, v) {
+                    let Ok(m) = h.merge(k, v) else {
+                        continue;
+                    };
+                    let c = (2 * v.0, 2 * v.1);
+                    let child = model.remove(&(k + 1, c)).expect("central child present");
+                    assert_eq!(child, model[&(k, v)] + 1);
+                    for x in &m.broken {
+                        assert_eq!(model.remove(&(k + 1, *x)), Some(0), "break at counter 0");
+                    }
+                } else if h.is_present(k, v) {
+                    let mut out = Vec::new();
+                    h.ensure_split(k, v, &mut out).unwrap();
+                    for (l, x) in out {
+                        let c = (2 * x.0, 2 * x.1);
+                        model.insert((l + 1, c), model[&(l, x)] + 1);
+                        for d in DIRS {
+                            let m = add(c, d);
+                            if in_domain(l + 1, m) && h.is_present(l + 1, m) {
+                                // Joined now (or already, from an earlier split).
+                                model.entry((l + 1, m)).or_insert(0);
+                            }
+                        }
+                    }
+                }
+                assert_eq!(counters(&h), model);
+            }
+        }
+    }
+
+    /// The bulk scan for blossom tops finds exactly the hexagons whose disc of radius 2 is
+    /// split with unsplit children (queries: the 19 splits and the children's 5-disc).
+    #[test]
+    fn blossom_tops_match_the_queries() {
+        let mut rng = ChaCha8Rng::seed_from_u64(10);
+        for (density, child) in [(0.95, 0.02), (0.99, 0.005), (1.0, 0.002)] {
+            let mut coarse = TileSet::default();
+            let mut fine = TileSet::default();
+            for a in -40i64..40 {
+                for b in -40i64..40 {
+                    if rng.random_bool(density) {
+                        coarse.insert((a, b));
+                    }
+                    if rng.random_bool(child) {
+                        fine.insert((2 * a + rng.random_range(0..2), 2 * b));
+                    }
+                }
+            }
+            let mut h = test_hierarchy(8);
+            h.split = vec![coarse.clone(), fine.clone()];
+            let mut got = Vec::new();
+            h.for_each_blossom_top(0, |v| got.push(v));
+            got.sort_unstable();
+            let mut want: Vec<Axial> = coarse
+                .iter()
+                .filter(|&t| {
+                    DISC2.iter().all(|d| coarse.contains(add(t, *d)))
+                        && !h.any_split_within(1, (2 * t.0, 2 * t.1), 5)
+                })
+                .collect();
+            want.sort_unstable();
+            assert!(!want.is_empty(), "{density}");
+            assert_eq!(got, want, "{density}");
+        }
+    }
+
     /// The levelled set keeps levels apart and lists each member once.
     #[test]
     fn hex_set_keeps_levels_apart() {
@@ -875,6 +1405,13 @@ mod tests {
                 .collect();
             want.sort_unstable();
             assert_eq!(got, want, "{k} {a} {b} {len} {r}");
+            if len == 0 {
+                let any = t
+                    .levels
+                    .get(k as usize)
+                    .is_some_and(|s| s.any_in_disc((a, b), r));
+                assert_eq!(any, !want.is_empty(), "{k} {a} {b} {r}");
+            }
             let mut u = HexSet::default();
             u.insert_stadium(k, a, (b, b + len), r);
             let mut got: Vec<Axial> = u.iter().map(|h| h.1).collect();

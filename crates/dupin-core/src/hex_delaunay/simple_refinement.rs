@@ -25,7 +25,7 @@
 //! triangles, n points.
 
 use super::error::HexDelaunayError;
-use super::hierarchy::{Cell, HexSet, Hierarchy};
+use super::hierarchy::{Cell, HexSet, Hierarchy, Merge, MergeError};
 use super::lattice::{Axial, DIRS, add};
 use crate::math::Vec2;
 use rustc_hash::FxHashMap;
@@ -247,6 +247,57 @@ impl Refinement {
             self.after_split(k, x);
         }
         Ok(out)
+    }
+
+    /// Merges the split hexagon `v` at level `k` now (section 3.2's reverse operation, see
+    /// [`Hierarchy::merge`]): the points in its children move to the merged hexagon (or, from
+    /// a broken join, to the neighbour's semi-hexagon), and the points whose rules may fire
+    /// again (in and next to the changed cells) are queued. Refused, changing nothing, when
+    /// the merge would unbalance the hierarchy.
+    pub fn merge_now(&mut self, k: u32, v: Axial) -> Result<Merge, MergeError> {
+        let m = self.hierarchy.merge(k, v)?;
+        let c = (2 * v.0, 2 * v.1);
+        let mut moved = Vec::new();
+        for d in std::iter::once((0, 0)).chain(DIRS) {
+            let x = add(c, d);
+            if self.occupied_full.contains(k + 1, x) {
+                self.occupied_full.remove(k + 1, x);
+                self.last_in.remove(&(k + 1, x));
+                moved.extend(
+                    self.occupants
+                        .remove(&Cell::Full(k + 1, x))
+                        .unwrap_or_default(),
+                );
+            }
+            if d != (0, 0) && self.occupied_semi.contains(k + 1, x) {
+                self.occupied_semi.remove(k + 1, x);
+                moved.extend(
+                    self.occupants
+                        .remove(&Cell::Semi(k + 1, x))
+                        .unwrap_or_default(),
+                );
+            }
+        }
+        for i in moved {
+            let cell = self.hierarchy.locate(self.points[i as usize]);
+            self.relocate(i, cell);
+        }
+        // Points next to the merged cells see absent or coarser neighbours now.
+        let mut near = Vec::new();
+        self.occupied_full
+            .for_each_in_stadium(k + 1, c.0, (c.1, c.1), 2, |x| {
+                near.push(Cell::Full(k + 1, x))
+            });
+        self.occupied_full
+            .for_each_in_stadium(k, v.0, (v.1, v.1), 1, |x| near.push(Cell::Full(k, x)));
+        for cell in near {
+            if let Some(pts) = self.occupants.get(&cell) {
+                for i in pts.clone() {
+                    self.push(i);
+                }
+            }
+        }
+        Ok(m)
     }
 
     /// Runs the refinement to the end.

@@ -1,9 +1,12 @@
 //! The stepper: the refinement one observable subdivision step at a time, for the page's 2D
 //! view, plus the input checks and bounding-hexagon set-up shared with the one-shot function.
 
+use super::coarsening::coarsen;
 use super::dual::{DualBuilder, Key, pack, unpack};
 use super::error::HexDelaunayError;
-use super::extended_refinement::{ExtendedState, Relocation, extended_pass, relocated_centres};
+use super::extended_refinement::{
+    ExtendedState, Relocation, after_coarsening, extended_pass, relocated_centres,
+};
 use super::fin_vertices::apply_fin_patches;
 use super::hierarchy::{Cell, Hierarchy};
 use super::lattice::{Axial, DIRS, Frame, add, parents_of_midpoint};
@@ -48,6 +51,12 @@ pub struct HexDelaunayStepper {
     segments: Vec<[u32; 2]>,
     /// Whether the last segment pass found nothing to split; reset by any split.
     segments_clean: bool,
+    /// Whether the local coarsening into blossoms (section 5.3, extended mode) runs.
+    coarsening: bool,
+    /// Whether it ran since the last insertion.
+    coarsened: bool,
+    /// The hexagons the last step merged (a coarsening step), in order.
+    last_merged: Vec<(u32, Axial)>,
 }
 
 impl HexDelaunayStepper {
@@ -150,22 +159,36 @@ impl HexDelaunayStepper {
             base_segments: Vec::new(),
             segments: Vec::new(),
             segments_clean: true,
+            coarsening: true,
+            coarsened: false,
+            last_merged: Vec::new(),
         })
     }
 
     /// One subdivision step. Returns `Ok(false)` once refinement is finished. With segments,
     /// once the point rules (and extended passes) find nothing, one pass of the segment rules
     /// (section 7.2, see `pslg.rs`) is one step.
+    ///
+    /// Extended mode: once every rule is at its fixed point, one step is the local coarsening
+    /// into blossoms (section 5.3, see `coarsening.rs`; [`last_merges`](Self::last_merges)
+    /// lists what it merged, [`last_splits`](Self::last_splits) is empty), after which the
+    /// rules are checked again (a full extended pass, then the segment pass).
     pub fn step(&mut self) -> Result<bool, HexDelaunayError> {
+        self.last_merged.clear();
         self.last = self.refinement.step()?;
         if self.mode == HexDelaunayMode::Extended {
             if self.last.is_empty() {
-                // Simple rules exhausted: one extended pass (section 5.2) is one step.
-                self.last =
-                    extended_pass(&mut self.refinement, &mut self.extended, &self.segments)?;
-                self.extended_clean = self.last.is_empty();
+                // Simple rules exhausted: one extended pass (section 5.2) is one step (none
+                // while nothing changed since a pass, or the check after coarsening, found
+                // nothing).
+                if !self.extended_clean {
+                    self.last =
+                        extended_pass(&mut self.refinement, &mut self.extended, &self.segments)?;
+                    self.extended_clean = self.last.is_empty();
+                }
             } else {
                 self.extended.record(&self.last);
+                self.extended_clean = false;
             }
         }
         if self.last.is_empty() && !self.segments.is_empty() {
@@ -179,6 +202,27 @@ impl HexDelaunayStepper {
         } else if !self.last.is_empty() {
             self.segments_clean = self.segments.is_empty();
         }
+        if self.last.is_empty() && self.wants_coarsening() && self.everything_clean() {
+            self.coarsened = true;
+            let splits_before = self.refinement.hierarchy.split_count;
+            let done = coarsen(&mut self.refinement, &self.segments);
+            if !done.merged.is_empty() {
+                // The rules are checked again around the blossoms (else by a full extended
+                // pass), then by the segment pass.
+                self.extended_clean = after_coarsening(
+                    &self.refinement,
+                    &mut self.extended,
+                    &self.segments,
+                    splits_before,
+                    &done.merged,
+                    &done.blossoms,
+                );
+                self.last_merged = done.merged;
+                self.segments_clean = self.segments.is_empty();
+                self.steps += 1;
+                return Ok(true);
+            }
+        }
         if self.last.is_empty() {
             Ok(false)
         } else {
@@ -188,8 +232,10 @@ impl HexDelaunayStepper {
     }
 
     /// Incremental insertion (the paper's abstract and section 9): adds further points to the
-    /// current subdivision, which is refined further (never coarsened) by the following steps or
-    /// [`run`](Self::run). The points must lie strictly inside [`domain`](Self::domain), which
+    /// current subdivision, which is refined further by the following steps or
+    /// [`run`](Self::run) (in the extended mode the coarsening into blossoms runs again once
+    /// the rules are at their fixed point; earlier blossoms are split where the new points'
+    /// rules ask). The points must lie strictly inside [`domain`](Self::domain), which
     /// the first batch fixed. They are numbered after all earlier points in
     /// [`HexTriangulation::input_vertex`]. On error nothing is inserted.
     pub fn insert(&mut self, points: &[Vec2]) -> Result<(), HexDelaunayError> {
@@ -223,11 +269,25 @@ impl HexDelaunayStepper {
         }
         self.extended_clean = false;
         self.extended.reset();
+        self.coarsened = false;
         if !self.base_segments.is_empty() {
             self.segments = split_at_points(&self.refinement.points, &self.base_segments);
             self.segments_clean = false;
         }
         Ok(())
+    }
+
+    /// Forgets that the rules were checked and runs the remaining steps: a full extended pass
+    /// must find nothing on a finished run (tests of the coarsening's local check).
+    #[cfg(test)]
+    pub(crate) fn recheck(&mut self) -> Result<bool, HexDelaunayError> {
+        self.extended.reset();
+        self.extended_clean = false;
+        let mut changed = false;
+        while self.step()? {
+            changed = true;
+        }
+        Ok(changed)
     }
 
     #[cfg(test)]
@@ -246,9 +306,36 @@ impl HexDelaunayStepper {
 
     /// Whether refinement is finished.
     pub fn is_done(&self) -> bool {
+        self.everything_clean() && !(self.wants_coarsening())
+    }
+
+    /// Whether no rule fires (simple, extended and segment rules at their fixed point).
+    fn everything_clean(&self) -> bool {
         self.refinement.is_done()
             && (self.mode == HexDelaunayMode::Simple || self.extended_clean)
             && self.segments_clean
+    }
+
+    /// Whether the coarsening into blossoms is still to run (extended mode).
+    fn wants_coarsening(&self) -> bool {
+        self.mode == HexDelaunayMode::Extended && self.coarsening && !self.coarsened
+    }
+
+    /// Turns the local coarsening into blossoms (section 5.3, extended mode; on by default)
+    /// on or off, e.g. to compare triangle counts. Takes effect at the next fixed point.
+    pub fn set_coarsening(&mut self, on: bool) {
+        self.coarsening = on;
+    }
+
+    /// The hexagons merged by the last step (centre and circumradius of each merged hexagon,
+    /// seven per blossom: its top, then the top's neighbours); empty unless the last step was
+    /// the coarsening into blossoms (section 5.3).
+    pub fn last_merges(&self) -> Vec<(Vec2, f64)> {
+        let f = &self.refinement.hierarchy.frame;
+        self.last_merged
+            .iter()
+            .map(|&(k, v)| (f.position(k, v), f.radius(k)))
+            .collect()
     }
 
     /// Number of steps taken through [`step`](Self::step).
@@ -358,7 +445,9 @@ impl HexDelaunayStepper {
     /// segments as vertex pairs and the unsnapped positions of the snapped vertices.
     fn dual(&self, snap: bool) -> (HexTriangulation, Vec<[u32; 2]>, FxHashMap<u32, Vec2>) {
         let h = &self.refinement.hierarchy;
-        let Relocation { mut moved, patches } = match self.mode {
+        let Relocation {
+            mut moved, patches, ..
+        } = match self.mode {
             HexDelaunayMode::Extended if self.is_done() => {
                 relocated_centres(&self.refinement, &self.extended, &self.segments)
             }
