@@ -384,7 +384,7 @@ impl Hierarchy {
                     continue;
                 }
                 let (ta, tb) = cand.keys[t];
-                let rows = split.rows_with_rim(ta, tb);
+                let rows = split.rows_with_rim::<1, 18>(ta, tb);
                 for a in 0..16usize {
                     let (up, me, down) = (rows[a + 2], rows[a + 1], rows[a]);
                     // Neighbours (1, 0), (1, -1), (0, 1), (0, -1), (-1, 1), (-1, 0).
@@ -444,7 +444,7 @@ impl Hierarchy {
             }
             let (ta, tb) = leafy.keys[t];
             // rows[a + 2], a in -2..=17: row a, columns -2..=17 at bits 0..=19.
-            let rows = leafy.rows_with_rim2(ta, tb);
+            let rows = leafy.rows_with_rim::<2, 20>(ta, tb);
             let erode = |up: u32, me: u32, down: u32| {
                 // Neighbours (1, 0), (1, -1), (0, 1), (0, -1), (-1, 1), (-1, 0) as in
                 // `for_each_with_fins`.
@@ -695,11 +695,13 @@ impl TileSet {
         ((v.0 >> TILE, v.1 >> TILE), bit)
     }
 
-    /// The split bits of the tile `(ta, tb)` with a rim of one from its eight neighbours:
-    /// `rows[a + 1]` for `a` in -1..=16 holds row `a`, columns -1..=16 at bits 0..=17.
-    fn rows_with_rim(&self, ta: i64, tb: i64) -> [u32; 18] {
-        let mut rows = [0u32; 18];
-        for (da, r0, r1) in [(-1i64, 15usize, 15usize), (0, 0, 15), (1, 0, 0)] {
+    /// The split bits of the tile `(ta, tb)` with a rim of `R` (1 or 2) from its eight
+    /// neighbours, `N = 16 + 2R` rows: `rows[a + R]` for `a` in -R..=15 + R holds row `a`,
+    /// columns -R..=15 + R at bits 0..N.
+    fn rows_with_rim<const R: usize, const N: usize>(&self, ta: i64, tb: i64) -> [u32; N] {
+        debug_assert!((1..=2).contains(&R) && N == 16 + 2 * R);
+        let mut rows = [0u32; N];
+        for (da, r0, r1) in [(-1i64, 16 - R, 15usize), (0, 0, 15), (1, 0, R - 1)] {
             for db in -1i64..=1 {
                 let i = self.tile((ta + da, tb + db));
                 if i == NONE {
@@ -709,38 +711,12 @@ impl TileSet {
                 for r in r0..=r1 {
                     let bits = ((w[r >> 2] >> ((r & 3) << TILE)) & 0xffff) as u32;
                     let part = match db {
-                        -1 => bits >> 15,
-                        0 => bits << 1,
-                        _ => (bits & 1) << 17,
+                        -1 => bits >> (16 - R),
+                        0 => bits << R,
+                        _ => (bits & ((1 << R) - 1)) << (16 + R),
                     };
-                    // Row r of the tile above or below is row -1 or 16 here.
-                    let a = (da * 16 + r as i64 + 1) as usize;
-                    rows[a] |= part;
-                }
-            }
-        }
-        rows
-    }
-
-    /// The split bits of the tile `(ta, tb)` with a rim of two: `rows[a + 2]` for `a` in
-    /// -2..=17 holds row `a`, columns -2..=17 at bits 0..=19.
-    fn rows_with_rim2(&self, ta: i64, tb: i64) -> [u32; 20] {
-        let mut rows = [0u32; 20];
-        for (da, r0, r1) in [(-1i64, 14usize, 15usize), (0, 0, 15), (1, 0, 1)] {
-            for db in -1i64..=1 {
-                let i = self.tile((ta + da, tb + db));
-                if i == NONE {
-                    continue;
-                }
-                let w = &self.words[i as usize];
-                for r in r0..=r1 {
-                    let bits = ((w[r >> 2] >> ((r & 3) << TILE)) & 0xffff) as u32;
-                    let part = match db {
-                        -1 => bits >> 14,
-                        0 => bits << 2,
-                        _ => (bits & 3) << 18,
-                    };
-                    rows[(da * 16 + r as i64 + 2) as usize] |= part;
+                    // Row r of the tile above or below is a rim row here.
+                    rows[(da * 16 + (r + R) as i64) as usize] |= part;
                 }
             }
         }
