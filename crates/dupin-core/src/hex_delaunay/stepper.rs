@@ -331,8 +331,13 @@ impl HexDelaunayStepper {
     /// seven per blossom: its top, then the top's neighbours); empty unless the last step was
     /// the coarsening into blossoms (section 5.3).
     pub fn last_merges(&self) -> Vec<(Vec2, f64)> {
+        self.discs(&self.last_merged)
+    }
+
+    /// Centre and circumradius of each hexagon `(level, lattice coordinates)`.
+    fn discs(&self, cells: &[(u32, Axial)]) -> Vec<(Vec2, f64)> {
         let f = &self.refinement.hierarchy.frame;
-        self.last_merged
+        cells
             .iter()
             .map(|&(k, v)| (f.position(k, v), f.radius(k)))
             .collect()
@@ -350,11 +355,7 @@ impl HexDelaunayStepper {
 
     /// The hexagons split by the last step (centre and circumradius), balancing splits first.
     pub fn last_splits(&self) -> Vec<(Vec2, f64)> {
-        let f = &self.refinement.hierarchy.frame;
-        self.last
-            .iter()
-            .map(|&(k, v)| (f.position(k, v), f.radius(k)))
-            .collect()
+        self.discs(&self.last)
     }
 
     /// Corners of the bounding hexagon Ω, counter-clockwise.
