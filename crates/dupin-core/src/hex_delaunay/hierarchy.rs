@@ -34,6 +34,7 @@ use super::lattice::{
 use crate::math::Vec2;
 use rustc_hash::FxHashMap;
 use std::cell::Cell as Memo;
+use std::ops::ControlFlow;
 
 /// A leaf cell of the hexagon mesh.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -897,10 +898,16 @@ impl TileSet {
         new
     }
 
-    /// Calls `f` for every member of the union of the discs of radius `r` around `(a, b)`,
-    /// `b` in `bs`: per tile of the bounding box, each row's interval is one mask on the
-    /// tile's row of 16 bits.
-    fn for_each_in_stadium(&self, a: i64, bs: (i64, i64), r: i64, mut f: impl FnMut(Axial)) {
+    /// Calls `f(row, tile column base, mask)` for every tile row meeting the union of the
+    /// discs of radius `r` around `(a, b)`, `b` in `bs`: the members of that row's interval,
+    /// as bits of the tile's row of 16; stops when `f` breaks.
+    fn stadium_rows(
+        &self,
+        a: i64,
+        bs: (i64, i64),
+        r: i64,
+        mut f: impl FnMut(i64, i64, u64) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
         let (a0, a1, b0, b1) = (a - r, a + r, bs.0 - r, bs.1 + r);
         for ta in a0 >> TILE..=a1 >> TILE {
             for tb in b0 >> TILE..=b1 >> TILE {
@@ -920,44 +927,39 @@ impl TileSet {
                     }
                     let row = (row_a & TILE_MASK) as usize;
                     let bits = (w[row >> 2] >> ((row & 3) << TILE)) & 0xffff;
-                    let mut m = bits & (((1u64 << (hi - lo + 1)) - 1) << (lo & TILE_MASK));
-                    while m != 0 {
-                        f((row_a, base_b | i64::from(m.trailing_zeros())));
-                        m &= m - 1;
-                    }
+                    f(
+                        row_a,
+                        base_b,
+                        bits & (((1u64 << (hi - lo + 1)) - 1) << (lo & TILE_MASK)),
+                    )?;
                 }
             }
         }
+        ControlFlow::Continue(())
     }
 
-    /// Whether a member lies within hexagonal distance `r` of `c`: the rows of
-    /// [`for_each_in_stadium`](Self::for_each_in_stadium), stopping at the first set bit.
-    fn any_in_disc(&self, c: Axial, r: i64) -> bool {
-        let (a0, a1, b0, b1) = (c.0 - r, c.0 + r, c.1 - r, c.1 + r);
-        for ta in a0 >> TILE..=a1 >> TILE {
-            for tb in b0 >> TILE..=b1 >> TILE {
-                let i = self.tile((ta, tb));
-                if i == NONE {
-                    continue;
-                }
-                let w = &self.words[i as usize];
-                let (base_a, base_b) = (ta << TILE, tb << TILE);
-                for row_a in a0.max(base_a)..=a1.min(base_a | TILE_MASK) {
-                    let i = row_a - c.0;
-                    let lo = (c.1 + (-r).max(-i - r)).max(base_b);
-                    let hi = (c.1 + r.min(-i + r)).min(base_b | TILE_MASK);
-                    if lo > hi {
-                        continue;
-                    }
-                    let row = (row_a & TILE_MASK) as usize;
-                    let bits = (w[row >> 2] >> ((row & 3) << TILE)) & 0xffff;
-                    if bits & (((1u64 << (hi - lo + 1)) - 1) << (lo & TILE_MASK)) != 0 {
-                        return true;
-                    }
-                }
+    /// Calls `f` for every member of the union of the discs of radius `r` around `(a, b)`,
+    /// `b` in `bs` (see [`stadium_rows`](Self::stadium_rows)).
+    fn for_each_in_stadium(&self, a: i64, bs: (i64, i64), r: i64, mut f: impl FnMut(Axial)) {
+        let _ = self.stadium_rows(a, bs, r, |row_a, base_b, mut m| {
+            while m != 0 {
+                f((row_a, base_b | i64::from(m.trailing_zeros())));
+                m &= m - 1;
             }
-        }
-        false
+            ControlFlow::Continue(())
+        });
+    }
+
+    /// Whether a member lies within hexagonal distance `r` of `c`, stopping at the first.
+    fn any_in_disc(&self, c: Axial, r: i64) -> bool {
+        self.stadium_rows(c.0, (c.1, c.1), r, |_, _, m| {
+            if m != 0 {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        })
+        .is_break()
     }
 
     /// Removes `v` (an emptied tile stays, as an all-zero entry); returns whether it was in.
