@@ -878,30 +878,18 @@ fn full_pass(r: &Refinement, segments: &[[u32; 2]]) -> (Marks, Relocation) {
     for (&(k, z), s) in ring_moved {
         moved.insert(pack(k, z), f.position(k, z) + s);
     }
-    let mut patches = Vec::with_capacity(accepted.len());
-    let mut tops = Vec::with_capacity(accepted.len());
-    for (t, i) in accepted {
-        tops.push(t);
-        let mut p = std::mem::take(&mut pass.patches[i]);
-        // The dual builder reports the vertex of every key in `moved`.
-        for &(key, q) in &p.moved {
-            moved.insert(key, q);
-        }
-        for &(key, q) in &p.uses {
-            moved.entry(key).or_insert(q);
-        }
-        // Now in `moved`; not kept twice through the dual's peak.
-        p.uses = Vec::new();
-        patches.push(p);
-    }
-    (
-        pass.marks(),
-        Relocation {
-            moved,
-            patches,
-            tops,
-        },
-    )
+    let mut relocation = Relocation {
+        moved,
+        patches: Vec::new(),
+        tops: Vec::new(),
+    };
+    relocation.add_patches(
+        accepted
+            .into_iter()
+            .map(|(t, i)| (t, std::mem::take(&mut pass.patches[i])))
+            .collect(),
+    );
+    (pass.marks(), relocation)
 }
 
 /// The relocations of section 5.4 for the dual of a finished extended refinement.
@@ -919,6 +907,8 @@ pub struct Relocation {
 impl Relocation {
     /// Adds accepted runs' patches (their vertices' positions, and the patches at their tops'
     /// places in the order): one merge of two sorted lists, O(patches), not an insertion each.
+    /// The dual builder reports the vertex of every key in `moved`; a patch's `uses` are
+    /// dropped once there, so they are not kept twice through the dual's peak.
     fn add_patches(&mut self, mut new: Vec<((u32, Axial), FinPatch)>) {
         new.sort_by_key(|e| e.0);
         for (_, p) in &mut new {
