@@ -1,16 +1,11 @@
 //! End-to-end tests of `dupin phex`.
 
 mod common;
-use common::{dupin, tmp};
+use common::{dupin, listed_scenes, tmp};
 
 #[test]
 fn lists_every_contract_scene() {
-    let o = dupin(&["phex", "--list-scenes"]);
-    assert!(o.status.success());
-    let names: Vec<String> = String::from_utf8_lossy(&o.stdout)
-        .lines()
-        .map(String::from)
-        .collect();
+    let names = listed_scenes("phex");
     for want in [
         "cyclide-architecture",
         "sphere-radial",

@@ -1,16 +1,11 @@
 //! End-to-end tests of `dupin pq` and `dupin offset`.
 
 mod common;
-use common::{dupin, json, tmp};
+use common::{dupin, json, listed_scenes, tmp};
 
 #[test]
 fn lists_the_contract_scenes() {
-    let o = dupin(&["pq", "--list-scenes"]);
-    assert!(o.status.success());
-    let names: Vec<String> = String::from_utf8_lossy(&o.stdout)
-        .lines()
-        .map(String::from)
-        .collect();
+    let names = listed_scenes("pq");
     for want in [
         "pq-catmull-clark",
         "conical-station",

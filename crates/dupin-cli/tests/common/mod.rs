@@ -22,3 +22,13 @@ pub fn dupin(args: &[&str]) -> std::process::Output {
 pub fn json(p: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
 }
+
+/// The names `dupin COMMAND --list-scenes` prints, one a line (asserting that it succeeds).
+pub fn listed_scenes(command: &str) -> Vec<String> {
+    let o = dupin(&[command, "--list-scenes"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .map(String::from)
+        .collect()
+}
