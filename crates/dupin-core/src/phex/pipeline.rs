@@ -354,7 +354,17 @@ impl PhexPipeline {
         for j in 1..layer_triangles.len() {
             layer_triangles[j] += layer_triangles[j - 1];
         }
-        Ok(PhexPipeline {
+        Ok(Self::at_start(surface, config, tri, layer_triangles))
+    }
+
+    /// A pipeline before its first step: no layer shown, no dual mesh, no optimiser.
+    fn at_start(
+        surface: Box<dyn Surface>,
+        config: PhexConfig,
+        tri: Triangulation,
+        layer_triangles: Vec<usize>,
+    ) -> Self {
+        PhexPipeline {
             surface,
             config,
             tri,
@@ -372,7 +382,7 @@ impl PhexPipeline {
                 max_planarity: 0.0,
                 invalid_faces: 0,
             },
-        })
+        }
     }
 
     fn from_loop(config: PhexConfig, surface: Box<dyn Surface>) -> Result<Self, PhexError> {
@@ -401,25 +411,7 @@ impl PhexPipeline {
         let levels = (1.05 * mean_axis / size).log2().ceil().max(1.0) as usize;
         let tri = super::loop_subdivision::convex_loop_triangulation(axes, levels)?;
         let n = tri.triangles.len();
-        Ok(PhexPipeline {
-            surface,
-            config,
-            tri,
-            layer_triangles: vec![n],
-            shown: 0,
-            dual: None,
-            optimiser: None,
-            phase: PhexPhase::Triangulation,
-            metrics: PhexMetrics {
-                phase: PhexPhase::Triangulation,
-                layer: 0,
-                iteration: 0,
-                faces: 0,
-                vertices: 0,
-                max_planarity: 0.0,
-                invalid_faces: 0,
-            },
-        })
+        Ok(Self::at_start(surface, config, tri, vec![n]))
     }
 
     /// The surface being meshed.

@@ -877,6 +877,23 @@ mod tests {
     /// The hand-assembled normal matrix and gradient are JᵀJ and Jᵀr: checked against finite
     /// differences of the objective at a planar mesh (where the second-order residual terms
     /// vanish, so dᵀ(JᵀJ)d is the objective's second directional derivative).
+    /// The full symmetric product `A d` from the optimiser's upper CSC values.
+    fn symmetric_product(opt: &PlanarityOptimiser, d: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; d.len()];
+        let rows = opt.pattern.row_indices();
+        for c in 0..d.len() {
+            let span = opt.pattern.col_ptr[c]..opt.pattern.col_ptr[c + 1];
+            for (&r, &a) in rows[span.clone()].iter().zip(&opt.values[span]) {
+                let r = r as usize;
+                out[r] += a * d[c];
+                if r != c {
+                    out[c] += a * d[r];
+                }
+            }
+        }
+        out
+    }
+
     #[test]
     fn assembled_normal_equations_match_finite_differences() {
         let scene = phex_scene("sphere-radial").unwrap();
@@ -896,22 +913,7 @@ mod tests {
             .collect();
         let (g, cost) = opt.assemble(&mesh, &x, &feet);
         assert!((cost - opt.cost(&mesh, &x, &feet)).abs() <= 1e-12 * cost.max(1e-300));
-        // Full symmetric matrix-vector product from the upper CSC values.
-        let hv = |d: &[f64]| {
-            let mut out = vec![0.0; d.len()];
-            let rows = opt.pattern.row_indices();
-            for c in 0..d.len() {
-                let span = opt.pattern.col_ptr[c]..opt.pattern.col_ptr[c + 1];
-                for (&r, &a) in rows[span.clone()].iter().zip(&opt.values[span]) {
-                    let r = r as usize;
-                    out[r] += a * d[c];
-                    if r != c {
-                        out[c] += a * d[r];
-                    }
-                }
-            }
-            out
-        };
+        let hv = |d: &[f64]| symmetric_product(&opt, d);
         let mut rng = ChaCha8Rng::seed_from_u64(11);
         let e = opt.edge;
         for _ in 0..5 {
@@ -952,18 +954,11 @@ mod tests {
         let n = 3 * mesh.num_vertices();
         let x: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
         let delta = 0.37;
-        let rows = opt.pattern.row_indices();
-        let mut want: Vec<f64> = x.iter().map(|v| delta * v).collect();
-        for c in 0..n {
-            let span = opt.pattern.col_ptr[c]..opt.pattern.col_ptr[c + 1];
-            for (&r, &a) in rows[span.clone()].iter().zip(&opt.values[span]) {
-                let r = r as usize;
-                want[r] += a * x[c];
-                if r != c {
-                    want[c] += a * x[r];
-                }
-            }
-        }
+        let want: Vec<f64> = symmetric_product(&opt, &x)
+            .iter()
+            .zip(&x)
+            .map(|(a, v)| a + delta * v)
+            .collect();
         let mut got = vec![0.0; n];
         opt.matvec(&x, delta, &mut got);
         for (a, b) in got.iter().zip(&want) {
