@@ -874,9 +874,6 @@ mod tests {
         }
     }
 
-    /// The hand-assembled normal matrix and gradient are JᵀJ and Jᵀr: checked against finite
-    /// differences of the objective at a planar mesh (where the second-order residual terms
-    /// vanish, so dᵀ(JᵀJ)d is the objective's second directional derivative).
     /// The full symmetric product `A d` from the optimiser's upper CSC values.
     fn symmetric_product(opt: &PlanarityOptimiser, d: &[f64]) -> Vec<f64> {
         let mut out = vec![0.0; d.len()];
@@ -894,6 +891,9 @@ mod tests {
         out
     }
 
+    /// The hand-assembled normal matrix and gradient are JᵀJ and Jᵀr: checked against finite
+    /// differences of the objective at a planar mesh (where the second-order residual terms
+    /// vanish, so dᵀ(JᵀJ)d is the objective's second directional derivative).
     #[test]
     fn assembled_normal_equations_match_finite_differences() {
         let scene = phex_scene("sphere-radial").unwrap();
