@@ -6,7 +6,7 @@
 //! `cargo run --release -p dupin-core --example pq_steps -- [torus|skew|FILE.obj] [MODE]`
 //! with MODE `planar` (default), `conical` or `circular` (`torus`: the benchmark's centroid
 //! dual, 1152 hexagons; `skew`: the 30 x 30 skew grid). `RUNS=n` repeats the run (default 3;
-//! the first pays the allocations' first touch).
+//! the first pays the allocations' first touch); `PENALTY=n` sets the penalty iterations.
 
 use dupin_core::{
     MeshTopology, PolyMesh, PqMode, PqOptions, PqPerturbation, parse_obj, skew_quad_grid,
@@ -61,10 +61,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(3);
-    let options = PqOptions {
+    let mut options = PqOptions {
         mode,
         ..PqOptions::default()
     };
+    if let Some(n) = std::env::var("PENALTY").ok().and_then(|v| v.parse().ok()) {
+        options.penalty_iterations = n;
+    }
     for run in 0..runs {
         eprintln!("run {run}: {input}, {mode:?}");
         let start = cpu();
@@ -80,12 +83,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .fold(0.0, f64::max);
             let now = std::time::Instant::now();
             eprintln!(
-                "  step {:2} -> {:?}: max_planarity {:.3e}, mode residual {:.3e}, move {:.3e}, {:.1} ms",
+                "  step {:2} -> {:?}: max_planarity {:.3e}, mode residual {:.3e}, move {:.3e}, fairness {:.6e}, {:.1} ms",
                 info.iteration,
                 info.phase,
                 info.max_planarity,
                 info.mode_residual,
                 moved,
+                fairness(solver.mesh()),
                 (now - last).as_secs_f64() * 1e3
             );
             last = now;
