@@ -6,11 +6,12 @@
 //! `cargo run --release -p dupin-core --example pq_steps -- [torus|skew|FILE.obj] [MODE]`
 //! with MODE `planar` (default), `conical` or `circular` (`torus`: the benchmark's centroid
 //! dual, 1152 hexagons; `skew`: the 30 x 30 skew grid). `RUNS=n` repeats the run (default 3;
-//! the first pays the allocations' first touch); `PENALTY=n` sets the penalty iterations.
+//! the first pays the allocations' first touch); `PENALTY=n` sets the penalty iterations,
+//! `REFINEMENT=sqp` the exact phase.
 
 use dupin_core::{
-    MeshTopology, PolyMesh, PqMode, PqOptions, PqPerturbation, parse_obj, skew_quad_grid,
-    torus_centroid_dual,
+    MeshTopology, PolyMesh, PqMode, PqOptions, PqPerturbation, Refinement, parse_obj,
+    skew_quad_grid, torus_centroid_dual,
 };
 
 /// CPU time of this thread in seconds (Linux `schedstat`, whose resolution can be a 4 ms tick
@@ -67,6 +68,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     if let Some(n) = std::env::var("PENALTY").ok().and_then(|v| v.parse().ok()) {
         options.penalty_iterations = n;
+    }
+    if std::env::var("REFINEMENT").is_ok_and(|v| v == "sqp") {
+        options.refinement = Refinement::Sqp;
     }
     for run in 0..runs {
         eprintln!("run {run}: {input}, {mode:?}");
