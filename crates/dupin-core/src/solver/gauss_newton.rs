@@ -410,6 +410,21 @@ impl LevenbergMarquardt {
         })
     }
 
+    /// [`Self::step`] at the current damping only: one factorisation (with its step halvings
+    /// and second-order correction), no damping increases; [`SolverError::NoDescent`] when
+    /// that step does not lower the cost (`x` unchanged). A trial of whether a problem is in
+    /// reach of near-Newton steps, at the price of one factorisation.
+    pub(crate) fn try_step_blocks<P: BlockLeastSquares + ?Sized>(
+        &mut self,
+        problem: &P,
+        x: &mut [f64],
+    ) -> Result<LmStep, SolverError> {
+        let retries = std::mem::replace(&mut self.options.max_retries, 0);
+        let step = self.step_blocks(problem, x);
+        self.options.max_retries = retries;
+        step
+    }
+
     /// A chord (simplified Newton) step from `x`, the point the last accepted
     /// [`Self::step`] or chord step reached: `(J₀ᵀJ₀ + μD) h = -J₀ᵀ r(x)` with the Jacobian
     /// `J₀` and the factorisation of the last factored step and a fresh residual, so it costs
