@@ -716,8 +716,9 @@ const CHORD_RATE: f64 = 0.05;
 /// near enough. Measured first steps after one penalty iteration: torus dual 0.0054, conical
 /// vase (5913 vertices) 0.0022 (kept: each saves three penalty factorisations); noisy vase
 /// 0.77 and skew grid rejected at near-Newton damping (discarded: the exact phase from there
-/// stalls or crawls and loses fairness, so the penalty phase goes on). A discarded probe
-/// costs one factorisation.
+/// stalls or crawls and loses fairness, so the penalty phase goes on). Over the test suite the
+/// kept ratios lie in 2.3e-10..0.094 and the discarded ones in 0.19..0.63 or are rejected.
+/// A discarded probe costs one factorisation.
 const PROBE_CONTRACTION: f64 = 0.1;
 
 impl PqPerturbation {
