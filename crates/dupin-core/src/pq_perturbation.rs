@@ -1117,11 +1117,13 @@ impl PqPerturbation {
         let last = self.lm.damping();
         // The exact phase's constraints are curved (angles, |n| = 1): a Newton step that
         // overshoots is repaired by a second-order correction rather than halved.
-        self.lm.set_second_order_correction(true);
         self.exact.set_second_order_correction(true);
         if probe {
             self.exact.set_damping(1e-9);
         } else {
+            // The penalty solver takes the `Refinement::Sqp` fall-back steps from here on
+            // (after a probe it may still take penalty steps, which keep their settings).
+            self.lm.set_second_order_correction(true);
             self.exact.set_damping_with_fallback(1e-9, last);
         }
     }
@@ -1167,6 +1169,28 @@ pub fn pq_perturb(mesh: &PolyMesh, options: PqOptions) -> Result<PqResult, PqErr
 mod tests {
     use super::*;
     use crate::pq_scenes::{skew_quad_grid, torus_centroid_dual};
+    use crate::principal_quad_mesh::{SurfaceOfRevolution, principal_quad_mesh};
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// The principal 30 x 30 mesh of the vase with seeded noise of 2% of the grid spacing
+    /// (the benchmark's harder conical start).
+    fn noisy_vase() -> PolyMesh {
+        let mut m = principal_quad_mesh(
+            &SurfaceOfRevolution::vase(),
+            (0.0, 6.0),
+            (-0.9, 0.9),
+            30,
+            30,
+        );
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        for p in &mut m.positions {
+            for k in 0..3 {
+                p[k] += 0.02 * 0.2 * (rng.random::<f64>() * 2.0 - 1.0);
+            }
+        }
+        m
+    }
 
     fn run(mesh: &PolyMesh, options: PqOptions) -> PqResult {
         let r = pq_perturb(mesh, options).unwrap();
@@ -1227,26 +1251,52 @@ mod tests {
 
     /// The probe after the first penalty iteration (`PROBE_CONTRACTION`): kept on the torus
     /// dual (one penalty factorisation instead of four, the exact phase converges from
-    /// there), discarded on the skew grid, where the run is then exactly the one without a
-    /// probe (same mesh bit for bit) at the price of one factorisation.
+    /// there), discarded on the skew grid and the noisy conical vase, where the penalty steps
+    /// that follow are exactly those of a run without a probe (same settings, same mesh after
+    /// them bit for bit) at the price of one factorisation.
     #[test]
     fn probe_starts_the_exact_phase_only_when_near() {
-        for (name, m, kept) in [
-            ("torus dual", torus_centroid_dual(48, 24, 3.0, 1.0), true),
-            ("skew 30x30", skew_quad_grid(30, 30.0), false),
+        let conical = PqOptions {
+            mode: PqMode::Conical,
+            ..PqOptions::default()
+        };
+        for (name, m, options, kept) in [
+            (
+                "torus dual",
+                torus_centroid_dual(48, 24, 3.0, 1.0),
+                PqOptions::default(),
+                true,
+            ),
+            (
+                "skew 30x30",
+                skew_quad_grid(30, 30.0),
+                PqOptions::default(),
+                false,
+            ),
+            ("noisy vase", noisy_vase(), conical, false),
         ] {
             let run = |probe: bool| {
-                let mut s = PqPerturbation::new(&m, PqOptions::default()).unwrap();
+                let mut s = PqPerturbation::new(&m, options.clone()).unwrap();
                 assert!(s.probe_allowed);
                 s.probe_allowed = probe;
+                // The mesh when the penalty phase ends.
+                let mut after_penalty = None;
                 while !s.is_done() {
+                    let penalty = s.phase() != PqPhase::Sqp || s.probe;
                     s.step();
+                    // Penalty steps keep the penalty settings, probe or not.
+                    if s.phase() == PqPhase::Penalty {
+                        assert_eq!(s.lm.options(), lm_options(), "{name}");
+                    }
+                    if penalty && s.phase() == PqPhase::Sqp && !s.probe {
+                        after_penalty = Some(s.mesh().clone());
+                    }
                 }
                 let penalty = s.lm.factorizations();
-                (penalty, s.finish())
+                (penalty, after_penalty, s.finish())
             };
-            let (penalty, probed) = run(true);
-            let (penalty_without, without) = run(false);
+            let (penalty, probed_penalty, probed) = run(true);
+            let (penalty_without, without_penalty, without) = run(false);
             assert!(probed.converged && without.converged, "{name}");
             assert_eq!(penalty_without, 4, "{name}");
             if kept {
@@ -1254,8 +1304,10 @@ mod tests {
                 assert!(probed.factorizations + 2 < without.factorizations, "{name}");
             } else {
                 assert_eq!(penalty, 4, "{name}");
-                assert_eq!(probed.mesh, without.mesh, "{name}");
+                assert!(probed_penalty.is_some(), "{name}");
+                assert_eq!(probed_penalty, without_penalty, "{name}");
                 assert_eq!(probed.factorizations, without.factorizations + 1, "{name}");
+                assert!((probed.max_move - without.max_move).abs() < 1e-9, "{name}");
             }
         }
     }

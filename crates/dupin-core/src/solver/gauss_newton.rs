@@ -226,6 +226,12 @@ impl LevenbergMarquardt {
         self.options.second_order_correction = on;
     }
 
+    /// The settings in force (with any changes made since [`Self::new`]).
+    #[cfg(test)]
+    pub(crate) fn options(&self) -> LmOptions {
+        self.options
+    }
+
     /// The current relative damping μ.
     pub fn damping(&self) -> f64 {
         self.damping
