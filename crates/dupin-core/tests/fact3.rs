@@ -90,7 +90,7 @@ fn refinement_aligns_with_principal_directions() {
     let mut m = PolyMesh::new(p, faces).unwrap();
     // More penalty iterations than the default 4: the closeness to the vase and the fairness
     // get time to act before the exact phase (4, measured before the probe: 0.0109, 0.0066,
-    // 0.0056 at levels 1-3; 12: 0.0077, 0.0030, 0.0014; the exact-phase probe is discarded at
+    // 0.0056 at levels 1-3; 12: 0.0077, 0.0030, 0.0017; the exact-phase probe is discarded at
     // every level here).
     let opts = PqOptions {
         mode: PqMode::Conical,
