@@ -3,11 +3,9 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use dupin_core::{
     PqMode, PqOptions, StripRule, SurfaceOfRevolution, catmull_clark, developable_subdivision,
-    max_planarity, pq_perturb, principal_quad_mesh, skew_quad_grid, torus_centroid_dual,
-    trefoil_moebius,
+    max_planarity, noisy_vase, pq_perturb, principal_quad_mesh, skew_quad_grid,
+    torus_centroid_dual, trefoil_moebius,
 };
-use rand::{RngExt, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 use std::hint::black_box;
 
 /// CPU time of this thread in seconds (Linux `schedstat`), to separate our own work from the
@@ -49,20 +47,6 @@ fn subdivided_conical_vase() -> dupin_core::PolyMesh {
     for _ in 0..3 {
         let r = pq_perturb(&m, opts.clone()).unwrap();
         m = catmull_clark(&r.mesh).unwrap();
-    }
-    m
-}
-
-/// A principal mesh with seeded random noise of 2% of the grid spacing (a harder start).
-fn noisy_vase(n: usize) -> dupin_core::PolyMesh {
-    let s = SurfaceOfRevolution::vase();
-    let mut m = principal_quad_mesh(&s, (0.0, 6.0), (-0.9, 0.9), n, n);
-    let h = 6.0 / n as f64;
-    let mut rng = ChaCha8Rng::seed_from_u64(5);
-    for p in &mut m.positions {
-        for k in 0..3 {
-            p[k] += 0.02 * h * (rng.random::<f64>() * 2.0 - 1.0);
-        }
     }
     m
 }

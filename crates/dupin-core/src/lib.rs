@@ -106,8 +106,8 @@ pub use pq_perturbation::{
 };
 pub use pq_scene_stepper::{MeshRule, PqScenePhase, PqSceneStepInfo, PqSceneStepper};
 pub use pq_scenes::{
-    PQ_SCENES, PqSceneError, PqSceneResult, pq_scene, skew_quad_grid, torus_centroid_dual,
-    torus_quad_mesh,
+    PQ_SCENES, PqSceneError, PqSceneResult, noisy_vase, pq_scene, skew_quad_grid,
+    torus_centroid_dual, torus_quad_mesh,
 };
 pub use principal_quad_mesh::{SurfaceOfRevolution, principal_quad_mesh};
 pub use render_buffers::{TriangleBuffers, polymesh_buffers, polymesh_edges, sample_surface};

@@ -1168,30 +1168,7 @@ pub fn pq_perturb(mesh: &PolyMesh, options: PqOptions) -> Result<PqResult, PqErr
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pq_scenes::{skew_quad_grid, torus_centroid_dual};
-    use crate::principal_quad_mesh::{SurfaceOfRevolution, principal_quad_mesh};
-    use rand::{RngExt, SeedableRng};
-    use rand_chacha::ChaCha8Rng;
-
-    /// The principal 30 x 30 mesh of the vase with seeded noise of 2% of the grid spacing
-    /// (the benchmark's harder conical start).
-    fn noisy_vase() -> PolyMesh {
-        let mut m = principal_quad_mesh(
-            &SurfaceOfRevolution::vase(),
-            (0.0, 6.0),
-            (-0.9, 0.9),
-            30,
-            30,
-        );
-        let mut rng = ChaCha8Rng::seed_from_u64(5);
-        for p in &mut m.positions {
-            for k in 0..3 {
-                p[k] += 0.02 * 0.2 * (rng.random::<f64>() * 2.0 - 1.0);
-            }
-        }
-        m
-    }
-
+    use crate::pq_scenes::{noisy_vase, skew_quad_grid, torus_centroid_dual};
     fn run(mesh: &PolyMesh, options: PqOptions) -> PqResult {
         let r = pq_perturb(mesh, options).unwrap();
         eprintln!(
@@ -1273,7 +1250,7 @@ mod tests {
                 PqOptions::default(),
                 false,
             ),
-            ("noisy vase", noisy_vase(), conical, false),
+            ("noisy vase", noisy_vase(30), conical, false),
         ] {
             let run = |probe: bool| {
                 let mut s = PqPerturbation::new(&m, options.clone()).unwrap();

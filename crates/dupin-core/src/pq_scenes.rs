@@ -5,6 +5,8 @@
 use crate::math::Vec3;
 use crate::mesh::PolyMesh;
 use crate::surface::{Surface, Torus};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 
 /// A quad grid of `n x n` quads over \[-1, 1\]², rotated by `rotation_deg` about the z axis
 /// and lifted to the saddle z = xy. The grid lines are neither principal nor asymptotic
@@ -51,6 +53,21 @@ pub fn torus_quad_mesh(nu: usize, nv: usize, major: f64, minor: f64) -> PolyMesh
         })
         .collect();
     PolyMesh::new(p, faces).expect("grid indices are valid")
+}
+
+/// The principal `n x n` quad mesh of the vase (its profile over (0, 6), angles (-0.9, 0.9))
+/// with seeded noise of 2% of the grid spacing on every coordinate: a conical start far from
+/// conical, the PQ benchmarks' harder case.
+pub fn noisy_vase(n: usize) -> PolyMesh {
+    let mut m = principal_quad_mesh(&SurfaceOfRevolution::vase(), (0.0, 6.0), (-0.9, 0.9), n, n);
+    let h = 6.0 / n as f64;
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    for p in &mut m.positions {
+        for k in 0..3 {
+            p[k] += 0.02 * h * (rng.random::<f64>() * 2.0 - 1.0);
+        }
+    }
+    m
 }
 
 /// The centroid dual of the regular triangulation of a torus (R = `major`, r = `minor`) with
