@@ -6,8 +6,11 @@
 //! - `cargo xtask build-web`: build the wasm package into the page (settings: `wasm-pack.toml`).
 //! - `cargo xtask serve [--port 8080]`: set up, build, and serve `web/` at http://127.0.0.1:8080/.
 //! - `cargo xtask test`: everything CI runs (`.ci/run` is exactly this).
+//! - `cargo xtask layering`: print each crate's top-level module graph; fails on a cycle (also a
+//!   step of `test`).
 
 mod config;
+mod layering;
 mod serve;
 mod setup;
 mod test;
@@ -42,6 +45,12 @@ enum Command {
     },
     /// Run every check CI runs.
     Test,
+    /// Print each crate's top-level module dependencies (`a -> b`) and fail on any cycle.
+    Layering {
+        /// Check the workspace at this directory instead of this one (e.g. another checkout).
+        #[arg(long)]
+        workspace: Option<std::path::PathBuf>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -56,6 +65,7 @@ fn main() -> ExitCode {
         }),
         Command::Serve { port } => serve::run(port),
         Command::Test => test::run(),
+        Command::Layering { workspace } => layering::print(workspace.as_deref()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

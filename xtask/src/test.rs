@@ -1,6 +1,7 @@
 //! `cargo xtask test`: every check, in the order a failure is cheapest to find.
 
 use crate::config::WebBuild;
+use crate::layering;
 use crate::serve;
 use crate::setup;
 use crate::util::{self, Result, cargo, root};
@@ -31,6 +32,8 @@ pub fn run() -> Result<()> {
     step("rustfmt", &mut || {
         util::run(cargo().args(["fmt", "--all", "--check"]))
     })?;
+    // No dependency cycles between a crate's top-level modules (a source scan: no build).
+    step("module layering", &mut || layering::check())?;
     step("clippy (native)", &mut || {
         util::run(cargo().args([
             "clippy",
