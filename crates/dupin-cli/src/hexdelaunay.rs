@@ -4,9 +4,8 @@
 
 use crate::common::{CliError, read_text, write_report, write_text};
 use clap::{Args, ValueEnum};
-use dupin_core::{
-    HexDelaunayMode, hex_delaunay, parse_points, parse_segments, triangulation_quality, write_obj,
-};
+use dupin_core::hex_delaunay::{HexDelaunayMode, hex_delaunay, triangulation_quality};
+use dupin_core::mesh::{parse_points, parse_segments, write_obj};
 use std::path::PathBuf;
 use std::time::Instant;
 

@@ -3,10 +3,8 @@
 
 use crate::common::{CliError, read_text, write_report, write_text};
 use clap::Args;
-use dupin_core::{
-    MeshTopology, conical_residual, face_normals, max_planarity, parse_obj, support_structure,
-    write_obj,
-};
+use dupin_core::conical::{conical_residual, face_normals, support_structure};
+use dupin_core::mesh::{MeshTopology, max_planarity, parse_obj, write_obj};
 use serde_json::json;
 use std::path::PathBuf;
 

@@ -2,9 +2,10 @@
 
 use crate::common::{CliError, write_report, write_text};
 use clap::Args;
-use dupin_core::{
-    PHEX_SCENES, PhexConfig, TriangulationMethod, parse_assignment, phex_run, phex_scene, write_obj,
-};
+use dupin_core::mesh::write_obj;
+use dupin_core::phex::{PhexConfig, TriangulationMethod, phex_run};
+use dupin_core::scenes::{PHEX_SCENES, phex_scene};
+use dupin_core::surface::parse_assignment;
 use serde_json::json;
 use std::path::PathBuf;
 

@@ -3,7 +3,8 @@
 
 use crate::common::{CliError, read_text, write_report, write_text};
 use clap::{Args, ValueEnum};
-use dupin_core::{PqMode, PqOptions, Refinement, parse_obj, pq_perturb, write_obj};
+use dupin_core::conical::{PqMode, PqOptions, Refinement, pq_perturb};
+use dupin_core::mesh::{parse_obj, write_obj};
 use serde_json::json;
 use std::path::PathBuf;
 

@@ -3,7 +3,8 @@
 
 use crate::common::{CliError, write_report, write_text};
 use clap::Args;
-use dupin_core::{PQ_SCENES, pq_scene, write_obj};
+use dupin_core::mesh::write_obj;
+use dupin_core::scenes::{PQ_SCENES, pq_scene};
 use serde_json::json;
 use std::path::PathBuf;
 

@@ -3,7 +3,8 @@
 
 use crate::common::{CliError, write_report};
 use clap::Args;
-use dupin_core::{CurvatureTolerance, Vec3, parse_assignment, surface_by_name, surface_catalog};
+use dupin_core::Vec3;
+use dupin_core::surface::{CurvatureTolerance, parse_assignment, surface_by_name, surface_catalog};
 use std::path::PathBuf;
 use std::time::Instant;
 

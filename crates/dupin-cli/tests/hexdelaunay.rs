@@ -88,10 +88,10 @@ fn triangulates_and_reports_contract_fields() {
     assert!(r["max_angle_deg"].as_f64().unwrap() <= 120.01);
     assert_eq!(r["delaunay"], true);
     assert!(r["seconds"].as_f64().unwrap() >= 0.0);
-    let mesh = dupin_core::parse_obj(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let mesh = dupin_core::mesh::parse_obj(&std::fs::read_to_string(&out).unwrap()).unwrap();
     assert_eq!(mesh.num_vertices() as u64, r["vertices"].as_u64().unwrap());
     assert_eq!(mesh.num_faces() as u64, r["triangles"].as_u64().unwrap());
-    for p in dupin_core::parse_points(text).unwrap() {
+    for p in dupin_core::mesh::parse_points(text).unwrap() {
         assert!(
             mesh.positions
                 .iter()
@@ -127,9 +127,9 @@ fn extended_mode_keeps_43_9_to_90_degrees() {
     assert!(r["min_angle_deg"].as_f64().unwrap() >= 43.89, "{r}");
     assert!(r["max_angle_deg"].as_f64().unwrap() <= 90.0001, "{r}");
     assert_eq!(r["delaunay"], true);
-    let mesh = dupin_core::parse_obj(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let mesh = dupin_core::mesh::parse_obj(&std::fs::read_to_string(&out).unwrap()).unwrap();
     assert_eq!(mesh.num_faces() as u64, r["triangles"].as_u64().unwrap());
-    for p in dupin_core::parse_points(text).unwrap() {
+    for p in dupin_core::mesh::parse_points(text).unwrap() {
         assert!(
             mesh.positions.iter().any(|v| v.x == p.x && v.y == p.y),
             "input point {p:?} is not an exact vertex"
@@ -203,12 +203,12 @@ fn pslg_segments_become_edges_and_report_the_exempt_triangles() {
         assert!(r["away_min_angle_deg"].as_f64().unwrap() >= lo, "{r}");
         assert!(r["away_max_angle_deg"].as_f64().unwrap() <= hi, "{r}");
         assert_eq!(r["away_delaunay"], true, "{r}");
-        let mesh = dupin_core::parse_obj(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        let mesh = dupin_core::mesh::parse_obj(&std::fs::read_to_string(&out).unwrap()).unwrap();
         assert_eq!(mesh.num_faces() as u64, r["triangles"].as_u64().unwrap());
         // Each segment's endpoints are exact vertices and the segment is covered by edges:
         // the edges lying on it (all vertices within 2e-9 of its length) sum to its length.
-        let p = dupin_core::parse_points(&std::fs::read_to_string(&pts).unwrap()).unwrap();
-        let s = dupin_core::parse_segments(&std::fs::read_to_string(&segs).unwrap()).unwrap();
+        let p = dupin_core::mesh::parse_points(&std::fs::read_to_string(&pts).unwrap()).unwrap();
+        let s = dupin_core::mesh::parse_segments(&std::fs::read_to_string(&segs).unwrap()).unwrap();
         let mut edges = std::collections::HashSet::new();
         for vs in mesh.faces() {
             for i in 0..vs.len() {

@@ -62,7 +62,7 @@ fn scene_writes_obj_and_contract_report() {
     assert_eq!(r["invalid_faces"].as_u64().unwrap(), 0);
     assert!(r["face_sizes"]["6"].as_u64().unwrap() > 100);
     let obj = std::fs::read_to_string(&mesh).unwrap();
-    let parsed = dupin_core::parse_obj(&obj).unwrap();
+    let parsed = dupin_core::mesh::parse_obj(&obj).unwrap();
     assert_eq!(parsed.num_faces() as u64, r["faces"].as_u64().unwrap());
     let _ = std::fs::remove_file(mesh);
     let _ = std::fs::remove_file(report);

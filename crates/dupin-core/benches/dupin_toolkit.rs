@@ -1,10 +1,13 @@
 //! Hot paths of the Dupin toolkit, called per vertex / per triangle by the P-Hex pipeline.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use dupin_core::{
-    DupinCyclide, DupinIndicatrix, MeshSurface, PolyMesh, Surface, Torus, TriangleStar, Vec2, Vec3,
-    dupin_center, dupin_center_3d, ideal_triangle, is_simple_polygon, tangent_dual_point,
+use dupin_core::mesh::{PolyMesh, is_simple_polygon};
+use dupin_core::phex::{
+    DupinIndicatrix, TriangleStar, dupin_center, dupin_center_3d, ideal_triangle,
+    tangent_dual_point,
 };
+use dupin_core::surface::{DupinCyclide, MeshSurface, Surface, Torus};
+use dupin_core::{Vec2, Vec3};
 use std::hint::black_box;
 
 fn bench(c: &mut Criterion) {

@@ -4,7 +4,9 @@
 //! Run: `cargo bench -p dupin-core --bench hex_delaunay -- --quick`.
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use dupin_core::{HexDelaunayMode, Vec2, hex_delaunay, parse_points, parse_segments};
+use dupin_core::Vec2;
+use dupin_core::hex_delaunay::{HexDelaunayMode, hex_delaunay};
+use dupin_core::mesh::{parse_points, parse_segments};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use spade::{ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation};

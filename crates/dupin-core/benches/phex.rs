@@ -3,11 +3,12 @@
 //! scene (ideal triangulation with the parabolic bound, both regions of K).
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use dupin_core::{
+use dupin_core::phex::{
     DualMesh, Initialisation, PhexConfig, PhexPipeline, PlanarityOptimiser, PlanarityOptions,
-    TriangulationMethod, TriangulationSpec, dual_mesh, phex_run, phex_scene, surface_by_name,
-    triangulate,
+    TriangulationMethod, TriangulationSpec, dual_mesh, phex_run, triangulate,
 };
+use dupin_core::scenes::phex_scene;
+use dupin_core::surface::surface_by_name;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::hint::black_box;
@@ -50,7 +51,7 @@ fn spec(size: f64) -> TriangulationSpec {
     let _ = s;
     TriangulationSpec {
         method: TriangulationMethod::Prescribed,
-        rule: dupin_core::LayerRule::Ideal { bound: 0.3 },
+        rule: dupin_core::phex::LayerRule::Ideal { bound: 0.3 },
         samples: (len / size).round() as usize,
         swap: false,
         start: 0.0,

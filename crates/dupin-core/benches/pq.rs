@@ -1,11 +1,13 @@
 //! PQ perturbation benchmarks (issue: speed targets of the conical paper).
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use dupin_core::{
-    PqMode, PqOptions, StripRule, SurfaceOfRevolution, catmull_clark, developable_subdivision,
-    max_planarity, noisy_vase, pq_perturb, principal_quad_mesh, skew_quad_grid,
-    torus_centroid_dual, trefoil_moebius,
+use dupin_core::conical::{
+    PqMode, PqOptions, StripRule, developable_subdivision, pq_perturb, principal_quad_mesh,
+    trefoil_moebius,
 };
+use dupin_core::mesh::{catmull_clark, max_planarity};
+use dupin_core::scenes::benchmark_meshes::{noisy_vase, skew_quad_grid, torus_centroid_dual};
+use dupin_core::surface::SurfaceOfRevolution;
 use std::hint::black_box;
 
 /// CPU time of this thread in seconds (Linux `schedstat`), to separate our own work from the
@@ -16,7 +18,7 @@ fn thread_cpu_seconds() -> Option<f64> {
     Some(ns * 1e-9)
 }
 
-fn report(name: &str, mesh: &dupin_core::PolyMesh, options: &PqOptions) {
+fn report(name: &str, mesh: &dupin_core::mesh::PolyMesh, options: &PqOptions) {
     let t = std::time::Instant::now();
     let c0 = thread_cpu_seconds();
     let r = pq_perturb(mesh, options.clone()).unwrap();
@@ -38,7 +40,7 @@ fn report(name: &str, mesh: &dupin_core::PolyMesh, options: &PqOptions) {
 /// As in the paper's Fig. 15 run: the finest level of Catmull-Clark + conical perturbation.
 /// A principal 10 x 9 control mesh of the vase, two levels of subdivision with conical
 /// perturbation, then one more subdivision: 81 x 73 = 5913 vertices to make conical.
-fn subdivided_conical_vase() -> dupin_core::PolyMesh {
+fn subdivided_conical_vase() -> dupin_core::mesh::PolyMesh {
     let opts = PqOptions {
         mode: PqMode::Conical,
         ..PqOptions::default()

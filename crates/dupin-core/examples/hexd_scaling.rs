@@ -9,7 +9,9 @@
 //! peer (e.g. Triangle); `HEXD_PHASES=n1,n2` prints the thread CPU time of refinement and dual
 //! extraction at those sizes.
 
-use dupin_core::{HexDelaunayMode, Vec2, hex_delaunay};
+use dupin_core::hex_delaunay::{HexDelaunayMode, hex_delaunay};
+
+use dupin_core::Vec2;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -65,7 +67,7 @@ fn spade_refine(points: &[Vec2]) -> (usize, f64) {
 
 /// FNV-1a over the triangles (in order) and the vertex coordinates' bits: equal fingerprints
 /// mean the same triangulation, so a data-layout change can be checked to change nothing.
-fn fingerprint(t: &dupin_core::HexTriangulation) -> u64 {
+fn fingerprint(t: &dupin_core::hex_delaunay::HexTriangulation) -> u64 {
     let mut h = 0xcbf2_9ce4_8422_2325u64;
     let mut eat = |x: u64| {
         h ^= x;
@@ -203,7 +205,7 @@ fn main() {
         for n in list.split(',').filter_map(|s| s.parse::<usize>().ok()) {
             let pts = uniform(n, n as u64);
             let t0 = thread_cpu().unwrap_or(0.0);
-            let mut s = dupin_core::HexDelaunayStepper::new(&pts, &[], mode).unwrap();
+            let mut s = dupin_core::hex_delaunay::HexDelaunayStepper::new(&pts, &[], mode).unwrap();
             let t1 = thread_cpu().unwrap_or(0.0);
             s.run().unwrap();
             let t2 = thread_cpu().unwrap_or(0.0);

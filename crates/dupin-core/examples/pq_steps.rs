@@ -9,10 +9,11 @@
 //! the first pays the allocations' first touch); `PENALTY=n` sets the penalty iterations,
 //! `REFINEMENT=sqp` the exact phase.
 
-use dupin_core::{
-    MeshTopology, PolyMesh, PqMode, PqOptions, PqPerturbation, Refinement, parse_obj,
-    skew_quad_grid, torus_centroid_dual,
-};
+use dupin_core::mesh::{MeshTopology, PolyMesh, parse_obj};
+
+use dupin_core::conical::{PqMode, PqOptions, PqPerturbation, Refinement};
+
+use dupin_core::scenes::benchmark_meshes::{skew_quad_grid, torus_centroid_dual};
 
 /// CPU time of this thread in seconds (Linux `schedstat`, whose resolution can be a 4 ms tick
 /// in a VM; 0 elsewhere).

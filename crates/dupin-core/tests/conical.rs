@@ -1,11 +1,16 @@
 //! Conical and circular meshes, their offsets and support structures (conical paper, Sec. 4-5).
 
-use dupin_core::{
-    MeshTopology, PolyMesh, PqMode, PqOptions, Refinement, SurfaceOfRevolution, Torus, Vec3,
-    VertexType, angle_balance, circular_residual, cone_axes, conical_residual, face_normals,
-    max_planarity, offset_mesh, pq_perturb, principal_quad_mesh, spherical_image,
+use dupin_core::mesh::{MeshTopology, PolyMesh, max_planarity};
+
+use dupin_core::conical::{
+    PqMode, PqOptions, Refinement, VertexType, angle_balance, circular_residual, cone_axes,
+    conical_residual, face_normals, offset_mesh, pq_perturb, principal_quad_mesh, spherical_image,
     support_structure, vertex_type,
 };
+
+use dupin_core::surface::{SurfaceOfRevolution, Torus};
+
+use dupin_core::Vec3;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -242,7 +247,7 @@ fn offsets_support_structure_and_fact_2() {
     let axes = cone_axes(&m, &topo);
     let (mut interior_beams, mut boundary_beams) = (0, 0);
     for (k, (a, b)) in topo.edges().into_iter().enumerate() {
-        let p = dupin_core::face_planarity(&beams, k);
+        let p = dupin_core::mesh::face_planarity(&beams, k);
         assert!(p <= 1e-10, "beam {k} ({a}, {b}): planarity {p}");
         if axes[a as usize].is_some() && axes[b as usize].is_some() {
             interior_beams += 1;
@@ -273,7 +278,7 @@ fn offsets_support_structure_and_fact_2() {
     assert!(img.num_faces() > 0);
     for f in 0..img.num_faces() {
         if img.face(f).len() == 4 {
-            assert!(dupin_core::face_planarity(&img, f) <= 1e-9);
+            assert!(dupin_core::mesh::face_planarity(&img, f) <= 1e-9);
         }
     }
 }
@@ -289,7 +294,7 @@ fn support_beams_planar_on_a_symmetric_principal_mesh() {
     for d in [0.03, -0.08] {
         let (beams, off) = support_structure(&m, d).unwrap();
         for (k, (a, b)) in topo.edges().into_iter().enumerate() {
-            let p = dupin_core::face_planarity(&beams, k);
+            let p = dupin_core::mesh::face_planarity(&beams, k);
             assert!(p <= 1e-10, "d {d}: beam ({a}, {b}) planarity {p}");
             let h = (off.positions[a as usize] - m.positions[a as usize]).norm();
             assert!(

@@ -2,9 +2,11 @@
 //! size h halves five times, the tangent-dual hexagon approaches the Dupin-dual hexagon, and a
 //! Dupin conic, at rate O(h^2) (fitted log-log slope in [1.8, 2.2]).
 
-use dupin_core::{
-    Curvature, Hyperboloid, Surface, Torus, TriangleStar, Vec2, Vec3, tangent_dual_point,
-};
+use dupin_core::surface::{Curvature, Hyperboloid, Surface, Torus};
+
+use dupin_core::phex::{TriangleStar, tangent_dual_point};
+
+use dupin_core::{Vec2, Vec3};
 
 /// The surface point whose orthogonal projection onto the tangent plane of `c` has local
 /// coordinates `target` (Newton on (u, v) from `uv0`).

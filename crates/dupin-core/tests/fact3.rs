@@ -9,10 +9,13 @@
 //! perturbation; and the angle is measured at a fixed distance from the boundary, where the
 //! conical condition (interior vertices only) does not hold.
 
-use dupin_core::{
-    MeshTopology, PolyMesh, PqMode, PqOptions, Surface, SurfaceOfRevolution, Vec3, catmull_clark,
-    conical_residual, max_planarity, pq_perturb,
-};
+use dupin_core::mesh::{MeshTopology, PolyMesh, catmull_clark, max_planarity};
+
+use dupin_core::conical::{PqMode, PqOptions, conical_residual, pq_perturb};
+
+use dupin_core::surface::{Surface, SurfaceOfRevolution};
+
+use dupin_core::Vec3;
 
 /// Graph distance of every vertex from the boundary.
 fn depth(m: &PolyMesh, topo: &MeshTopology) -> Vec<usize> {

@@ -4,7 +4,9 @@
 #[cfg(target_arch = "wasm32")]
 use wasm_bindgen_test::wasm_bindgen_test as test;
 
-use dupin_core::{phex_run, phex_scene};
+use dupin_core::phex::phex_run;
+
+use dupin_core::scenes::phex_scene;
 
 #[test]
 fn torus_bound_10k_faces_five_runs() {

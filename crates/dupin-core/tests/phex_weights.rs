@@ -1,9 +1,9 @@
 //! The free mode's optimisation weights: `PhexConfig::lambda` and `mu` (P-Hex paper, section 7)
 //! reach the planarity optimisation, and bad values are typed errors.
 
-use dupin_core::{
-    Initialisation, LayerRule, PhexConfig, PhexError, PhexPipeline, phex_run, phex_scene,
-};
+use dupin_core::phex::{Initialisation, LayerRule, PhexConfig, PhexError, PhexPipeline, phex_run};
+
+use dupin_core::scenes::phex_scene;
 
 fn small() -> PhexConfig {
     // About 1k hexagons that need Gauss-Newton iterations (BENCHMARKS.md's 1k size).
@@ -14,7 +14,7 @@ fn small() -> PhexConfig {
     c
 }
 
-fn max_diff(a: &dupin_core::PolyMesh, b: &dupin_core::PolyMesh) -> f64 {
+fn max_diff(a: &dupin_core::mesh::PolyMesh, b: &dupin_core::mesh::PolyMesh) -> f64 {
     a.positions
         .iter()
         .zip(&b.positions)

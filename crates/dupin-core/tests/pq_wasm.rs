@@ -7,7 +7,11 @@
 #[cfg(target_arch = "wasm32")]
 use wasm_bindgen_test::wasm_bindgen_test as test;
 
-use dupin_core::{PqOptions, max_planarity, pq_perturb, torus_centroid_dual};
+use dupin_core::conical::{PqOptions, pq_perturb};
+
+use dupin_core::mesh::max_planarity;
+
+use dupin_core::scenes::benchmark_meshes::torus_centroid_dual;
 
 #[test]
 fn torus_dual_1152_hexagons_five_runs() {

@@ -1,10 +1,16 @@
 //! Subdivision rules and their combination with PQ perturbation (conical paper, Sec. 3).
 
-use dupin_core::{
-    MeshTopology, PolyMesh, PqOptions, PqStrip, StripClosure, StripRule, Torus, Vec3,
-    catmull_clark, chaikin, doo_sabin, focal_points, lane_riesenfeld_cubic, max_planarity,
-    pq_perturb, principal_quad_mesh,
+use dupin_core::mesh::{
+    MeshTopology, PolyMesh, catmull_clark, chaikin, doo_sabin, lane_riesenfeld_cubic, max_planarity,
 };
+
+use dupin_core::conical::{
+    PqOptions, PqStrip, StripClosure, StripRule, focal_points, pq_perturb, principal_quad_mesh,
+};
+
+use dupin_core::surface::Torus;
+
+use dupin_core::Vec3;
 
 fn grid(n: usize, lift: impl Fn(f64, f64) -> f64) -> PolyMesh {
     let mut p = Vec::new();
@@ -64,7 +70,7 @@ fn catmull_clark_counts_planarity_and_boundary() {
     // Corners stay fixed; a bilinear (affine here) grid is reproduced on the inside.
     assert_eq!(s.positions[0], m.positions[0]);
     // Hexagons become quads too.
-    let hex = dupin_core::torus_centroid_dual(6, 6, 3.0, 1.0);
+    let hex = dupin_core::scenes::benchmark_meshes::torus_centroid_dual(6, 6, 3.0, 1.0);
     let s = catmull_clark(&hex).unwrap();
     assert_eq!(s.num_faces(), 36 * 6);
     assert!(s.faces().all(|f| f.len() == 4));
@@ -121,7 +127,7 @@ fn doo_sabin_counts_and_orientation() {
     };
     assert!((width(&s) - width(&m)).abs() < 1e-12);
     // On a closed mesh: F + E + V faces.
-    let hex = dupin_core::torus_centroid_dual(6, 6, 3.0, 1.0);
+    let hex = dupin_core::scenes::benchmark_meshes::torus_centroid_dual(6, 6, 3.0, 1.0);
     let s = doo_sabin(&hex).unwrap();
     assert_eq!(s.num_faces(), 36 + 108 + 72);
     MeshTopology::new(&s).unwrap();

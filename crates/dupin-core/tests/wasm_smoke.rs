@@ -5,12 +5,20 @@
 #[cfg(target_arch = "wasm32")]
 use wasm_bindgen_test::wasm_bindgen_test as test;
 
-use dupin_core::{
-    DupinIndicatrix, MeshTopology, PqMode, PqOptions, SurfaceOfRevolution, TriangleStar, Vec2,
-    conical_residual, dupin_center, ideal_triangle, is_affine_quasi_regular_hexagon,
-    is_affine_regular_hexagon, max_planarity, pq_perturb, principal_quad_mesh, skew_quad_grid,
-    surface_by_name, surface_catalog, torus_centroid_dual,
+use dupin_core::phex::{
+    DupinIndicatrix, TriangleStar, dupin_center, ideal_triangle, is_affine_quasi_regular_hexagon,
+    is_affine_regular_hexagon,
 };
+
+use dupin_core::mesh::{MeshTopology, max_planarity};
+
+use dupin_core::conical::{PqMode, PqOptions, conical_residual, pq_perturb, principal_quad_mesh};
+
+use dupin_core::surface::{SurfaceOfRevolution, surface_by_name, surface_catalog};
+
+use dupin_core::Vec2;
+
+use dupin_core::scenes::benchmark_meshes::{skew_quad_grid, torus_centroid_dual};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

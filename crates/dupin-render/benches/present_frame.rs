@@ -7,7 +7,8 @@
 //! Run: `cargo bench -p dupin-render --bench present_frame -- --quick`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use dupin_core::{polymesh_buffers, polymesh_edges, torus_quad_mesh};
+use dupin_core::mesh::{polymesh_buffers, polymesh_edges};
+use dupin_core::scenes::benchmark_meshes::torus_quad_mesh;
 use dupin_render::{FrameInstances, OrbitCamera, PresentationOffscreen, frame_instances};
 use std::time::{Duration, Instant};
 

@@ -3,7 +3,7 @@
 
 use crate::mesh_renderer::RenderError;
 use crate::readback::{PendingSnapshot, read_back};
-use dupin_core::TriangleBuffers;
+use dupin_core::mesh::TriangleBuffers;
 
 pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 

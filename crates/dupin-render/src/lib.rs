@@ -1,7 +1,7 @@
 //! # dupin-render
 //!
 //! A small wgpu renderer for Dupin meshes. It takes plain buffers from `dupin-core`
-//! ([`dupin_core::TriangleBuffers`], line segments) and draws them lit into any colour target:
+//! ([`dupin_core::mesh::TriangleBuffers`], line segments) and draws them lit into any colour target:
 //! a browser canvas (WebGPU, or WebGL2 as the fallback) or an offscreen texture read back to RGBA
 //! for tests. The core never knows about this crate.
 

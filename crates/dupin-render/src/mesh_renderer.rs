@@ -3,7 +3,7 @@
 use crate::camera::OrbitCamera;
 use crate::gpu_mesh::{self, DepthBuffer, GpuMesh, PipelineSpec, Vertex};
 use crate::readback::PendingSnapshot;
-use dupin_core::TriangleBuffers;
+use dupin_core::mesh::TriangleBuffers;
 use thiserror::Error;
 
 /// Background colour of every view (linear RGB), also used by tests to count covered pixels.

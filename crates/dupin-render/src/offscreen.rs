@@ -4,7 +4,7 @@ use crate::camera::OrbitCamera;
 use crate::mesh_renderer::{MeshRenderer, RenderError};
 use crate::presentation::{FrameInstances, PresentationRenderer};
 use crate::readback::PendingSnapshot;
-use dupin_core::TriangleBuffers;
+use dupin_core::mesh::TriangleBuffers;
 
 /// An 8-bit sRGB RGBA image, rows top to bottom.
 #[derive(Debug, Clone, PartialEq)]

@@ -13,7 +13,7 @@ use crate::camera::OrbitCamera;
 use crate::gpu_mesh::{self, DEPTH_FORMAT, DepthBuffer, GpuMesh, PipelineSpec, Vertex};
 use crate::mesh_renderer::{RenderError, background_for};
 use crate::readback::PendingSnapshot;
-use dupin_core::TriangleBuffers;
+use dupin_core::mesh::TriangleBuffers;
 use glam::{Mat4, Vec3, camera::rh};
 
 /// Side of the square shadow map, texels.

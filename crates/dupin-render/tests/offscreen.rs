@@ -5,7 +5,7 @@
 //! `DUPIN_BLESS=1 cargo test -p dupin-render --test offscreen` rewrites the reference after an
 //! intended visual change; look at `target/render-tests/*.png` before committing it.
 
-use dupin_core::{Torus, sample_surface};
+use dupin_core::surface::{Torus, sample_surface};
 use dupin_render::{BACKGROUND, OffscreenImage, OrbitCamera, render_offscreen};
 
 mod common;

@@ -6,7 +6,9 @@
 //!
 //! `DUPIN_BLESS=1 cargo test -p dupin-render --test presentation` rewrites the reference.
 
-use dupin_core::{PolyMesh, TriangleBuffers, Vec3, polymesh_buffers, polymesh_edges};
+use dupin_core::mesh::{PolyMesh, TriangleBuffers, polymesh_buffers, polymesh_edges};
+
+use dupin_core::Vec3;
 use dupin_render::{
     FrameInstances, OffscreenImage, OrbitCamera, PresentationOffscreen, frame_instances,
     render_presentation_offscreen,

@@ -8,7 +8,9 @@
 //! triangles that do not meet a segment). Whatever the core refuses (crossing segments, bad
 //! points) comes back as the core's error message.
 
-use dupin_core::{HexDelaunayMode, HexDelaunayStepper, Vec2, triangulation_quality};
+use dupin_core::hex_delaunay::{HexDelaunayMode, HexDelaunayStepper, triangulation_quality};
+
+use dupin_core::Vec2;
 use serde::Serialize;
 use wasm_bindgen::prelude::*;
 

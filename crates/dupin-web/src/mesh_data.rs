@@ -1,9 +1,10 @@
 //! Triangle buffers handed to JavaScript as typed arrays.
 
-use dupin_core::{
-    PolyMesh, Torus, TriangleBuffers, Vec3, polymesh_buffers, polymesh_edges, sample_surface,
-    write_obj,
-};
+use dupin_core::mesh::{PolyMesh, TriangleBuffers, polymesh_buffers, polymesh_edges, write_obj};
+
+use dupin_core::surface::{Torus, sample_surface};
+
+use dupin_core::Vec3;
 use wasm_bindgen::prelude::*;
 
 /// A triangle mesh as typed arrays: `positions` and `normals` (3 floats a vertex), `indices`

@@ -2,7 +2,13 @@
 //! 3D point (both with the viewer's orbit camera), and the triangle star of the picked vertex
 //! as the teaching inset needs it (P-Hex paper, section 4.1).
 
-use dupin_core::{Curvature, PhexPhase, PhexPipeline, Vec3, pick_vertex, vertex_ring};
+use dupin_core::surface::Curvature;
+
+use dupin_core::phex::{PhexPhase, PhexPipeline};
+
+use dupin_core::Vec3;
+
+use dupin_core::mesh::{pick_vertex, vertex_ring};
 use dupin_render::OrbitCamera;
 use glam::{Vec3 as G3, Vec4};
 use serde::{Deserialize, Serialize};
@@ -159,7 +165,7 @@ pub(crate) fn star_of(p: &PhexPipeline, triangles: &[[u32; 3]], v: usize) -> Sta
 #[cfg(test)]
 mod tests {
     use super::*;
-    use dupin_core::{PhexConfig, TriangulationMethod};
+    use dupin_core::phex::{PhexConfig, TriangulationMethod};
 
     #[test]
     fn the_ray_through_a_projected_point_passes_through_it() {

@@ -1,13 +1,16 @@
 //! Presentation mode: the current panel mesh as glass with metal frames (beams along edges,
 //! nodes at vertices), optionally with its offset layer (conical-meshes paper, section on
-//! offsets: `dupin_core::offset_mesh`) joined by support beams, drawn by
+//! offsets: `dupin_core::conical::offset_mesh`) joined by support beams, drawn by
 //! `dupin_render::PresentationRenderer` (sun shadow map, hemisphere light) with a damped orbit.
 
 // Scene building is used by the wasm-only `Presenter` (and the native tests).
 #![cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
 
 use crate::mesh_data::MeshData;
-use dupin_core::{PolyMesh, TriangleBuffers, Vec3, offset_mesh, polymesh_buffers, torus_quad_mesh};
+use dupin_core::Vec3;
+use dupin_core::conical::offset_mesh;
+use dupin_core::mesh::{PolyMesh, TriangleBuffers, polymesh_buffers};
+use dupin_core::scenes::benchmark_meshes::torus_quad_mesh;
 use wasm_bindgen::prelude::*;
 
 /// Glass and frame buffers of a presentation scene, with counts for the page.
@@ -23,7 +26,7 @@ pub(crate) struct Scene {
 /// Builds the scene for `mesh`; with `offset`, adds the face-offset layer at a quarter of the
 /// mean edge length and a support beam from each vertex to its offset.
 pub(crate) fn build_scene(mesh: &PolyMesh, offset: bool) -> Scene {
-    let edges = dupin_core::polymesh_edges(mesh);
+    let edges = dupin_core::mesh::polymesh_edges(mesh);
     let (mut sum, mut n) = (0.0f64, 0usize);
     for s in edges.chunks_exact(6) {
         let d = ((s[3] - s[0]).powi(2) + (s[4] - s[1]).powi(2) + (s[5] - s[2]).powi(2)).sqrt();
@@ -43,7 +46,7 @@ pub(crate) fn build_scene(mesh: &PolyMesh, offset: bool) -> Scene {
             Ok(off) => {
                 let (g, _) = polymesh_buffers(&off, None);
                 append(&mut glass, &g);
-                frame_edges.extend(dupin_core::polymesh_edges(&off));
+                frame_edges.extend(dupin_core::mesh::polymesh_edges(&off));
                 // Support beams: vertex i of the mesh to vertex i of its offset.
                 for i in 0..mesh.num_vertices().min(off.num_vertices()) {
                     let (a, b): (Vec3, Vec3) = (mesh.positions[i], off.positions[i]);

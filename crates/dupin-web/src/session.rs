@@ -1,12 +1,14 @@
 //! `Session`: the contract's step-by-step JS API over the core's P-Hex pipeline and PQ scenes.
 
 use crate::mesh_data::MeshData;
-use dupin_core::{
-    Initialisation, LayerRule, PHEX_SCENES, PQ_SCENES, PhexConfig, PhexPipeline, PolyMesh, PqMode,
-    PqSceneStepInfo, PqSceneStepper, SheetOptions, TriangulationMethod, face_info, face_planarity,
-    max_planarity, panel_schedule, panel_schedule_svg, phex_scene, support_structure,
-    surface_catalog, write_obj,
+use dupin_core::conical::{PqMode, PqSceneStepInfo, PqSceneStepper, support_structure};
+use dupin_core::fabrication::{SheetOptions, panel_schedule, panel_schedule_svg};
+use dupin_core::mesh::{PolyMesh, face_planarity, max_planarity, write_obj};
+use dupin_core::phex::{
+    Initialisation, LayerRule, PhexConfig, PhexPipeline, TriangulationMethod, face_info,
 };
+use dupin_core::scenes::{PHEX_SCENES, PQ_SCENES, phex_scene, pq_scene_stepper};
+use dupin_core::surface::surface_catalog;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use wasm_bindgen::prelude::*;
@@ -316,7 +318,7 @@ impl Session {
             .map_err(|e| JsError::new(&format!("bad session config: {e}")))?;
         let run = match (&cfg.scene, &cfg.surface) {
             (Some(scene), None) if PQ_SCENES.contains(&scene.as_str()) => Run::Pq {
-                stepper: Box::new(PqSceneStepper::new(scene).map_err(err)?),
+                stepper: Box::new(pq_scene_stepper(scene).map_err(err)?),
                 started: false,
             },
             (Some(scene), None) => {
@@ -478,7 +480,7 @@ impl Session {
 
     /// The SVG panel schedule of the current mesh: every panel flattened into its plane,
     /// numbered by face index, edge lengths in mm for panels scaled so the mean edge is
-    /// `panel_edge_m` metres, packed on square sheets (see `dupin_core::panel_schedule`).
+    /// `panel_edge_m` metres, packed on square sheets (see `dupin_core::fabrication::panel_schedule`).
     #[wasm_bindgen(js_name = exportSvg)]
     pub fn export_svg(&self, panel_edge_m: f64) -> Result<String, JsError> {
         if !(panel_edge_m.is_finite() && panel_edge_m > 0.0) {
@@ -850,7 +852,7 @@ mod tests {
     #[test]
     #[ignore]
     fn profile_10k_worker_step() {
-        use dupin_core::{
+        use dupin_core::phex::{
             Initialisation, PhexConfig, PhexPipeline, PlanarityOptimiser, TriangulationMethod,
         };
         let cpu = || {
@@ -939,7 +941,7 @@ mod tests {
     fn pq_session(scene: &str) -> Session {
         Session {
             run: Run::Pq {
-                stepper: Box::new(PqSceneStepper::new(scene).unwrap()),
+                stepper: Box::new(pq_scene_stepper(scene).unwrap()),
                 started: false,
             },
             config: serde_json::from_str(&format!(r#"{{"scene": "{scene}"}}"#)).unwrap(),
@@ -980,7 +982,7 @@ mod tests {
         let m = s.metrics_struct();
         assert_eq!(m.phase, "done");
         assert!(m.max_planarity <= 1e-10 && m.conical_residual.unwrap() <= 1e-10);
-        let one_shot = dupin_core::pq_scene("conical-station").unwrap();
+        let one_shot = dupin_core::scenes::pq_scene("conical-station").unwrap();
         assert_eq!(s.current_mesh().unwrap(), one_shot.mesh);
         assert_eq!(m.iteration, one_shot.iterations);
     }
@@ -1005,7 +1007,10 @@ mod tests {
         };
         let (offset, beams, segments) = s.layer_meshes(&mesh).unwrap().unwrap();
         let (offset, beams) = (offset.unwrap(), beams.unwrap());
-        let edges = dupin_core::MeshTopology::new(&mesh).unwrap().edges().len();
+        let edges = dupin_core::mesh::MeshTopology::new(&mesh)
+            .unwrap()
+            .edges()
+            .len();
         assert_eq!(offset.num_faces(), mesh.num_faces());
         assert_eq!(beams.num_faces(), edges);
         assert!(max_planarity(&offset) <= 1e-9, "{}", max_planarity(&offset));
@@ -1013,10 +1018,10 @@ mod tests {
         assert_eq!(segments.len(), 6 * mesh.num_vertices());
         let layered = s.mesh(None).unwrap();
         let tris = |m: &MeshData| m.buffers.triangle_count();
-        let offset_tris = dupin_core::polymesh_buffers(&offset, None)
+        let offset_tris = dupin_core::mesh::polymesh_buffers(&offset, None)
             .0
             .triangle_count();
-        let beam_tris = dupin_core::polymesh_buffers(&beams, None)
+        let beam_tris = dupin_core::mesh::polymesh_buffers(&beams, None)
             .0
             .triangle_count();
         assert_eq!(tris(&layered), tris(&plain) + offset_tris + beam_tris);

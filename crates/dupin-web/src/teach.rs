@@ -9,10 +9,12 @@
 //! geometry is the core's; this file only arranges it for drawing.
 
 use crate::pick::StarPick;
-use dupin_core::{
-    Curvature, DupinConic, DupinIndicatrix, PointType, TriangleStar, Vec2, Vec3,
-    dupin_conic_through, ideal_triangle, is_simple_polygon, surface_by_name,
+use dupin_core::mesh::is_simple_polygon;
+use dupin_core::phex::{
+    DupinConic, DupinIndicatrix, TriangleStar, dupin_conic_through, ideal_triangle,
 };
+use dupin_core::surface::{Curvature, PointType, surface_by_name};
+use dupin_core::{Vec2, Vec3};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::f64::consts::TAU;
@@ -731,7 +733,7 @@ mod tests {
 #[cfg(test)]
 mod mesh_star_tests {
     use super::*;
-    use dupin_core::{Surface, Torus};
+    use dupin_core::surface::{Surface, Torus};
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 

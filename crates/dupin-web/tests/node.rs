@@ -132,7 +132,10 @@ fn mesh_arrays_round_trip_and_reject_bad_lengths() {
 #[wasm_bindgen_test]
 fn surface_catalog_lists_every_library_surface_with_ranges() {
     let cat = js_sys::Array::from(&dupin_web::surface_catalog_js().unwrap());
-    assert_eq!(cat.length() as usize, dupin_core::surface_catalog().len());
+    assert_eq!(
+        cat.length() as usize,
+        dupin_core::surface::surface_catalog().len()
+    );
     for s in cat.iter() {
         let params = js_sys::Array::from(&js_sys::Reflect::get(&s, &"params".into()).unwrap());
         for p in params.iter() {

@@ -1,8 +1,8 @@
 //! Circular meshes (conical paper, Sec. 5, eq. (7)): a planar convex quad has a circumcircle
 //! exactly when its opposite angles sum to π, φ1 + φ3 = π and φ2 + φ4 = π.
 
-use crate::discrete_terms::corner_angle;
-use crate::math::Vec3;
+use crate::Vec3;
+use crate::conical::discrete_terms::corner_angle;
 use crate::mesh::PolyMesh;
 
 /// The two circularity terms φ1 + φ3 - π and φ2 + φ4 - π of a quad face; `None` for other

@@ -2,10 +2,10 @@
 //! face planes touch one oriented cone of revolution, equivalently (Geometry Fact 1) the
 //! interior angles ω1..ω4 of the four faces at the vertex balance, ω1 + ω3 = ω2 + ω4.
 
-use crate::discrete_terms::angle_grad;
-use crate::math::Vec3;
+use crate::Vec3;
+use crate::conical::discrete_terms::angle_grad;
+use crate::mesh::MeshTopology;
 use crate::mesh::PolyMesh;
-use crate::mesh_topology::MeshTopology;
 
 /// One interior angle at a vertex: value, (vertex, previous, next) and their gradients.
 pub(crate) type VertexAngle = (f64, [u32; 3], [Vec3; 3]);

@@ -7,11 +7,11 @@
 //! Möbius band), a [`StripRule`] and a number of rounds. Output: the refined PQ strip, its
 //! determinant terms and its singular curve (the intersection points of consecutive rulings).
 
-use crate::discrete_terms::quad_det_grad;
-use crate::math::Vec3;
+use crate::Vec3;
+use crate::conical::discrete_terms::quad_det_grad;
+use crate::conical::{PqError, PqOptions, PqPerturbation, PqResult};
 use crate::mesh::PolyMesh;
-use crate::pq_perturbation::{PqError, PqOptions, PqPerturbation, PqResult};
-use crate::subdivision::{chaikin, lane_riesenfeld_cubic};
+use crate::mesh::{chaikin, lane_riesenfeld_cubic};
 
 /// A strip of quads (a_i, a_{i+1}, b_{i+1}, b_i) between two polylines.
 #[derive(Debug, Clone, PartialEq)]
@@ -276,7 +276,7 @@ pub fn trefoil_moebius(n: usize, width: f64) -> PqStrip {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::planarity::max_planarity;
+    use crate::mesh::max_planarity;
 
     #[test]
     fn moebius_closure_is_consistent() {

@@ -3,7 +3,7 @@
 //! (the `c_det` terms). Gradients are written out by hand because they are three-line closed
 //! forms; no autodiff crate is needed for them.
 
-use crate::math::Vec3;
+use crate::Vec3;
 
 /// Angle in \[0, π\] at `c` between the directions to `a` and `b`, with its gradients with
 /// respect to `c`, `a` and `b`. At a degenerate corner (collinear edges) the gradients are

@@ -5,10 +5,10 @@
 //!
 //! Input: a mesh with planar faces (ideally conical), the distance. Output: the offset mesh.
 
+use crate::Vec3;
 use crate::conical::{cone_axes, face_normals};
-use crate::math::Vec3;
 use crate::mesh::PolyMesh;
-use crate::mesh_topology::{MeshTopology, TopologyError};
+use crate::mesh::{MeshTopology, TopologyError};
 use thiserror::Error;
 
 /// Why an offset could not be built.
@@ -27,7 +27,7 @@ pub enum OffsetError {
 
 /// The face-offset mesh at distance `distance` (positive along the face normals).
 ///
-/// Interior valence-4 vertices move along their cone axis ([`crate::cone_axes`]) by
+/// Interior valence-4 vertices move along their cone axis ([`crate::conical::cone_axes`]) by
 /// `d / cos θ`, θ the angle between axis and face normals. Other vertices satisfy the shifted
 /// planes of their faces in the least-squares sense; when the planes do not determine them
 /// (boundary vertices in one or two faces) the remaining freedom is used to make every offset

@@ -42,13 +42,13 @@
 //! Every face gets planar to the contract's `max_planarity` <= tolerance, including the
 //! hexagons of P-Hex meshes and mixed meshes; triangles are planar already.
 
-use crate::circular::circular_residual;
+use crate::Vec3;
+use crate::conical::circular_residual;
 use crate::conical::conical_residual;
-use crate::discrete_terms::{angle_grad, quad_det_grad};
-use crate::math::Vec3;
+use crate::conical::discrete_terms::{angle_grad, quad_det_grad};
 use crate::mesh::PolyMesh;
-use crate::mesh_topology::{MeshTopology, TopologyError};
-use crate::planarity::max_planarity;
+use crate::mesh::max_planarity;
+use crate::mesh::{MeshTopology, TopologyError};
 use crate::solver::{
     BlockLayout, BlockLeastSquares, BlockSystem, ConstrainedLeastSquares, LevenbergMarquardt,
     LmOptions, LmStep, SolverError, SparseSystem, Sqp, SqpOptions,
@@ -1168,7 +1168,7 @@ pub fn pq_perturb(mesh: &PolyMesh, options: PqOptions) -> Result<PqResult, PqErr
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pq_scenes::{noisy_vase, skew_quad_grid, torus_centroid_dual};
+    use crate::scenes::benchmark_meshes::{noisy_vase, skew_quad_grid, torus_centroid_dual};
     fn run(mesh: &PolyMesh, options: PqOptions) -> PqResult {
         let r = pq_perturb(mesh, options).unwrap();
         eprintln!(

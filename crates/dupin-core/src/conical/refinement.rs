@@ -2,24 +2,92 @@
 //! perturbation alternating, Figs. 7, 9, 14, 16, 17), for a viewer that watches the hierarchy
 //! grow: control mesh -> perturbed -> subdivided -> perturbed -> ...
 //!
-//! Input: a scene name of [`crate::PQ_SCENES`] (or a control mesh / strip with its rule, level
-//! count and [`PqOptions`]). One [`PqSceneStepper::step`] is one perturbation iteration
+//! Input: a [`PqSceneSpec`] (a control mesh or strip with its rule, level count and
+//! [`PqOptions`]; the named scenes are in [`crate::scenes`]). One [`PqSceneStepper::step`] is one perturbation iteration
 //! ([`PqPerturbation::step`]) or one subdivision (Catmull-Clark or Doo-Sabin for meshes, one
 //! curve-rule round for strips). Output after every step: the current mesh, level, phase,
 //! iteration count and the scene's measures; [`PqSceneStepper::finish`] gives the same
-//! [`PqSceneResult`] as [`crate::pq_scene`].
+//! [`PqSceneResult`].
 
-use crate::circular::circular_residual;
-use crate::conical::conical_residual;
-use crate::developable_strip::{PqStrip, StripRule};
-use crate::mesh::PolyMesh;
-use crate::mesh_topology::MeshTopology;
-use crate::planarity::max_planarity;
-use crate::pq_perturbation::{PqMode, PqOptions, PqPerturbation, PqPhase};
-use crate::pq_scenes::{
-    PqSceneError, PqSceneResult, SceneSpec, scene_spec, singular_points_inside,
-};
-use crate::subdivision::{catmull_clark, doo_sabin};
+use super::circular::circular_residual;
+use super::cones::conical_residual;
+use super::developable_strip::{PqStrip, StripRule};
+use super::perturbation::{PqError, PqMode, PqOptions, PqPerturbation, PqPhase};
+use crate::mesh::{MeshTopology, PolyMesh, TopologyError, catmull_clark, doo_sabin, max_planarity};
+use thiserror::Error;
+
+/// Why a PQ scene could not be built.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum PqSceneError {
+    /// No scene has this name.
+    #[error("unknown PQ scene `{0}` (see --list-scenes)")]
+    UnknownScene(String),
+    /// The perturbation rejected a mesh of the scene.
+    #[error(transparent)]
+    Pq(#[from] PqError),
+    /// Subdivision met a non-manifold mesh.
+    #[error(transparent)]
+    Topology(#[from] TopologyError),
+}
+
+/// The final mesh of a PQ scene and its measures.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PqSceneResult {
+    /// The final mesh.
+    pub mesh: PolyMesh,
+    /// Subdivision levels applied.
+    pub levels: usize,
+    /// Perturbation iterations over all levels.
+    pub iterations: usize,
+    /// Whether every perturbation converged.
+    pub converged: bool,
+    /// Contract `max_planarity`.
+    pub max_planarity: f64,
+    /// `conical_residual` (conical scenes).
+    pub conical_residual: Option<f64>,
+    /// `circular_residual` (circular scenes).
+    pub circular_residual: Option<f64>,
+    /// Largest determinant term (developable scenes).
+    pub max_determinant: Option<f64>,
+    /// Number of quads whose singular-curve point lies on the strip (developable scenes).
+    pub singular_points_inside: Option<usize>,
+}
+
+/// What a PQ scene is made of: a control mesh refined by a surface subdivision rule, or a
+/// control strip refined by a curve rule, with the perturbation options of every level.
+#[derive(Debug, Clone)]
+pub enum PqSceneSpec {
+    /// Subdivide with Catmull-Clark and perturb, `levels` times, after perturbing `control`.
+    Mesh {
+        /// The control mesh (level 0).
+        control: PolyMesh,
+        /// Subdivision levels after the control mesh.
+        levels: usize,
+        /// The perturbation options of every level.
+        options: PqOptions,
+    },
+    /// Developable subdivision of `strip` with `rule`, `rounds` times.
+    Strip {
+        /// The control strip (level 0).
+        strip: PqStrip,
+        /// The curve subdivision rule of its polylines.
+        rule: StripRule,
+        /// Subdivision rounds after the control strip.
+        rounds: usize,
+        /// The perturbation options of every level.
+        options: PqOptions,
+    },
+}
+
+/// Number of quads of `strip` whose singular-curve point lies on the strip (ruling parameter
+/// in \[0, 1\]).
+fn singular_points_inside(strip: &PqStrip) -> usize {
+    strip
+        .singular_curve()
+        .iter()
+        .filter(|p| matches!(p, Some((_, t)) if (0.0..=1.0).contains(t)))
+        .count()
+}
 
 /// Surface subdivision rule between the levels of a mesh scene.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -112,15 +180,15 @@ pub struct PqSceneStepper {
 }
 
 impl PqSceneStepper {
-    /// The named scene of [`crate::PQ_SCENES`], at its control mesh.
-    pub fn new(name: &str) -> Result<Self, PqSceneError> {
-        match scene_spec(name)? {
-            SceneSpec::Mesh {
+    /// The scene `spec` at its control mesh.
+    pub fn from_spec(spec: PqSceneSpec) -> Result<Self, PqSceneError> {
+        match spec {
+            PqSceneSpec::Mesh {
                 control,
                 levels,
                 options,
             } => Self::for_mesh(&control, MeshRule::CatmullClark, levels, options),
-            SceneSpec::Strip {
+            PqSceneSpec::Strip {
                 strip,
                 rule,
                 rounds,
@@ -153,7 +221,7 @@ impl PqSceneStepper {
 
     /// Developable subdivision: perturb `strip` (with the determinant terms, glued across a
     /// closed or Möbius joint), then `rounds` times subdivide its polylines with `rule` and
-    /// perturb, as [`crate::developable_subdivision`] does.
+    /// perturb, as [`super::developable_subdivision`] does.
     pub fn for_strip(
         strip: &PqStrip,
         rule: StripRule,
@@ -331,7 +399,79 @@ impl PqSceneStepper {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pq_scenes::{PQ_SCENES, pq_scene};
+    use crate::conical::{developable_subdivision, pq_perturb};
+    use crate::scenes::{PQ_SCENES, benchmark_meshes::skew_quad_grid, pq_scene_spec};
+
+    /// The scene built from the one-shot parts (`pq_perturb`, `catmull_clark`,
+    /// `developable_subdivision`), independently of the stepper.
+    fn one_shot(name: &str) -> PqSceneResult {
+        match pq_scene_spec(name).unwrap() {
+            PqSceneSpec::Mesh {
+                control,
+                levels,
+                options,
+            } => subdivide_and_perturb(&control, levels, &options).unwrap(),
+            PqSceneSpec::Strip {
+                strip,
+                rule,
+                rounds,
+                options,
+            } => {
+                let (levels, it, ok) =
+                    developable_subdivision(&strip, rule, rounds, &options).unwrap();
+                strip_result(levels, it, ok)
+            }
+        }
+    }
+
+    /// Subdivide with `rule` and perturb with `options`, `levels` times, after perturbing the
+    /// control mesh itself.
+    fn subdivide_and_perturb(
+        control: &PolyMesh,
+        levels: usize,
+        options: &PqOptions,
+    ) -> Result<PqSceneResult, PqSceneError> {
+        let mut r = pq_perturb(control, options.clone())?;
+        let mut iterations = r.iterations;
+        let mut converged = r.converged;
+        for _ in 0..levels {
+            let fine = catmull_clark(&r.mesh)?;
+            r = pq_perturb(&fine, options.clone())?;
+            iterations += r.iterations;
+            converged &= r.converged;
+        }
+        let topo = MeshTopology::new(&r.mesh)?;
+        Ok(PqSceneResult {
+            max_planarity: max_planarity(&r.mesh),
+            conical_residual: (options.mode == PqMode::Conical)
+                .then(|| conical_residual(&r.mesh, &topo)),
+            circular_residual: (options.mode == PqMode::Circular)
+                .then(|| circular_residual(&r.mesh)),
+            mesh: r.mesh,
+            levels,
+            iterations,
+            converged,
+            max_determinant: None,
+            singular_points_inside: None,
+        })
+    }
+
+    fn strip_result(levels: Vec<PqStrip>, iterations: usize, converged: bool) -> PqSceneResult {
+        let last = levels.last().expect("at least the control level");
+        let mesh = last.to_mesh();
+        let inside = singular_points_inside(last);
+        PqSceneResult {
+            max_planarity: max_planarity(&mesh),
+            conical_residual: None,
+            circular_residual: None,
+            max_determinant: Some(last.max_determinant()),
+            singular_points_inside: Some(inside),
+            mesh,
+            levels: levels.len() - 1,
+            iterations,
+            converged,
+        }
+    }
 
     /// Every PQ scene stepped to the end gives exactly the one-shot `pq_scene` result, and the
     /// steps are the promised ones: the control mesh first, every step changes the state,
@@ -340,7 +480,7 @@ mod tests {
     #[test]
     fn stepper_ends_at_the_one_shot_result() {
         for &name in PQ_SCENES {
-            let mut s = PqSceneStepper::new(name).unwrap();
+            let mut s = PqSceneStepper::from_spec(pq_scene_spec(name).unwrap()).unwrap();
             assert_eq!(s.phase(), PqScenePhase::Control);
             assert_eq!((s.level(), s.iteration()), (0, 0));
             let mut prev = s.info();
@@ -371,7 +511,7 @@ mod tests {
             // Every step is one iteration or one subdivision.
             assert_eq!(steps, prev.iteration + prev.levels, "{name}");
             let stepped = s.finish().unwrap();
-            let one_shot = pq_scene(name).unwrap();
+            let one_shot = one_shot(name);
             assert_eq!(stepped, one_shot, "{name}");
         }
     }
@@ -381,7 +521,7 @@ mod tests {
     /// not its vertex cones), and the last perturbation restores the contract bounds.
     #[test]
     fn measures_follow_the_levels() {
-        let mut s = PqSceneStepper::new("conical-station").unwrap();
+        let mut s = PqSceneStepper::from_spec(pq_scene_spec("conical-station").unwrap()).unwrap();
         // The control mesh follows principal lines of a surface of revolution: already PQ
         // and conical, so the first step subdivides.
         let control = s.info();
@@ -413,7 +553,7 @@ mod tests {
     /// the perturbation makes every level planar.
     #[test]
     fn doo_sabin_levels_are_planar() {
-        let control = crate::pq_scenes::skew_quad_grid(3, 20.0);
+        let control = skew_quad_grid(3, 20.0);
         let mut s = PqSceneStepper::for_mesh(&control, MeshRule::DooSabin, 1, PqOptions::default())
             .unwrap();
         let mut faces = Vec::new();
@@ -440,13 +580,13 @@ mod tests {
             closeness: f64::NAN,
             ..PqOptions::default()
         };
-        let control = crate::pq_scenes::skew_quad_grid(2, 0.0);
+        let control = skew_quad_grid(2, 0.0);
         assert!(matches!(
             PqSceneStepper::for_mesh(&control, MeshRule::CatmullClark, 1, options),
             Err(PqSceneError::Pq(_))
         ));
         assert!(matches!(
-            PqSceneStepper::new("nope"),
+            pq_scene_spec("nope"),
             Err(PqSceneError::UnknownScene(_))
         ));
     }

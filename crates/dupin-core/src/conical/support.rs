@@ -3,9 +3,9 @@
 //! cone axes are coplanar (Geometry Fact 2), these quads are planar: beams of constant height
 //! that can be cut from flat stock.
 
+use crate::conical::{OffsetError, offset_mesh};
+use crate::mesh::MeshTopology;
 use crate::mesh::PolyMesh;
-use crate::mesh_topology::MeshTopology;
-use crate::offset::{OffsetError, offset_mesh};
 
 /// The support structure between `mesh` and its offset at distance `distance`: one quad per
 /// edge (a, b): a, b, b', a' (primes on the offset), in the order of

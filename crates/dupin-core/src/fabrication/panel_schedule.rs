@@ -9,8 +9,8 @@
 //! small factor of optimal for panels of similar size, which is what panel meshes have. No crate
 //! does this small job for plain 2D polygons, so it is written here.
 
-use crate::math::{Vec2, Vec3};
 use crate::mesh::PolyMesh;
+use crate::{Vec2, Vec3};
 use nalgebra::{Matrix3, SymmetricEigen};
 use std::fmt::Write;
 
@@ -285,7 +285,9 @@ pub fn panel_schedule_svg(schedule: &PanelSchedule, unit_scale: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{Vec3, phex_run, phex_scene};
+    use crate::Vec3;
+    use crate::phex::phex_run;
+    use crate::scenes::phex_scene;
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 

@@ -40,7 +40,7 @@ use super::extended_refinement::{in_half_hexagon, ring, tops_mask};
 use super::hierarchy::WINDOW_DISC2;
 use super::lattice::{Axial, DIRS, add, hex_norm};
 use super::simple_refinement::Refinement;
-use crate::math::Vec2;
+use crate::Vec2;
 
 /// What one coarsening pass did.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]

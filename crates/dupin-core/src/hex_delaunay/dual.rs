@@ -18,7 +18,7 @@
 
 use super::hierarchy::{HexSet, Hierarchy, window_bit};
 use super::lattice::{Axial, DIRS, add, normalize, on_boundary};
-use crate::math::Vec2;
+use crate::Vec2;
 use rustc_hash::{FxHashMap, FxHashSet};
 use std::collections::hash_map::Entry;
 

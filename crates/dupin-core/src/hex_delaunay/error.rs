@@ -2,7 +2,7 @@
 
 use thiserror::Error;
 
-/// Errors of [`crate::hex_delaunay`] and [`crate::HexDelaunayStepper`].
+/// Errors of [`crate::hex_delaunay::hex_delaunay`] and [`crate::hex_delaunay::HexDelaunayStepper`].
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum HexDelaunayError {
     /// No input points were given.

@@ -39,7 +39,7 @@ use super::fin_vertices::{FinPatch, Run, run_patch, top_new};
 use super::hierarchy::{Cell, HexSet, Hierarchy, window_bit};
 use super::lattice::{Axial, DIRS, add, hex_norm, in_domain, on_boundary};
 use super::simple_refinement::Refinement;
-use crate::math::Vec2;
+use crate::Vec2;
 use rustc_hash::{FxHashMap, FxHashSet};
 use std::sync::Mutex;
 

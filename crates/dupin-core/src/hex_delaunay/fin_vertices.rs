@@ -25,7 +25,7 @@
 //! A blossom is 60 triangles.
 
 use super::dual::Key;
-use crate::math::Vec2;
+use crate::Vec2;
 use rustc_hash::FxHashMap;
 
 /// A vertex of a patch: an existing dual vertex by key, or a new one.

@@ -31,7 +31,7 @@ use super::error::HexDelaunayError;
 use super::lattice::{
     Axial, DIRS, Frame, add, in_domain, is_even, normalize, on_boundary, parents_of_midpoint,
 };
-use crate::math::Vec2;
+use crate::Vec2;
 use rustc_hash::FxHashMap;
 use std::cell::Cell as Memo;
 use std::ops::ControlFlow;

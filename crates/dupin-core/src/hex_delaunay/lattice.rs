@@ -14,7 +14,7 @@
 //! hexagons" (Fig. 1 right). At level `k` a lattice point lies in Ω iff its hexagonal distance
 //! from the origin is at most `2^(k-1)`.
 
-use crate::math::Vec2;
+use crate::Vec2;
 
 /// Axial lattice coordinates of a hexagon centre at some level.
 pub type Axial = (i64, i64);

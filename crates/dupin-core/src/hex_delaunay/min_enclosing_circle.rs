@@ -7,7 +7,7 @@
 //! Written by hand: no maintained crate in the dependency set offers it for `nalgebra` points,
 //! and it is thirty lines.
 
-use crate::math::Vec2;
+use crate::Vec2;
 use rand::SeedableRng;
 use rand::seq::SliceRandom;
 use rand_chacha::ChaCha8Rng;

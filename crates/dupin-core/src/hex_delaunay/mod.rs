@@ -49,8 +49,8 @@ pub use min_enclosing_circle::{Circle, min_enclosing_circle};
 pub use quality::{TriangulationQuality, triangulation_quality};
 pub use stepper::{HexCell, HexDelaunayStepper};
 
-use crate::math::{Vec2, Vec3};
 use crate::mesh::PolyMesh;
+use crate::{Vec2, Vec3};
 
 /// Which refinement to run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -27,7 +27,7 @@ use super::error::HexDelaunayError;
 use super::hierarchy::{Cell, Hierarchy};
 use super::lattice::{Axial, DIRS, add, in_domain};
 use super::simple_refinement::Refinement;
-use crate::math::Vec2;
+use crate::Vec2;
 use robust::{Coord, orient2d};
 use rustc_hash::{FxHashMap, FxHashSet};
 
@@ -796,7 +796,7 @@ pub(crate) mod tests {
     /// and an inserted point on a segment splits it.
     #[test]
     fn stepper_with_segments_matches_one_shot_and_inserts() {
-        use crate::HexDelaunayStepper;
+        use crate::hex_delaunay::HexDelaunayStepper;
         let mut rng = ChaCha8Rng::seed_from_u64(73);
         for case in 0..40 {
             let mode = if case % 2 == 0 {
@@ -853,9 +853,10 @@ pub(crate) mod tests {
 
     /// The paper's data set 4, the letters IMR as a PSLG (fixture under tests/data).
     pub(crate) fn imr() -> (Vec<Vec2>, Vec<[usize; 2]>) {
-        let pts = crate::parse_points(include_str!("../../tests/data/imr_points.txt")).unwrap();
+        let pts =
+            crate::mesh::parse_points(include_str!("../../tests/data/imr_points.txt")).unwrap();
         let segs =
-            crate::parse_segments(include_str!("../../tests/data/imr_segments.txt")).unwrap();
+            crate::mesh::parse_segments(include_str!("../../tests/data/imr_segments.txt")).unwrap();
         (pts, segs)
     }
 

@@ -1,6 +1,6 @@
 //! Quality measures of a planar triangulation: the quantities the paper's section 6 bounds.
 
-use crate::math::Vec2;
+use crate::Vec2;
 use robust::{Coord, incircle};
 use rustc_hash::FxHashMap;
 

@@ -27,7 +27,7 @@
 use super::error::HexDelaunayError;
 use super::hierarchy::{Cell, HexSet, Hierarchy, Merge, MergeError};
 use super::lattice::{Axial, DIRS, add};
-use crate::math::Vec2;
+use crate::Vec2;
 use rustc_hash::FxHashMap;
 use std::collections::VecDeque;
 
@@ -375,7 +375,7 @@ mod tests {
     use super::super::lattice::{in_domain, on_boundary};
     use super::super::tests::{FAMILIES, sample};
     use super::*;
-    use crate::HexDelaunayStepper;
+    use crate::hex_delaunay::HexDelaunayStepper;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 
@@ -385,7 +385,9 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(31);
         for case in 0..900 {
             let pts = sample(FAMILIES[case % FAMILIES.len()], &mut rng);
-            let mut s = HexDelaunayStepper::new(&pts, &[], crate::HexDelaunayMode::Simple).unwrap();
+            let mut s =
+                HexDelaunayStepper::new(&pts, &[], crate::hex_delaunay::HexDelaunayMode::Simple)
+                    .unwrap();
             s.run().unwrap();
             let r = s.refinement();
             let h = &r.hierarchy;

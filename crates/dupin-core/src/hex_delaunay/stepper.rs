@@ -16,7 +16,7 @@ use super::pslg::{
 };
 use super::simple_refinement::Refinement;
 use super::{HexDelaunayMode, HexTriangulation, MAX_COORDINATE, MAX_LEVEL, MIN_EXTENT};
-use crate::math::Vec2;
+use crate::Vec2;
 use robust::{Coord, orient2d};
 use rustc_hash::{FxHashMap, FxHashSet};
 
@@ -418,7 +418,7 @@ impl HexDelaunayStepper {
     /// points. Input points are exact vertices only once refinement is finished; segments are
     /// edge chains only then too. Should the segment insertion break down numerically (see
     /// [`HexDelaunayError::SegmentInsertion`]), the triangulation is returned without the
-    /// segments and [`HexTriangulation::segment_edges`] is empty; [`crate::hex_delaunay`]
+    /// segments and [`HexTriangulation::segment_edges`] is empty; [`crate::hex_delaunay::hex_delaunay`]
     /// reports that error instead.
     pub fn triangulation(&self) -> HexTriangulation {
         match self.try_triangulation() {

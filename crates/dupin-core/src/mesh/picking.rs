@@ -2,7 +2,7 @@
 //! vertex, for the page's teaching inset (P-Hex paper, section 4.1: the triangle star of a
 //! vertex and its Dupin hexagon).
 //!
-//! Input: vertex positions and counter-clockwise triangles (a [`crate::Triangulation`]'s, or
+//! Input: vertex positions and counter-clockwise triangles (a [`crate::phex::Triangulation`]'s, or
 //! the first layers of it). Output: the vertex nearest to where a ray first meets the
 //! triangles, and the six ring neighbours of an interior valence-6 vertex in counter-clockwise
 //! order. The ray test is written out (Moller-Trumbore, a dozen lines) because a collision

@@ -1,7 +1,7 @@
 //! The planarity measure of the outside contract: for each face, the largest distance of its
 //! vertices from the face's least-squares plane, divided by the face's mean edge length.
 
-use crate::math::Vec3;
+use crate::Vec3;
 use crate::mesh::PolyMesh;
 use nalgebra::{Matrix3, SymmetricEigen};
 

@@ -4,7 +4,7 @@
 //! Uses `robust::orient2d` (Shewchuk's adaptive exact orientation), so the answer is exact for
 //! the given floating-point vertices. O(n^2) segment pairs: meant for faces (n ~ 6).
 
-use crate::math::Vec2;
+use crate::Vec2;
 use robust::{Coord, orient2d};
 use thiserror::Error;
 

@@ -1,6 +1,6 @@
 //! Polygon meshes of any face size, stored compactly (one index array plus face offsets).
 
-use crate::math::Vec3;
+use crate::Vec3;
 use std::collections::BTreeMap;
 use thiserror::Error;
 

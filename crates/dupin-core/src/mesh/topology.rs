@@ -265,7 +265,7 @@ impl MeshTopology {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::Vec3;
+    use crate::Vec3;
 
     fn grid(n: usize) -> PolyMesh {
         let mut p = Vec::new();

@@ -27,7 +27,8 @@
 
 use super::PhexError;
 use super::triangulation::Triangulation;
-use crate::{PolyMesh, Vec3};
+use crate::Vec3;
+use crate::mesh::PolyMesh;
 use nalgebra::Matrix3;
 
 /// Cut-off of the smallest singular value of the tangent-plane system relative to the middle
@@ -89,7 +90,7 @@ pub enum Initialisation {
     #[default]
     TangentDuality,
     /// Approximate Dupin duality (section 6, steps 1 to 4: per-vertex Dupin centers averaged,
-    /// the centroid in parabolic regions, see [`crate::approximate_dupin_center`]). Faces start
+    /// the centroid in parabolic regions, see [`crate::phex::approximate_dupin_center`]). Faces start
     /// non-planar; the Gauss-Newton optimisation makes them planar.
     DupinDuality,
 }
@@ -125,7 +126,7 @@ pub fn dual_mesh(t: &Triangulation) -> Result<DualMesh, PhexError> {
 /// Errors: [`PhexError::NoValidTriangulation`] when no interior vertex exists.
 pub fn dual_mesh_with(
     t: &Triangulation,
-    surface: &dyn crate::Surface,
+    surface: &dyn crate::surface::Surface,
     init: Initialisation,
 ) -> Result<DualMesh, PhexError> {
     dual_mesh_options(t, surface, init, false)
@@ -137,7 +138,7 @@ pub fn dual_mesh_with(
 /// Errors: [`PhexError::NoValidTriangulation`] when no face can be formed.
 pub fn dual_mesh_options(
     t: &Triangulation,
-    surface: &dyn crate::Surface,
+    surface: &dyn crate::surface::Surface,
     init: Initialisation,
     boundary_faces: bool,
 ) -> Result<DualMesh, PhexError> {
@@ -167,7 +168,7 @@ pub fn dual_mesh_options(
             points
         }
         Initialisation::DupinDuality => {
-            let curv: Vec<Option<crate::Curvature>> =
+            let curv: Vec<Option<crate::surface::Curvature>> =
                 t.uv.iter()
                     .zip(&t.positions)
                     .map(|(uv, p)| {
@@ -184,7 +185,7 @@ pub fn dual_mesh_options(
                     let centroid = tr.iter().map(|&i| t.positions[i as usize]).sum::<Vec3>() / 3.0;
                     match tr.map(|i| curv[i as usize].as_ref()) {
                         [Some(a), Some(b), Some(c)] => {
-                            crate::approximate_dupin_center([a, b, c], PARABOLIC_THRESHOLD)
+                            crate::phex::approximate_dupin_center([a, b, c], PARABOLIC_THRESHOLD)
                                 .map_or(centroid, |r| r.0)
                         }
                         _ => centroid,
@@ -262,7 +263,7 @@ fn starts_simple(pts: &[Vec3], origin: Vec3, n: Vec3) -> bool {
         .iter()
         .map(|p| crate::Vec2::new((p - origin).dot(&e1), (p - origin).dot(&e2)))
         .collect();
-    crate::is_simple_polygon(&q).unwrap_or(false)
+    crate::mesh::is_simple_polygon(&q).unwrap_or(false)
 }
 
 fn dual_from_points_impl(
@@ -417,17 +418,17 @@ mod tests {
         // parabolic triangles become centroids, every other triangle keeps its tangent-plane
         // point, and the initial mesh is valid.
         let params = [("radius", 1.0), ("amplitude", 0.35)];
-        let mut cfg = crate::PhexConfig::for_surface(
+        let mut cfg = crate::phex::PhexConfig::for_surface(
             "vase",
             &[],
-            crate::TriangulationMethod::Prescribed,
+            crate::phex::TriangulationMethod::Prescribed,
             Some(0.12),
         );
         cfg.optimize = false;
-        let r = crate::phex_run(cfg).unwrap();
+        let r = crate::phex::phex_run(cfg).unwrap();
         assert_eq!(r.report.invalid_faces, 0);
         let t = &r.triangulation;
-        let s = crate::surface_by_name("vase", &params).unwrap();
+        let s = crate::surface::surface_by_name("vase", &params).unwrap();
         let d = dual_mesh_options(t, s.as_ref(), Initialisation::TangentDuality, false).unwrap();
         let plain = dual_mesh(t).unwrap();
         let mut replaced = 0;
@@ -456,11 +457,11 @@ mod tests {
     fn stable_parabolic_points_are_kept_on_the_torus() {
         // The torus's parabolic circles: the tangent-plane points stay near their triangles,
         // so the rule keeps the exact tangent duality and the faces start planar.
-        let mut cfg = crate::phex_scene("torus-bound").unwrap().config;
+        let mut cfg = crate::scenes::phex_scene("torus-bound").unwrap().config;
         cfg.optimize = false;
-        let r = crate::phex_run(cfg).unwrap();
+        let r = crate::phex::phex_run(cfg).unwrap();
         let t = &r.triangulation;
-        let s = crate::surface_by_name("torus", &[]).unwrap();
+        let s = crate::surface::surface_by_name("torus", &[]).unwrap();
         let parabolic = t
             .triangles
             .iter()
@@ -501,7 +502,8 @@ mod tests {
 
     #[test]
     fn every_dual_face_lies_in_the_tangent_plane_of_its_vertex() {
-        let r = crate::phex_run(crate::phex_scene("torus-bound").unwrap().config).unwrap();
+        let r = crate::phex::phex_run(crate::scenes::phex_scene("torus-bound").unwrap().config)
+            .unwrap();
         let t = &r.triangulation;
         let d = dual_mesh(t).unwrap();
         for (f, &v) in d.face_vertex.iter().enumerate() {
@@ -515,13 +517,14 @@ mod tests {
 
     #[test]
     fn boundary_faces_close_the_dual_and_become_planar() {
-        use crate::{PlanarityOptimiser, PlanarityOptions, max_planarity};
+        use crate::mesh::max_planarity;
+        use crate::phex::{PlanarityOptimiser, PlanarityOptions};
         use std::collections::HashSet;
         for (scene, seed) in [("sphere-radial", 3u64), ("hyperboloid-valid", 4)] {
-            let sc = crate::phex_scene(scene).unwrap();
+            let sc = crate::scenes::phex_scene(scene).unwrap();
             let mut cfg = sc.config.clone();
             cfg.optimize = false;
-            let r = crate::phex_run(cfg).unwrap();
+            let r = crate::phex::phex_run(cfg).unwrap();
             let t = &r.triangulation;
             let inner = dual_mesh(t).unwrap();
             let d = DualMesh::with_boundary_faces(t).unwrap();
@@ -565,7 +568,7 @@ mod tests {
                 }
             }
             assert!(max_planarity(&mesh) > 1e-5);
-            let surface = crate::surface_by_name(&sc.config.surface, &[]).unwrap();
+            let surface = crate::surface::surface_by_name(&sc.config.surface, &[]).unwrap();
             let mut opt =
                 PlanarityOptimiser::new(&mesh, Some(&d.vertex_uv), PlanarityOptions::default())
                     .unwrap();

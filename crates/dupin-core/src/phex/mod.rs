@@ -1,28 +1,42 @@
-//! P-Hex meshes (P-Hex paper, sections 5 to 7): a valid triangulation of a surface, its
-//! tangent/Dupin dual hexagonal mesh, and Gauss-Newton planarity optimisation, as a one-shot
-//! function ([`phex_run`]) and a stateful stepper ([`PhexPipeline`]).
+//! P-Hex meshes (P-Hex paper): Dupin duality on a smooth surface (sections 3 to 5.1), a valid
+//! triangulation along conjugate directions (section 5), its tangent/Dupin dual hexagonal mesh
+//! (section 6) and Gauss-Newton planarity optimisation (sections 6, 7), as a one-shot function
+//! ([`phex_run`]) and a stateful stepper ([`PhexPipeline`]).
+//!
+//! | section | concept | file |
+//! |---|---|---|
+//! | 3 to 5.1 | indicatrix, Dupin center, tangent duality, triangle stars, ideal triangle | `duality/` |
+//! | 5.2, 5.3 | triangulation methods 1 and 2, parabolic rules, Loop subdivision | `triangulation/` |
+//! | 6 | the hexagonal mesh dual to a triangulation (tangent or Dupin duality) | `dual_hexagons.rs` |
+//! | 6, 7 | Gauss-Newton planarity optimisation with fairness and surface distance | `planarity_optimisation.rs` |
+//! | 5 to 7 | the stepped pipeline and its one-shot run | `pipeline.rs` |
+//! | 8 | the report: planarity, validity, shape deviation per face | `report.rs` |
 
-mod conjugate_fields;
-mod dupin_dual_hexagons;
-mod loop_subdivision;
+mod dual_hexagons;
+mod duality;
 mod pipeline;
 mod planarity_optimisation;
 mod report;
-mod scenes;
 mod triangulation;
 
-pub use conjugate_fields::{ConjugateFields, triangulate_along_fields};
-pub use dupin_dual_hexagons::{
+pub use dual_hexagons::{
     DualMesh, Initialisation, PARABOLIC_THRESHOLD, dual_mesh, dual_mesh_options, dual_mesh_with,
     tangent_plane_point,
 };
-pub use loop_subdivision::{convex_loop_triangulation, loop_subdivide};
+pub use duality::{
+    DupinCenterError, DupinCenterMethod, DupinConic, DupinHexagon, DupinIndicatrix, IdealTriangle,
+    IdealTriangleError, IndicatrixError, TangentDualPoint, TangentDualityError, TriangleStar,
+    TriangleStarError, approximate_dupin_center, dupin_center, dupin_center_3d,
+    dupin_conic_through, ideal_apex_3d, ideal_triangle, is_affine_quasi_regular_hexagon,
+    is_affine_regular_hexagon, tangent_dual_point,
+};
 pub use pipeline::{PhexConfig, PhexMetrics, PhexPhase, PhexPipeline, PhexResult, phex_run};
 pub use planarity_optimisation::{PlanarityOptimiser, PlanarityOptions, PlanarityStep};
 pub use report::{FaceInfo, PhexReport, face_info, phex_report};
-pub use scenes::{FREEFORM, FreeformSurface, PHEX_SCENES, PhexScene, TwistedSurface, phex_scene};
 pub use triangulation::{
-    LayerRule, Triangulation, TriangulationMethod, TriangulationSpec, bounded_ratio, triangulate,
+    ConjugateFields, DEFAULT_BOUND, LayerRule, MAX_RATIO, MAX_RATIO_ELLIPTIC, Triangulation,
+    TriangulationMethod, TriangulationSpec, bounded_ratio, convex_loop_triangulation,
+    loop_subdivide, triangulate, triangulate_along_fields,
 };
 
 use thiserror::Error;
@@ -30,7 +44,7 @@ use thiserror::Error;
 /// Why a P-Hex run could not be done. Every message says what to change.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum PhexError {
-    /// The scene name is not one of [`PHEX_SCENES`].
+    /// The scene name is not one of [`crate::scenes::PHEX_SCENES`].
     #[error("unknown P-Hex scene '{name}'; known scenes: {known}")]
     UnknownScene {
         /// The name given.
@@ -40,7 +54,7 @@ pub enum PhexError {
     },
     /// The surface name, a parameter or a parameter relation is invalid.
     #[error("{0}")]
-    Surface(#[from] crate::RegistryError),
+    Surface(#[from] crate::surface::RegistryError),
     /// A run parameter (method, iterations, weights) is out of range.
     #[error("bad parameter: {0}")]
     BadParameter(String),
@@ -52,5 +66,5 @@ pub enum PhexError {
     NoValidTriangulation(String),
     /// The sparse solver failed.
     #[error("planarity optimisation failed: {0}")]
-    Solver(#[from] crate::SolverError),
+    Solver(#[from] crate::solver::SolverError),
 }

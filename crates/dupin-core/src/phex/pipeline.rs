@@ -4,17 +4,17 @@
 //! web page); [`phex_run`] the one-shot function (for the CLI).
 
 use super::PhexError;
-use super::conjugate_fields::triangulate_along_fields;
-use super::dupin_dual_hexagons::{DualMesh, dual_mesh_options};
+use super::dual_hexagons::{DualMesh, dual_mesh_options};
 use super::planarity_optimisation::{PlanarityOptimiser, PlanarityOptions};
 use super::report::{PhexReport, phex_report};
-use super::scenes::TwistedSurface;
 use super::triangulation::{
     LayerRule, Triangulation, TriangulationMethod, TriangulationSpec, triangulate,
+    triangulate_along_fields,
 };
-use crate::{PolyMesh, Surface, max_planarity, surface_by_name};
+use crate::mesh::{PolyMesh, max_planarity};
+use crate::surface::{FREEFORM, FreeformSurface, Surface, TwistedSurface, surface_by_name};
 
-/// Everything a run needs. Build it from a scene ([`crate::phex_scene`]) or with
+/// Everything a run needs. Build it from a scene ([`crate::scenes::phex_scene`]) or with
 /// [`PhexConfig::for_surface`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct PhexConfig {
@@ -84,7 +84,7 @@ impl PhexConfig {
             twist: 0.0,
             method,
             rule: LayerRule::Ideal {
-                bound: super::scenes::DEFAULT_BOUND,
+                bound: super::DEFAULT_BOUND,
             },
             swap: false,
             across,
@@ -181,7 +181,7 @@ fn build_surface(config: &PhexConfig) -> Result<Box<dyn Surface>, PhexError> {
         .iter()
         .map(|(k, v)| (k.as_str(), *v))
         .collect();
-    let s: Box<dyn Surface> = if config.surface == super::scenes::FREEFORM {
+    let s: Box<dyn Surface> = if config.surface == FREEFORM {
         let (mut amplitude, mut curl) = (0.4, 0.3);
         for (k, v) in &params {
             let slot = match *k {
@@ -190,7 +190,7 @@ fn build_surface(config: &PhexConfig) -> Result<Box<dyn Surface>, PhexError> {
                 _ => {
                     return Err(PhexError::BadParameter(format!(
                         "{} has no parameter '{k}'; use amplitude or curl",
-                        super::scenes::FREEFORM
+                        FREEFORM
                     )));
                 }
             };
@@ -201,7 +201,7 @@ fn build_surface(config: &PhexConfig) -> Result<Box<dyn Surface>, PhexError> {
             }
             *slot = *v;
         }
-        Box::new(super::scenes::FreeformSurface { amplitude, curl })
+        Box::new(FreeformSurface { amplitude, curl })
     } else {
         surface_by_name(&config.surface, &params)?
     };
@@ -409,7 +409,7 @@ impl PhexPipeline {
             )));
         }
         let levels = (1.05 * mean_axis / size).log2().ceil().max(1.0) as usize;
-        let tri = super::loop_subdivision::convex_loop_triangulation(axes, levels)?;
+        let tri = super::triangulation::convex_loop_triangulation(axes, levels)?;
         let n = tri.triangles.len();
         Ok(Self::at_start(surface, config, tri, vec![n]))
     }

@@ -40,7 +40,7 @@
 //! count towards the switch to Cholesky.
 //!
 //! Why this file assembles the normal equations itself instead of going through the shared
-//! [`crate::LevenbergMarquardt`] engine: the engine takes Jacobian triplets, so every iteration
+//! [`crate::solver::LevenbergMarquardt`] engine: the engine takes Jacobian triplets, so every iteration
 //! it would receive ~80 (row, col) products per tetrahedron (about 5 million triplets for 10k
 //! hexagons), compare the whole triplet pattern with the previous one, and sum duplicates
 //! through an argsort. Here the sparsity pattern of JᵀJ is fixed by the mesh connectivity, so
@@ -51,8 +51,11 @@
 //! (element -> variable list) instead of triplets.
 
 use super::PhexError;
+use crate::mesh::{PolyMesh, max_planarity};
+use crate::solver::SolverError;
 use crate::solver::SparseCholesky;
-use crate::{PolyMesh, SolverError, Surface, Vec2, Vec3, max_planarity};
+use crate::surface::Surface;
+use crate::{Vec2, Vec3};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::amd;
 use faer::sparse::{SymbolicSparseColMat, SymbolicSparseColMatRef};
@@ -807,7 +810,8 @@ impl PlanarityOptimiser {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{phex_run, phex_scene};
+    use crate::phex::phex_run;
+    use crate::scenes::phex_scene;
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
@@ -840,7 +844,7 @@ mod tests {
             }
             let before = max_planarity(&mesh);
             assert!(before > 1e-4);
-            let surface = crate::surface_by_name(&scene.config.surface, &[]).unwrap();
+            let surface = crate::surface::surface_by_name(&scene.config.surface, &[]).unwrap();
             let min_edge = |m: &PolyMesh| {
                 m.faces()
                     .flat_map(|f| (0..f.len()).map(move |k| (f[k], f[(k + 1) % f.len()])))
@@ -901,7 +905,7 @@ mod tests {
         cfg.optimize = false;
         let mesh = phex_run(cfg).unwrap().mesh;
         assert!(max_planarity(&mesh) < 1e-9);
-        let surface = crate::surface_by_name(&scene.config.surface, &[]).unwrap();
+        let surface = crate::surface::surface_by_name(&scene.config.surface, &[]).unwrap();
         let mut opt = PlanarityOptimiser::new(&mesh, None, PlanarityOptions::default()).unwrap();
         let x = mesh.positions.clone();
         let feet: Vec<(Vec3, Vec3)> = x
@@ -981,7 +985,7 @@ mod tests {
                 p[k] += rng.random_range(-1.0..1.0) * 1e-3 * e;
             }
         }
-        let surface = crate::surface_by_name(&scene.config.surface, &[]).unwrap();
+        let surface = crate::surface::surface_by_name(&scene.config.surface, &[]).unwrap();
         let mut opt = PlanarityOptimiser::new(&mesh, None, PlanarityOptions::default()).unwrap();
         let x = mesh.positions.clone();
         let feet: Vec<(Vec3, Vec3)> = x
@@ -1016,7 +1020,7 @@ mod tests {
     /// where the old code took 7 iterations, the last 3 with a factorisation each.
     #[test]
     fn dupin_duality_start_converges_without_cholesky_fallback() {
-        use crate::{Initialisation, PhexConfig, PhexPipeline, TriangulationMethod};
+        use crate::phex::{Initialisation, PhexConfig, PhexPipeline, TriangulationMethod};
         let mut cfg =
             PhexConfig::for_surface("torus", &[], TriangulationMethod::Prescribed, Some(0.4));
         cfg.initialisation = Initialisation::DupinDuality;

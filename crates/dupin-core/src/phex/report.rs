@@ -2,7 +2,11 @@
 //! and 7): planarity, validity (simple polygon), convexity and the shape deviation from the
 //! affine regular (K > 0) or affine quasi-regular (K < 0) hexagon, plus the surface distance.
 
-use crate::{PolyMesh, Surface, Vec2, Vec3, face_planarity, is_simple_polygon};
+use crate::mesh::{PolyMesh, face_planarity, is_simple_polygon};
+
+use crate::surface::Surface;
+
+use crate::{Vec2, Vec3};
 use std::collections::BTreeMap;
 
 /// Diagnostics of one face.

@@ -1,10 +1,11 @@
 //! The P-Hex scenes of the contract, after the P-Hex paper's figures (Figs. 1, 11, 15, 18, 19,
 //! 20, 22 and section 3), as triangulation settings on library surfaces.
 
-use super::PhexError;
-use super::pipeline::PhexConfig;
-use super::triangulation::{LayerRule, TriangulationMethod};
-use crate::{Domain, Surface, SurfaceDerivatives};
+use crate::phex::{
+    DEFAULT_BOUND, Initialisation, LayerRule, PhexConfig, PhexError, PlanarityOptions,
+    TriangulationMethod,
+};
+use crate::surface::FREEFORM;
 use std::f64::consts::{PI, TAU};
 
 /// Every P-Hex scene name (what `dupin phex --list-scenes` prints).
@@ -40,9 +41,6 @@ pub struct PhexScene {
     pub expect_valid: bool,
 }
 
-/// The section 5.3 lower bound b used by the scenes.
-pub const DEFAULT_BOUND: f64 = 0.3;
-
 #[allow(clippy::too_many_arguments)] // a table row: one argument per column
 fn cfg(
     surface: &str,
@@ -67,11 +65,11 @@ fn cfg(
         iterations: 10,
         optimize: true,
         loop_subdivision: false,
-        initialisation: super::Initialisation::TangentDuality,
+        initialisation: Initialisation::TangentDuality,
         boundary_faces: true,
         field_angle: None,
-        lambda: super::PlanarityOptions::default().fairness,
-        mu: super::PlanarityOptions::default().distance,
+        lambda: PlanarityOptions::default().fairness,
+        mu: PlanarityOptions::default().distance,
     }
 }
 
@@ -316,85 +314,18 @@ pub fn phex_scene(name: &str) -> Result<PhexScene, PhexError> {
     })
 }
 
-/// Name of the scene-only freeform surface of `freeform-parabolic` (see [`FreeformSurface`]).
-pub const FREEFORM: &str = "freeform-translational";
-
-/// The translational freeform surface of the `freeform-parabolic` scene (Fig. 22 stand-in):
-/// P(u, v) = (u, v, amplitude sin(u) + curl v^2), u in [-2, 2], v in [-1.5, 1.5] (pipeline
-/// parameters `amplitude`, default 0.4, and `curl`, default 0.3, each in [-1, 1]). Its parameter
-/// lines are conjugate (translational surface), K > 0 for u < 0, K < 0 for u > 0, with the
-/// parabolic line u = 0 crossing every base curve.
-pub struct FreeformSurface {
-    /// Amplitude of the sine profile.
-    pub amplitude: f64,
-    /// Coefficient of v^2.
-    pub curl: f64,
-}
-
-impl Surface for FreeformSurface {
-    fn domain(&self) -> Domain {
-        Domain {
-            u: (-2.0, 2.0),
-            v: (-1.5, 1.5),
-            periodic_u: false,
-            periodic_v: false,
-        }
-    }
-
-    fn derivatives(&self, u: f64, v: f64) -> SurfaceDerivatives {
-        let (su, cu) = u.sin_cos();
-        let (a, b) = (self.amplitude, self.curl);
-        SurfaceDerivatives {
-            p: crate::Vec3::new(u, v, a * su + b * v * v),
-            pu: crate::Vec3::new(1.0, 0.0, a * cu),
-            pv: crate::Vec3::new(0.0, 1.0, 2.0 * b * v),
-            puu: crate::Vec3::new(0.0, 0.0, -a * su),
-            puv: crate::Vec3::zeros(),
-            pvv: crate::Vec3::new(0.0, 0.0, 2.0 * b),
-        }
-    }
-}
-
-/// A surface re-parametrised as P(u + twist v, v): its v-lines become spirals (used for the
-/// spiral sphere pattern of Fig. 20).
-pub struct TwistedSurface {
-    /// The original surface.
-    pub inner: Box<dyn Surface>,
-    /// Shear factor.
-    pub twist: f64,
-}
-
-impl Surface for TwistedSurface {
-    fn domain(&self) -> Domain {
-        self.inner.domain()
-    }
-
-    fn derivatives(&self, u: f64, v: f64) -> SurfaceDerivatives {
-        let t = self.twist;
-        let d = self.inner.derivatives(u + t * v, v);
-        SurfaceDerivatives {
-            p: d.p,
-            pu: d.pu,
-            pv: d.pu * t + d.pv,
-            puu: d.puu,
-            puv: d.puu * t + d.puv,
-            pvv: d.puu * (t * t) + d.puv * (2.0 * t) + d.pvv,
-        }
-    }
-}
-
 #[cfg(test)]
 pub(crate) use tests::acceptance as acceptance_for_tests;
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{PhexPipeline, PhexReport, phex_run};
+    use crate::phex::{PhexPipeline, PhexReport, phex_run};
 
     /// Faces counted as "away from parabolic curves": |K| at least this share of the largest |K|.
     const AWAY: f64 = 0.2;
 
-    /// Bound on the shape deviation (see [`crate::FaceInfo::shape_deviation`]) of the hexagons
+    /// Bound on the shape deviation (see [`crate::phex::FaceInfo::shape_deviation`]) of the hexagons
     /// away from parabolic curves, for every valid scene.
     pub(crate) const SHAPE_BOUND: f64 = 0.8;
 
@@ -475,7 +406,7 @@ mod tests {
                         bad.push(format!("shape deviation {shape:.2}"));
                     }
                     // Boundary faces are part of the mesh checked above, on every open scene.
-                    let interior = crate::dual_mesh(&r.triangulation)
+                    let interior = crate::phex::dual_mesh(&r.triangulation)
                         .map(|d| d.mesh.num_faces())
                         .unwrap_or(0);
                     let closed = ["torus-bound", "cyclide-prescribed", "convex-loop"];
@@ -534,7 +465,7 @@ mod tests {
         }
         assert_eq!(last_faces, p.triangulation().triangles.len());
         let m = p.step().unwrap();
-        assert_ne!(m.phase, crate::PhexPhase::Triangulation);
+        assert_ne!(m.phase, crate::phex::PhexPhase::Triangulation);
         let mut guard = 0;
         while !p.done() {
             p.step().unwrap();
@@ -562,7 +493,7 @@ mod tests {
     fn dupin_duality_initialisation_is_made_planar_by_gauss_newton() {
         for name in ["sphere-radial", "hyperboloid-valid", "torus-bound"] {
             let mut c = phex_scene(name).unwrap().config;
-            c.initialisation = crate::Initialisation::DupinDuality;
+            c.initialisation = crate::phex::Initialisation::DupinDuality;
             if name == "torus-bound" {
                 // Coarser than the scene (about 2.7k faces) to keep the test fast.
                 c.size = Some(0.3);
@@ -778,10 +709,10 @@ mod tests {
                 ("radius".to_string(), radius),
                 ("amplitude".to_string(), amplitude),
             ];
-            let mut c = crate::PhexConfig::for_surface(
+            let mut c = crate::phex::PhexConfig::for_surface(
                 "vase",
                 &params,
-                crate::TriangulationMethod::Prescribed,
+                crate::phex::TriangulationMethod::Prescribed,
                 Some(0.12),
             );
             c.across = Some((start, 3.0));

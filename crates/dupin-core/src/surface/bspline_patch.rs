@@ -2,7 +2,7 @@
 //! right and 22: freeform surfaces with parabolic curves).
 
 use super::{Domain, Surface, SurfaceDerivatives};
-use crate::math::Vec3;
+use crate::Vec3;
 use thiserror::Error;
 
 /// Why a control net was rejected.
@@ -210,7 +210,7 @@ impl Surface for BSplinePatch {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::surface::hyperbolic_paraboloid::graph_curvatures;
+    use crate::surface::graph_curvatures;
     use crate::surface::test_support::*;
 
     #[test]

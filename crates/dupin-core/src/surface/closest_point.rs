@@ -5,7 +5,7 @@
 //! no crate in the stack offers for an arbitrary `Surface`; it allocates nothing.
 
 use super::Surface;
-use crate::math::{Vec2, Vec3};
+use crate::{Vec2, Vec3};
 use thiserror::Error;
 
 /// Result of a closest-point query.

@@ -9,8 +9,8 @@
 //! it is a few lines, allocation free, stable at umbilics, and cheaper per vertex in the P-Hex
 //! hot loops than a general eigen-solver).
 
-use crate::math::{Vec2, Vec3};
 use crate::surface::SurfaceDerivatives;
+use crate::{Vec2, Vec3};
 use thiserror::Error;
 
 /// Why curvature could not be computed.

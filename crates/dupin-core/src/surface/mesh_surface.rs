@@ -7,11 +7,11 @@
 //! the dependency tree of `spade`); its exact nearest-neighbour search runs on our own triangle
 //! type with an exact point-triangle distance.
 
-use crate::curvature::{Curvature, CurvatureError};
-use crate::math::Vec3;
+use crate::Vec3;
 use crate::mesh::PolyMesh;
-use crate::obj::{ObjError, parse_obj};
+use crate::mesh::{ObjError, parse_obj};
 use crate::surface::SurfaceDerivatives;
+use crate::surface::{Curvature, CurvatureError};
 use nalgebra::{Matrix5, Vector5};
 use rstar::{AABB, PointDistance, RTree, RTreeObject};
 use thiserror::Error;
@@ -317,7 +317,7 @@ fn fit_quadric(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::obj::write_obj;
+    use crate::mesh::write_obj;
     use crate::surface::{Surface, Torus};
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;

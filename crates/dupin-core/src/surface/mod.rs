@@ -4,39 +4,29 @@
 //! everything else (normal, fundamental forms, curvature, closest point) is provided from them.
 
 mod bspline_patch;
-mod catenoid;
 mod closest_point;
-mod cylinder;
-mod dupin_cyclide;
-mod ellipsoid;
-mod enneper;
-mod hyperbolic_paraboloid;
-mod hyperboloid;
+mod curvature;
+mod library;
 mod mesh_surface;
 mod registry;
-mod sphere;
-mod torus;
-mod vase;
+mod sampling;
 
 pub use bspline_patch::{BSplinePatch, BSplinePatchError};
-pub use catenoid::Catenoid;
 pub use closest_point::{ClosestPoint, ClosestPointError};
-pub use cylinder::Cylinder;
-pub use dupin_cyclide::DupinCyclide;
-pub use ellipsoid::Ellipsoid;
-pub use enneper::Enneper;
-pub use hyperbolic_paraboloid::HyperbolicParaboloid;
-pub use hyperboloid::Hyperboloid;
+pub use curvature::{Curvature, CurvatureError, CurvatureTolerance, PointType, TangentFrame};
+#[cfg(test)]
+pub(crate) use library::graph_curvatures;
+pub use library::{
+    Catenoid, Cylinder, DupinCyclide, Ellipsoid, Enneper, FREEFORM, FreeformSurface,
+    HyperbolicParaboloid, Hyperboloid, Sphere, SurfaceOfRevolution, Torus, TwistedSurface, Vase,
+};
 pub use mesh_surface::{MeshClosestPoint, MeshSurface, MeshSurfaceError, VertexCurvature};
 pub use registry::{
     ParamSpec, RegistryError, SurfaceSpec, parse_assignment, surface_by_name, surface_catalog,
 };
-pub use sphere::Sphere;
-pub use torus::Torus;
-pub use vase::Vase;
+pub use sampling::sample_surface;
 
-use crate::curvature::{Curvature, CurvatureError};
-use crate::math::{Vec2, Vec3};
+use crate::{Vec2, Vec3};
 
 /// The parameter rectangle of a surface and which directions wrap around.
 ///

@@ -346,7 +346,7 @@ pub fn parse_assignment(s: &str) -> Result<(String, f64), RegistryError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::curvature::{CurvatureTolerance, PointType};
+    use crate::surface::{CurvatureTolerance, PointType};
 
     #[test]
     fn every_catalog_surface_builds_with_defaults_and_is_regular_inside() {
@@ -377,17 +377,17 @@ mod tests {
         let s = surface_by_name("torus", &[("R", 3.0), ("r", 1.0)]).unwrap();
         let (u, v) = (0.4_f64, 1.1_f64);
         let w = 3.0 + v.cos();
-        let want = crate::math::Vec3::new(w * u.cos(), w * u.sin(), v.sin());
+        let want = crate::Vec3::new(w * u.cos(), w * u.sin(), v.sin());
         assert!((s.position(u, v) - want).norm() < 1e-14);
         let s = surface_by_name("hyperboloid", &[("a", 2.0), ("c", 0.5)]).unwrap();
-        let want = crate::math::Vec3::new(
+        let want = crate::Vec3::new(
             2.0 * v.cosh() * u.cos(),
             2.0 * v.cosh() * u.sin(),
             0.5 * v.sinh(),
         );
         assert!((s.position(u, v) - want).norm() < 1e-14);
         let s = surface_by_name("sphere", &[("radius", 2.0)]).unwrap();
-        let want = 2.0 * crate::math::Vec3::new(v.cos() * u.cos(), v.cos() * u.sin(), v.sin());
+        let want = 2.0 * crate::Vec3::new(v.cos() * u.cos(), v.cos() * u.sin(), v.sin());
         assert!((s.position(u, v) - want).norm() < 1e-14);
     }
 

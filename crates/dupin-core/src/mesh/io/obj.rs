@@ -1,7 +1,7 @@
 //! Wavefront OBJ in and out, as the outside contract fixes it: `v` and `f` only, full double
 //! precision, 1-based indices, faces kept at their true size.
 
-use crate::math::Vec3;
+use crate::Vec3;
 use crate::mesh::{MeshError, PolyMesh};
 use std::fmt::Write as _;
 use thiserror::Error;

@@ -1,7 +1,7 @@
 //! The contract's point-set and segment text formats: one `x y` (or `i j`) per line, `#`
 //! comments and blank lines ignored. Parsing only (no filesystem), so the web page can use it.
 
-use crate::math::Vec2;
+use crate::Vec2;
 use thiserror::Error;
 
 /// Why a point or segment file was rejected.

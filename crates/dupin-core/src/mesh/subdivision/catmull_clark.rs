@@ -4,9 +4,9 @@
 //!
 //! Input: a manifold oriented mesh. Output: the refined quad mesh, same orientation.
 
-use crate::math::Vec3;
+use crate::Vec3;
 use crate::mesh::PolyMesh;
-use crate::mesh_topology::{MeshTopology, TopologyError};
+use crate::mesh::{MeshTopology, TopologyError};
 use std::collections::HashMap;
 
 /// One Catmull-Clark step. Vertex `i` of the input keeps index `i` in the output.

@@ -2,7 +2,7 @@
 //! polylines of a PQ strip). Each segment (p, q) yields 3/4 p + 1/4 q and 1/4 p + 3/4 q. Open
 //! polylines keep their end points.
 
-use crate::math::Vec3;
+use crate::Vec3;
 
 /// One Chaikin step on `points`, closed (cyclic) or open.
 pub fn chaikin(points: &[Vec3], closed: bool) -> Vec<Vec3> {

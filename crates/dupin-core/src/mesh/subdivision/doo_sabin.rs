@@ -12,9 +12,9 @@
 //!
 //! Input: a manifold oriented mesh. Output: the refined mesh, same orientation.
 
-use crate::math::Vec3;
+use crate::Vec3;
 use crate::mesh::PolyMesh;
-use crate::mesh_topology::{MeshTopology, TopologyError};
+use crate::mesh::{MeshTopology, TopologyError};
 
 /// One Doo-Sabin step. The first new vertices are indexed by face corner (face-major order),
 /// followed by two Chaikin points per boundary edge (in corner order).

@@ -2,7 +2,7 @@
 //! vertex points (p_{i-1} + 6 p_i + p_{i+1}) / 8 and edge midpoints (p_i + p_{i+1}) / 2
 //! (conical paper, Fig. 8). Open polylines keep their end points.
 
-use crate::math::Vec3;
+use crate::Vec3;
 
 /// One cubic Lane-Riesenfeld step on `points`, closed (cyclic) or open.
 pub fn lane_riesenfeld_cubic(points: &[Vec3], closed: bool) -> Vec<Vec3> {

@@ -5,9 +5,9 @@
 //! equations 2 B(b - a, o - a) = Q(b - a), 2 B(c - a, o - a) = Q(c - a) (the circumcenter in the
 //! "metric" Q). Closed-form 2 x 2 solve, no allocation.
 
-use crate::curvature::{Curvature, PointType};
-use crate::dupin_indicatrix::{DupinConic, DupinIndicatrix, IndicatrixError};
-use crate::math::{Vec2, Vec3};
+use crate::phex::{DupinConic, DupinIndicatrix, IndicatrixError};
+use crate::surface::{Curvature, PointType};
+use crate::{Vec2, Vec3};
 use thiserror::Error;
 
 /// Why a Dupin center does not exist.
@@ -184,8 +184,8 @@ mod tests {
 
     #[test]
     fn section_6_approximation_tends_to_the_tangent_dual_point() {
+        use crate::phex::tangent_dual_point;
         use crate::surface::{Surface, Torus};
-        use crate::tangent_duality::tangent_dual_point;
         let t = Torus {
             major: 2.0,
             minor: 0.7,

@@ -11,9 +11,9 @@
 //! center at (A + B + 4C)/6 is |CM| = sqrt(3)|AD| (as for K > 0), which the tests verify.
 //! Any apex on the line beyond DE gives a valid triangle star (Propositions 4 and 5).
 
-use crate::curvature::{Curvature, PointType};
-use crate::dupin_indicatrix::{DupinIndicatrix, IndicatrixError};
-use crate::math::{Vec2, Vec3};
+use crate::phex::{DupinIndicatrix, IndicatrixError};
+use crate::surface::{Curvature, PointType};
+use crate::{Vec2, Vec3};
 use thiserror::Error;
 
 /// Why no ideal triangle exists on this base.
@@ -186,9 +186,9 @@ fn cross(a: &Vec2, b: &Vec2) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dupin_center::dupin_center;
-    use crate::polygon::is_simple_polygon;
-    use crate::triangle_star::TriangleStar;
+    use crate::mesh::is_simple_polygon;
+    use crate::phex::TriangleStar;
+    use crate::phex::dupin_center;
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 

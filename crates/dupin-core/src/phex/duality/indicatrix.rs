@@ -5,8 +5,8 @@
 //! x along `dir1`, y along `dir2`. There the indicatrix is `k1 x^2 + k2 y^2 = +-1`; its
 //! quadratic form `Q(x, y) = k1 x^2 + k2 y^2` is the second fundamental form.
 
-use crate::curvature::{Curvature, CurvatureTolerance, PointType};
-use crate::math::{Vec2, Vec3};
+use crate::surface::{Curvature, CurvatureTolerance, PointType};
+use crate::{Vec2, Vec3};
 use thiserror::Error;
 
 /// Why an indicatrix operation has no answer.

@@ -2,7 +2,7 @@
 //! Fig. 6), with a condition estimate that tells when the construction breaks down (nearly
 //! parallel planes: vertices too close or curvature too small).
 
-use crate::math::Vec3;
+use crate::Vec3;
 use nalgebra::Matrix3;
 use thiserror::Error;
 

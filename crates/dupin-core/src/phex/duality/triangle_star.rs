@@ -7,11 +7,11 @@
 //! (center, ring_i, ring_(i+1)). The Dupin hexagon joins the Dupin centers of the six triangles
 //! in order; the star is valid when that hexagon is simple.
 
-use crate::curvature::PointType;
-use crate::dupin_center::{DupinCenterError, dupin_conic_through};
-use crate::dupin_indicatrix::{DupinConic, DupinIndicatrix};
-use crate::math::Vec2;
-use crate::polygon::{is_simple_polygon, strictly_inside_triangle};
+use crate::Vec2;
+use crate::mesh::{is_simple_polygon, strictly_inside_triangle};
+use crate::phex::{DupinCenterError, dupin_conic_through};
+use crate::phex::{DupinConic, DupinIndicatrix};
+use crate::surface::PointType;
 use std::f64::consts::{FRAC_PI_2, PI};
 use thiserror::Error;
 

@@ -12,17 +12,16 @@
 //! defined up to sign, so each step is oriented against the previous one, which no ODE crate
 //! does for us).
 
-use super::PhexError;
-use super::triangulation::{
-    LayerRule, Triangulation, TriangulationSpec, bounded_ratio, ideal_ratio,
-};
-use crate::{Surface, Vec2, Vec3};
+use super::layers::{LayerRule, Triangulation, TriangulationSpec, bounded_ratio, ideal_ratio};
+use crate::phex::PhexError;
+use crate::surface::Surface;
+use crate::{Vec2, Vec3};
 
 /// The two conjugate direction fields of method 2 on a surface.
 pub struct ConjugateFields<'a> {
     surface: &'a dyn Surface,
     angle: f64,
-    dom: crate::Domain,
+    dom: crate::surface::Domain,
 }
 
 impl<'a> ConjugateFields<'a> {
@@ -490,7 +489,7 @@ pub fn triangulate_along_fields(
     Ok(t)
 }
 
-fn pos(s: &dyn Surface, dom: &crate::Domain, p: Vec2) -> Vec3 {
+fn pos(s: &dyn Surface, dom: &crate::surface::Domain, p: Vec2) -> Vec3 {
     let (u, v) = dom.normalize(p.x, p.y);
     s.position(u, v)
 }
@@ -520,7 +519,7 @@ fn hit(
 /// Points of the polyline `line` every `size` of 3D length (the last one at its end).
 fn resample(
     s: &dyn Surface,
-    dom: &crate::Domain,
+    dom: &crate::surface::Domain,
     line: &[Vec2],
     size: f64,
 ) -> Result<Vec<Vec2>, PhexError> {
@@ -556,7 +555,8 @@ fn resample(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{PhexConfig, TriangulationMethod, phex_run, surface_by_name};
+    use crate::phex::{PhexConfig, TriangulationMethod, phex_run};
+    use crate::surface::surface_by_name;
 
     /// (surface, params, across range, angle in degrees, size) of the field-angle cases.
     type Case = (&'static str, Vec<(String, f64)>, (f64, f64), f64, f64);
@@ -636,7 +636,7 @@ mod tests {
     fn field_angle_runs_meet_the_acceptance_thresholds() {
         for c in cases() {
             let r = phex_run(config(&c)).unwrap_or_else(|e| panic!("{}: {e}", c.0));
-            let bad = crate::phex::scenes::acceptance_for_tests(&r.report);
+            let bad = crate::scenes::acceptance_for_tests(&r.report);
             eprintln!("{}: {} faces, {bad:?}", c.0, r.report.faces);
             assert!(r.report.faces > 500, "{}", c.0);
             assert!(bad.is_empty(), "{}: {bad:?}", c.0);

@@ -10,8 +10,10 @@
 //! principal curvature lines) and only chooses the next base line so that the new points sit at
 //! the ideal height, i.e. above the line DE of section 5.1.
 
-use super::PhexError;
-use crate::{Surface, Vec2, Vec3, ideal_apex_3d};
+use crate::phex::PhexError;
+use crate::phex::ideal_apex_3d;
+use crate::surface::Surface;
+use crate::{Vec2, Vec3};
 
 /// Above this |CM|/|AB| the ideal triangle is taken as degenerate (the base is nearly along a
 /// parabolic direction) and the previous step is re-used (section 5.3).
@@ -37,6 +39,9 @@ pub enum TriangulationMethod {
     /// Method 2: pre-specified conjugation along the parameter lines (conjugate directions).
     Prescribed,
 }
+
+/// The section 5.3 lower bound b of the scenes and of a configuration for a library surface.
+pub const DEFAULT_BOUND: f64 = 0.3;
 
 /// How the layer height |CM| is chosen for each layer.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -165,7 +170,7 @@ pub fn triangulate(s: &dyn Surface, spec: &TriangulationSpec) -> Result<Triangul
 struct Builder<'a> {
     s: &'a dyn Surface,
     spec: &'a TriangulationSpec,
-    dom: crate::Domain,
+    dom: crate::surface::Domain,
     t: Triangulation,
     closed: bool,
     periodic_across: bool,
@@ -481,7 +486,7 @@ impl<'a> Builder<'a> {
     }
 }
 
-fn period_along(dom: &crate::Domain, swap: bool) -> f64 {
+fn period_along(dom: &crate::surface::Domain, swap: bool) -> f64 {
     if swap {
         dom.v.1 - dom.v.0
     } else {
@@ -489,7 +494,7 @@ fn period_along(dom: &crate::Domain, swap: bool) -> f64 {
     }
 }
 
-fn period_across(dom: &crate::Domain, swap: bool) -> f64 {
+fn period_across(dom: &crate::surface::Domain, swap: bool) -> f64 {
     if swap {
         dom.u.1 - dom.u.0
     } else {
@@ -674,7 +679,8 @@ fn plan_closed_steps(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{PhexConfig, phex_run, surface_by_name};
+    use crate::phex::{PhexConfig, phex_run};
+    use crate::surface::surface_by_name;
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
@@ -762,9 +768,9 @@ mod tests {
         // Section 5.3 on the vase (method 2, bottom up): the middle parabolic circle v = 1.5
         // runs along the layers and lies midway in the one layer that crosses it.
         for (radius, amplitude) in [(1.0, 0.2), (1.0, 0.3), (1.0, 0.35), (0.8, 0.3), (1.3, 0.5)] {
-            let mut c = crate::phex_scene("vase-bottom-up").unwrap().config;
+            let mut c = crate::scenes::phex_scene("vase-bottom-up").unwrap().config;
             c.params = vec![("radius".into(), radius), ("amplitude".into(), amplitude)];
-            let p = crate::PhexPipeline::new(c).unwrap();
+            let p = crate::phex::PhexPipeline::new(c).unwrap();
             let t = p.triangulation();
             let v: Vec<f64> = t.layers.iter().map(|l| t.uv[l[0] as usize].y).collect();
             let j = v
@@ -809,7 +815,7 @@ mod tests {
                     cfg.across = across;
                 }
                 let res = phex_run(cfg).unwrap_or_else(|e| panic!("{name} {params:?}: {e}"));
-                let bad = crate::phex::scenes::acceptance_for_tests(&res.report);
+                let bad = crate::scenes::acceptance_for_tests(&res.report);
                 assert!(bad.is_empty(), "{name} {params:?}: {bad:?}");
             }
         }

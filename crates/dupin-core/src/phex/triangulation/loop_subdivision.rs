@@ -5,8 +5,8 @@
 //! projected onto the ellipsoid so that distances and normals are those of an analytic convex
 //! surface.
 
-use super::PhexError;
-use super::triangulation::Triangulation;
+use super::layers::Triangulation;
+use crate::phex::PhexError;
 use crate::{Vec2, Vec3};
 use std::collections::HashMap;
 

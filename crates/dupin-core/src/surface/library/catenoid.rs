@@ -1,8 +1,8 @@
 //! Catenoid, the minimal surface of revolution (P-Hex paper, Fig. 21 left: minimal surfaces,
 //! K < 0 everywhere, H = 0).
 
-use super::{Domain, Surface, SurfaceDerivatives, revolution_derivatives};
 use crate::surface::RegistryError;
+use crate::surface::{Domain, Surface, SurfaceDerivatives, revolution_derivatives};
 use std::f64::consts::TAU;
 
 /// Catenoid (c cosh(v/c) cos u, c cosh(v/c) sin u, v), u in [0, 2 pi) periodic,

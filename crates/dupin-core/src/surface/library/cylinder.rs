@@ -1,8 +1,8 @@
 //! Circular cylinder, a developable surface (P-Hex paper, section 3 last paragraph and
 //! section 5.3: K = 0 everywhere, Dupin conics degenerate to pairs of lines).
 
-use super::{Domain, Surface, SurfaceDerivatives, revolution_derivatives};
 use crate::surface::RegistryError;
+use crate::surface::{Domain, Surface, SurfaceDerivatives, revolution_derivatives};
 use std::f64::consts::TAU;
 
 /// Cylinder (r cos u, r sin u, v), u in [0, 2 pi) periodic, v in [0, height].
@@ -45,8 +45,8 @@ impl Surface for Cylinder {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::curvature::{CurvatureTolerance, PointType};
     use crate::surface::test_support::*;
+    use crate::surface::{CurvatureTolerance, PointType};
 
     #[test]
     fn derivatives_and_curvature() {

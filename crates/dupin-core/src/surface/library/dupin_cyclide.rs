@@ -1,8 +1,8 @@
 //! Ring Dupin cyclide (P-Hex paper, Figs. 1 and 15: both signs of K, curvature lines are circles).
 
-use super::{Domain, Surface, SurfaceDerivatives};
-use crate::math::Vec3;
+use crate::Vec3;
 use crate::surface::RegistryError;
+use crate::surface::{Domain, Surface, SurfaceDerivatives};
 use std::f64::consts::TAU;
 
 /// Ring Dupin cyclide in the standard form with focal ellipse x^2/a^2 + y^2/b^2 = 1 and focal

@@ -1,8 +1,8 @@
 //! Triaxial ellipsoid (an elliptic surface everywhere; P-Hex paper, section 4.2, K > 0).
 
-use super::{Domain, Surface, SurfaceDerivatives};
-use crate::math::Vec3;
+use crate::Vec3;
 use crate::surface::RegistryError;
+use crate::surface::{Domain, Surface, SurfaceDerivatives};
 use std::f64::consts::{FRAC_PI_2, TAU};
 
 /// Ellipsoid (a cos v cos u, b cos v sin u, c sin v), u in [0, 2 pi) periodic, v in

@@ -1,8 +1,8 @@
 //! Enneper's minimal surface (P-Hex paper, Fig. 21 left: minimal surfaces, K < 0, H = 0).
 
-use super::{Domain, Surface, SurfaceDerivatives};
-use crate::math::Vec3;
+use crate::Vec3;
 use crate::surface::RegistryError;
+use crate::surface::{Domain, Surface, SurfaceDerivatives};
 
 /// Enneper surface s (u - u^3/3 + u v^2, v - v^3/3 + v u^2, u^2 - v^2) over
 /// [-extent, extent]^2. Principal curvatures +-2 / (s (1 + u^2 + v^2)^2).

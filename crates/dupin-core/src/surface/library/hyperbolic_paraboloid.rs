@@ -1,9 +1,9 @@
 //! Hyperbolic paraboloid z = x^2 / (2a) - y^2 / (2b) (a saddle: K < 0 everywhere; P-Hex paper,
 //! section 4.2, Proposition 5).
 
-use super::{Domain, Surface, SurfaceDerivatives};
-use crate::math::Vec3;
+use crate::Vec3;
 use crate::surface::RegistryError;
+use crate::surface::{Domain, Surface, SurfaceDerivatives};
 
 /// Graph P(u, v) = (u, v, u^2 / (2a) - v^2 / (2b)) over [-size, size]^2. `a` and `b` are the
 /// radii of curvature at the apex (k1 = 1/a, k2 = -1/b there, normal pointing up).

@@ -1,8 +1,8 @@
 //! One-sheet hyperboloid of revolution, parametrised as in the outside contract (P-Hex paper,
 //! Fig. 11: K < 0 everywhere).
 
-use super::{Domain, Surface, SurfaceDerivatives, revolution_derivatives};
 use crate::surface::RegistryError;
+use crate::surface::{Domain, Surface, SurfaceDerivatives, revolution_derivatives};
 use std::f64::consts::TAU;
 
 /// Hyperboloid (a cosh v cos u, a cosh v sin u, c sinh v), u in [0, 2 pi) periodic,

@@ -1,6 +1,6 @@
 //! Sphere, parametrised as in the outside contract (P-Hex paper, section 7, Fig. 20).
 
-use super::{Domain, Surface, SurfaceDerivatives, revolution_derivatives};
+use crate::surface::{Domain, Surface, SurfaceDerivatives, revolution_derivatives};
 use std::f64::consts::{FRAC_PI_2, TAU};
 
 /// Sphere r (cos v cos u, cos v sin u, sin v), u in [0, 2 pi) periodic, v in [-pi/2, pi/2].

@@ -1,7 +1,7 @@
 //! Torus of revolution, parametrised as in the outside contract.
 
-use super::{Domain, Surface, SurfaceDerivatives};
-use crate::math::Vec3;
+use crate::Vec3;
+use crate::surface::{Domain, Surface, SurfaceDerivatives};
 use std::f64::consts::TAU;
 
 /// Torus ((R + r cos v) cos u, (R + r cos v) sin u, r sin v), u, v in [0, 2 pi), both periodic.

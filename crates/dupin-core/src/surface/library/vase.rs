@@ -1,8 +1,8 @@
 //! A vase: surface of revolution whose profile has an inflection, so it carries a parabolic
 //! circle (P-Hex paper, section 5.3, Figs. 17 left and 18).
 
-use super::{Domain, Surface, SurfaceDerivatives, revolution_derivatives};
 use crate::surface::RegistryError;
+use crate::surface::{Domain, Surface, SurfaceDerivatives, revolution_derivatives};
 use std::f64::consts::{PI, TAU};
 
 /// Vase (rho(v) cos u, rho(v) sin u, v) with rho(v) = radius + amplitude sin(2 pi v / height),
@@ -73,8 +73,8 @@ impl Surface for Vase {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::curvature::{CurvatureTolerance, PointType};
     use crate::surface::test_support::*;
+    use crate::surface::{CurvatureTolerance, PointType};
 
     #[test]
     fn derivatives_curvature_and_parabolic_circle() {

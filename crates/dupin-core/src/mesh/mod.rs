@@ -1,0 +1,33 @@
+//! Polygon meshes and what every algorithm needs of them: the [`PolyMesh`] store, halfedge
+//! topology, the contract's planarity measure (one least-squares plane for the whole crate),
+//! simple-polygon tests, vertex picking, render buffers, the text formats ([`io`]) and the
+//! surface subdivision rules.
+//!
+//! | concept | file |
+//! |---|---|
+//! | compact polygon mesh | `polymesh.rs` |
+//! | halfedges, manifold and orientation checks | `topology.rs` |
+//! | least-squares plane, `max_planarity` (contract) | `planarity.rs` |
+//! | simple polygons, exact predicates (P-Hex sec. 4.2) | `polygon.rs` |
+//! | vertex under a ray, triangle star of a vertex (P-Hex sec. 4.1) | `picking.rs` |
+//! | triangle buffers for renderers | `render_buffers.rs` |
+//! | OBJ, point sets, segments | `io/` |
+//! | Catmull-Clark, Doo-Sabin, Chaikin, Lane-Riesenfeld (conical paper, sec. 3) | `subdivision/` |
+
+mod io;
+mod picking;
+mod planarity;
+mod polygon;
+mod polymesh;
+mod render_buffers;
+mod subdivision;
+mod topology;
+
+pub use io::{ObjError, PointSetError, parse_obj, parse_points, parse_segments, write_obj};
+pub use picking::{VertexPick, VertexStarError, pick_vertex, vertex_ring};
+pub use planarity::{face_planarity, max_planarity};
+pub use polygon::{PolygonError, is_simple_polygon, segments_intersect, strictly_inside_triangle};
+pub use polymesh::{MeshError, PolyMesh};
+pub use render_buffers::{TriangleBuffers, polymesh_buffers, polymesh_edges};
+pub use subdivision::{catmull_clark, chaikin, doo_sabin, lane_riesenfeld_cubic};
+pub use topology::{MeshTopology, TopologyError};

@@ -1,0 +1,128 @@
+//! Test and benchmark meshes for PQ perturbation: a skew quad grid on z = xy, a regular torus
+//! quad mesh, a noisy vase and the centroid dual of a regular torus triangulation.
+
+use crate::Vec3;
+use crate::conical::principal_quad_mesh;
+use crate::mesh::PolyMesh;
+use crate::surface::{Surface, SurfaceOfRevolution, Torus};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// A quad grid of `n x n` quads over \[-1, 1\]², rotated by `rotation_deg` about the z axis
+/// and lifted to the saddle z = xy. The grid lines are neither principal nor asymptotic
+/// directions of the surface, so the quads are far from planar.
+pub fn skew_quad_grid(n: usize, rotation_deg: f64) -> PolyMesh {
+    let n = n.max(1);
+    let (s, c) = rotation_deg.to_radians().sin_cos();
+    let mut p = Vec::with_capacity((n + 1) * (n + 1));
+    for j in 0..=n {
+        for i in 0..=n {
+            let a = -1.0 + 2.0 * i as f64 / n as f64;
+            let b = -1.0 + 2.0 * j as f64 / n as f64;
+            let (x, y) = (c * a - s * b, s * a + c * b);
+            p.push(Vec3::new(x, y, x * y));
+        }
+    }
+    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+    let faces: Vec<[u32; 4]> = (0..n)
+        .flat_map(|j| (0..n).map(move |i| [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]))
+        .collect();
+    PolyMesh::new(p, faces).expect("grid indices are valid")
+}
+
+/// The `nu x nv` quad mesh of a torus's parameter lines (R = `major`, r = `minor`; its
+/// principal curvature lines, so the quads are planar up to O(h^2)): vertex `i * nv + j` at
+/// (u, v) = 2π (i / nu, j / nv), quads oriented along the outward normal.
+pub fn torus_quad_mesh(nu: usize, nv: usize, major: f64, minor: f64) -> PolyMesh {
+    let (nu, nv) = (nu.max(3), nv.max(3));
+    let torus = Torus { major, minor };
+    let (du, dv) = (
+        std::f64::consts::TAU / nu as f64,
+        std::f64::consts::TAU / nv as f64,
+    );
+    let p: Vec<Vec3> = (0..nu)
+        .flat_map(|i| (0..nv).map(move |j| (i, j)))
+        .map(|(i, j)| torus.position(i as f64 * du, j as f64 * dv))
+        .collect();
+    let faces: Vec<[u32; 4]> = (0..nu)
+        .flat_map(|i| {
+            (0..nv).map(move |j| {
+                let (i1, j1) = ((i + 1) % nu, (j + 1) % nv);
+                [i * nv + j, i1 * nv + j, i1 * nv + j1, i * nv + j1].map(|k| k as u32)
+            })
+        })
+        .collect();
+    PolyMesh::new(p, faces).expect("grid indices are valid")
+}
+
+/// The principal `n x n` quad mesh of the vase (its profile over (0, 6), angles (-0.9, 0.9))
+/// with seeded noise of 2% of the grid spacing on every coordinate: a conical start far from
+/// conical, the PQ benchmarks' harder case.
+pub fn noisy_vase(n: usize) -> PolyMesh {
+    let mut m = principal_quad_mesh(&SurfaceOfRevolution::vase(), (0.0, 6.0), (-0.9, 0.9), n, n);
+    let h = 6.0 / n as f64;
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    for p in &mut m.positions {
+        for k in 0..3 {
+            p[k] += 0.02 * h * (rng.random::<f64>() * 2.0 - 1.0);
+        }
+    }
+    m
+}
+
+/// The centroid dual of the regular triangulation of a torus (R = `major`, r = `minor`) with
+/// `nu x nv` vertices (each parameter quad split along the same diagonal, all valences 6):
+/// one vertex per triangle at its centroid, one hexagon per torus vertex. `nu * nv` hexagons,
+/// oriented along the outward normal.
+pub fn torus_centroid_dual(nu: usize, nv: usize, major: f64, minor: f64) -> PolyMesh {
+    let (nu, nv) = (nu.max(3), nv.max(3));
+    let torus = Torus { major, minor };
+    let du = std::f64::consts::TAU / nu as f64;
+    let dv = std::f64::consts::TAU / nv as f64;
+    let vert = |i: usize, j: usize| torus.position((i % nu) as f64 * du, (j % nv) as f64 * dv);
+    // Triangle (i, j, 0) = (i,j),(i+1,j),(i+1,j+1); (i, j, 1) = (i,j),(i+1,j+1),(i,j+1).
+    let mut p = Vec::with_capacity(2 * nu * nv);
+    for j in 0..nv {
+        for i in 0..nu {
+            p.push((vert(i, j) + vert(i + 1, j) + vert(i + 1, j + 1)) / 3.0);
+            p.push((vert(i, j) + vert(i + 1, j + 1) + vert(i, j + 1)) / 3.0);
+        }
+    }
+    let tri = |i: usize, j: usize, k: usize| (2 * ((j % nv) * nu + (i % nu)) + k) as u32;
+    let mut faces = Vec::with_capacity(nu * nv);
+    for j in 0..nv {
+        for i in 0..nu {
+            let (im, jm) = (i + nu - 1, j + nv - 1);
+            faces.push([
+                tri(i, j, 0),
+                tri(i, j, 1),
+                tri(im, j, 0),
+                tri(im, jm, 1),
+                tri(im, jm, 0),
+                tri(i, jm, 1),
+            ]);
+        }
+    }
+    PolyMesh::new(p, faces).expect("dual indices are valid")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::MeshTopology;
+
+    #[test]
+    fn torus_quad_mesh_is_closed_and_faces_outward() {
+        let m = torus_quad_mesh(12, 8, 2.0, 0.7);
+        assert_eq!((m.num_vertices(), m.num_faces()), (96, 96));
+        let topo = MeshTopology::new(&m).unwrap();
+        assert!((0..m.num_vertices()).all(|v| !topo.is_boundary(v)));
+        for f in 0..m.num_faces() {
+            let v: Vec<Vec3> = m.face(f).iter().map(|&i| m.positions[i as usize]).collect();
+            let n = (v[2] - v[0]).cross(&(v[3] - v[1]));
+            let c = (v[0] + v[1] + v[2] + v[3]) / 4.0;
+            let axis = Vec3::new(c.x, c.y, 0.0).normalize() * 2.0;
+            assert!(n.dot(&(c - axis)) > 0.0, "face {f} points inward");
+        }
+    }
+}
