@@ -25,7 +25,7 @@ mod topology;
 
 pub use io::{ObjError, PointSetError, parse_obj, parse_points, parse_segments, write_obj};
 pub use picking::{VertexPick, VertexStarError, pick_vertex, vertex_ring};
-pub use planarity::{face_planarity, max_planarity};
+pub use planarity::{face_planarity, least_squares_plane, max_planarity};
 pub use polygon::{PolygonError, is_simple_polygon, segments_intersect, strictly_inside_triangle};
 pub use polymesh::{MeshError, PolyMesh};
 pub use render_buffers::{TriangleBuffers, polymesh_buffers, polymesh_edges};

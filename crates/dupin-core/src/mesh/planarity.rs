@@ -13,18 +13,29 @@ pub fn face_planarity(mesh: &PolyMesh, i: usize) -> f64 {
     let f = mesh.face(i);
     let n = f.len();
     let p = |k: usize| mesh.positions[f[k] as usize];
-    let c = (0..n).map(p).sum::<Vec3>() / n as f64;
-    let mut cov = Matrix3::zeros();
-    for k in 0..n {
-        let d = p(k) - c;
-        cov += d * d.transpose();
-    }
-    let normal = least_squares_normal(&cov);
+    let (c, normal) = least_squares_plane((0..n).map(p));
     let dmax = (0..n)
         .map(|k| (p(k) - c).dot(&normal).abs())
         .fold(0.0, f64::max);
     let e = mesh.face_mean_edge(i);
     if e > 0.0 { dmax / e } else { 0.0 }
+}
+
+/// The least-squares plane of `points` (at least one): its point, the centroid, and its unit
+/// normal (sign arbitrary), the eigenvector of the smallest eigenvalue of the points'
+/// covariance matrix ([`least_squares_normal`]). The one plane fit of the crate: the contract's
+/// `max_planarity`, panel flattening and the PQ solver's start all use it.
+pub fn least_squares_plane(points: impl Iterator<Item = Vec3> + Clone) -> (Vec3, Vec3) {
+    let (sum, n) = points
+        .clone()
+        .fold((Vec3::zeros(), 0usize), |(s, n), p| (s + p, n + 1));
+    let c = sum / n as f64;
+    let mut cov = Matrix3::zeros();
+    for p in points {
+        let d = p - c;
+        cov += d * d.transpose();
+    }
+    (c, least_squares_normal(&cov))
 }
 
 /// Unit eigenvector of the smallest eigenvalue of a symmetric positive semi-definite 3 x 3
