@@ -30,6 +30,25 @@ impl CliError {
     }
 }
 
+/// Refuses a path that cannot become an output file: a directory, or a file in a folder that
+/// does not exist.
+pub fn check_writable(path: &Path) -> Result<(), CliError> {
+    let shown = path.display();
+    if path.is_dir() {
+        return Err(CliError::Input(format!(
+            "{shown} is a directory; give a file name to write"
+        )));
+    }
+    let parent = path.parent().filter(|p| !p.as_os_str().is_empty());
+    if let Some(dir) = parent.filter(|d| !d.is_dir()) {
+        return Err(CliError::Input(format!(
+            "{shown}: folder {} does not exist",
+            dir.display()
+        )));
+    }
+    Ok(())
+}
+
 /// Reads a whole text file.
 #[allow(dead_code)]
 pub fn read_text(path: &Path) -> Result<String, CliError> {

@@ -2,7 +2,7 @@
 //!
 //! Exit code 0 on success; 2 on bad input with one line on stderr starting `error:`.
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::process::ExitCode;
 
 mod common;
@@ -48,23 +48,80 @@ fn run(cli: Cli) -> Result<(), common::CliError> {
     }
 }
 
+/// The command line with the settings every subcommand shares: negative numbers are values
+/// (`--size -1` is a bad size, not an unknown flag).
+fn command() -> clap::Command {
+    let mut cmd = Cli::command();
+    let names: Vec<String> = cmd
+        .get_subcommands()
+        .map(|c| c.get_name().to_string())
+        .collect();
+    for name in names {
+        cmd = cmd.mut_subcommand(name, |c| c.allow_negative_numbers(true));
+    }
+    cmd
+}
+
+/// Refuses output paths that cannot be written before any work is done, so that a bad
+/// `--report` does not leave a fresh `--out` behind it.
+fn check_outputs(matches: &clap::ArgMatches) -> Result<(), common::CliError> {
+    let Some((_, sub)) = matches.subcommand() else {
+        return Ok(());
+    };
+    for id in ["out", "report", "support"] {
+        if let Some(path) = sub.try_get_one::<std::path::PathBuf>(id).ok().flatten() {
+            common::check_writable(path)?;
+        }
+    }
+    Ok(())
+}
+
+/// clap's message on one line: its first line, with the lines that name what is missing or
+/// wrong appended (`error: the following required arguments were not provided: --out <OUT>`).
+fn one_line(e: &clap::Error) -> String {
+    let msg = e.to_string();
+    let mut lines = msg
+        .lines()
+        .map(str::trim)
+        .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
+        .filter(|l| !l.is_empty());
+    let first = lines.next().unwrap_or("error: bad arguments").to_string();
+    lines.fold(first, |acc, l| format!("{acc} {l}"))
+}
+
 fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
-        Ok(cli) => cli,
+    let matches = match command().try_get_matches() {
+        Ok(m) => m,
         Err(e) => {
             use clap::error::ErrorKind;
-            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
-                let _ = e.print();
-                return ExitCode::SUCCESS;
+            match e.kind() {
+                ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+                    let _ = e.print();
+                    return ExitCode::SUCCESS;
+                }
+                ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+                    let names: Vec<String> = command()
+                        .get_subcommands()
+                        .map(|c| c.get_name().to_string())
+                        .collect();
+                    eprintln!(
+                        "error: no command given; use one of {} (dupin --help)",
+                        names.join(", ")
+                    );
+                }
+                _ => eprintln!("{}", one_line(&e)),
             }
-            // clap's message already starts with `error:`; keep it to one line.
-            let msg = e.to_string();
-            let first = msg.lines().next().unwrap_or("error: bad arguments");
-            eprintln!("{first}");
             return ExitCode::from(2);
         }
     };
-    match run(cli) {
+    let cli = match Cli::from_arg_matches(&matches) {
+        Ok(cli) => cli,
+        Err(e) => {
+            eprintln!("{}", one_line(&e));
+            return ExitCode::from(2);
+        }
+    };
+    match check_outputs(&matches).and_then(|()| run(cli)) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {}", e.to_string().replace('\n', " "));

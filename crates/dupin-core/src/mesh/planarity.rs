@@ -30,9 +30,18 @@ pub fn least_squares_plane(points: impl Iterator<Item = Vec3> + Clone) -> (Vec3,
         .clone()
         .fold((Vec3::zeros(), 0usize), |(s, n), p| (s + p, n + 1));
     let c = sum / n as f64;
+    // The covariance of a face of size 1e-160 underflows, of size 1e160 overflows: scale the
+    // offsets to about 1 first, by a power of two so that the scaling is exact and ordinary
+    // faces get the same bits as unscaled sums.
+    let size = points.clone().map(|p| (p - c).amax()).fold(0.0, f64::max);
+    let scale = if size > 0.0 && size.is_finite() {
+        2f64.powi((-size.log2().floor() as i32).clamp(-1000, 1000))
+    } else {
+        1.0
+    };
     let mut cov = Matrix3::zeros();
     for p in points {
-        let d = p - c;
+        let d = (p - c) * scale;
         cov += d * d.transpose();
     }
     (c, least_squares_normal(&cov))
@@ -168,5 +177,32 @@ mod tests {
         let edge = (2.0 + 2.0 * (1.0f64 + 0.01).sqrt()) / 4.0;
         let got = max_planarity(&m);
         assert!(got > 0.02 && got < 0.03, "{got} vs edge {edge}");
+    }
+
+    /// The measure is scale free from 1e-160 to 1e150 and at offsets of state-plane
+    /// coordinates: the same bent quad gives the same figure to 1e-12 relative.
+    #[test]
+    fn planarity_is_scale_and_offset_free() {
+        let base = [
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.1),
+            Vec3::new(0.0, 1.1, 0.0),
+        ];
+        let at = |scale: f64, offset: Vec3| {
+            let p: Vec<Vec3> = base.iter().map(|q| q * scale + offset).collect();
+            max_planarity(&PolyMesh::new(p, [[0u32, 1, 2, 3]]).unwrap())
+        };
+        let want = at(1.0, Vec3::zeros());
+        for scale in [1e-160, 1e-6, 1e6, 1e150] {
+            let got = at(scale, Vec3::zeros());
+            assert!(
+                (got / want - 1.0).abs() < 1e-12,
+                "scale {scale}: {got} vs {want}"
+            );
+        }
+        // A 1 m panel 1e7 m from the origin keeps the figure to the rounding of its coordinates.
+        let got = at(1.0, Vec3::new(1e7, -3e6, 2e5));
+        assert!((got / want - 1.0).abs() < 1e-7, "offset: {got} vs {want}");
     }
 }

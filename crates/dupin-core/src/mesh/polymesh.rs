@@ -130,7 +130,8 @@ impl PolyMesh {
         h
     }
 
-    /// Length of the diagonal of the axis-aligned bounding box (0 for an empty mesh).
+    /// Length of the diagonal of the axis-aligned bounding box (0 for an empty mesh), finite for
+    /// any finite coordinates.
     pub fn bbox_diagonal(&self) -> f64 {
         let mut lo = Vec3::repeat(f64::INFINITY);
         let mut hi = Vec3::repeat(f64::NEG_INFINITY);
@@ -139,10 +140,9 @@ impl PolyMesh {
             hi = hi.sup(p);
         }
         if self.positions.is_empty() {
-            0.0
-        } else {
-            (hi - lo).norm()
+            return 0.0;
         }
+        robust_norm(hi - lo)
     }
 
     /// Mean length of the edges of face `i`.
@@ -151,10 +151,25 @@ impl PolyMesh {
         let n = f.len();
         (0..n)
             .map(|k| {
-                (self.positions[f[(k + 1) % n] as usize] - self.positions[f[k] as usize]).norm()
+                robust_norm(self.positions[f[(k + 1) % n] as usize] - self.positions[f[k] as usize])
             })
             .sum::<f64>()
             / n as f64
+    }
+}
+
+/// The length of `d`, also where its squared components overflow (past 1e154) or lose digits
+/// to subnormals (below 1e-154); the same bits as `d.norm()` in between.
+pub(crate) fn robust_norm(d: Vec3) -> f64 {
+    let n = d.norm();
+    if n.is_finite() && n > 1e-150 {
+        return n;
+    }
+    let s = d.amax();
+    if s > 0.0 && s.is_finite() {
+        s * (d / s).norm()
+    } else {
+        n
     }
 }
 

@@ -12,10 +12,16 @@ use thiserror::Error;
 const NONE: u32 = u32::MAX;
 
 /// Why a mesh is not an oriented 2-manifold (with boundary) the optimisers can work on.
+///
+/// Messages number vertices and faces from 1, as OBJ files do; the fields are 0-based.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum TopologyError {
     /// An edge is shared by more than two faces.
-    #[error("edge ({a}, {b}) is shared by more than two faces (non-manifold)")]
+    #[error(
+        "the edge between vertices {} and {} is shared by more than two faces (non-manifold)",
+        .a + 1,
+        .b + 1
+    )]
     NonManifoldEdge {
         /// One endpoint (0-based vertex index).
         a: usize,
@@ -23,7 +29,12 @@ pub enum TopologyError {
         b: usize,
     },
     /// Two faces traverse a shared edge in the same direction.
-    #[error("faces around edge ({a}, {b}) are inconsistently oriented")]
+    #[error(
+        "the faces on both sides of the edge from vertex {} to {} are inconsistently oriented \
+         (one of them lists its vertices the other way round)",
+        .a + 1,
+        .b + 1
+    )]
     InconsistentOrientation {
         /// Start of the edge traversed twice in the same direction.
         a: usize,
@@ -31,19 +42,35 @@ pub enum TopologyError {
         b: usize,
     },
     /// The faces around a vertex do not form one fan (e.g. two cones touching at a vertex).
-    #[error("vertex {vertex} is non-manifold: its faces do not form a single fan")]
+    #[error("vertex {} is non-manifold: its faces do not form a single fan", .vertex + 1)]
     NonManifoldVertex {
         /// The vertex (0-based).
         vertex: usize,
     },
+    /// Two faces list the same vertices in the same cyclic order.
+    #[error("face {} repeats face {} (the same vertices in the same order)", .face + 1, .first + 1)]
+    DuplicateFace {
+        /// The later face (0-based).
+        face: usize,
+        /// The earlier face it repeats.
+        first: usize,
+    },
     /// An edge has (numerically) zero length.
-    #[error("edge ({a}, {b}) has zero length")]
+    #[error("the edge between vertices {} and {} has zero length", .a + 1, .b + 1)]
     ZeroLengthEdge {
         /// One endpoint.
         a: usize,
         /// The other endpoint.
         b: usize,
     },
+}
+
+/// Whether two faces list the same vertices in the same cyclic order.
+fn same_cycle(f: &[u32], g: &[u32]) -> bool {
+    f.len() == g.len()
+        && g.iter()
+            .position(|&v| v == f[0])
+            .is_some_and(|s| (0..f.len()).all(|k| f[k] == g[(s + k) % g.len()]))
 }
 
 /// Halfedge adjacency of a polygon mesh; build with [`MeshTopology::new`].
@@ -105,7 +132,17 @@ impl MeshTopology {
                     b: a.max(b) as usize,
                 });
             }
-            if directed.insert((a, b), c).is_some() {
+            if let Some(other) = directed.insert((a, b), c) {
+                let (f, g) = (
+                    topo.corner_face[c as usize],
+                    topo.corner_face[other as usize],
+                );
+                if same_cycle(mesh.face(f as usize), mesh.face(g as usize)) {
+                    return Err(TopologyError::DuplicateFace {
+                        face: f.max(g) as usize,
+                        first: f.min(g) as usize,
+                    });
+                }
                 return Err(TopologyError::InconsistentOrientation {
                     a: a as usize,
                     b: b as usize,
@@ -333,5 +370,32 @@ mod tests {
             MeshTopology::new(&bowtie),
             Err(TopologyError::NonManifoldVertex { vertex: 0 })
         ));
+    }
+
+    /// Messages count from 1 as OBJ files do, a repeated face is named as such, and edges of
+    /// huge meshes are not taken for zero-length ones.
+    #[test]
+    fn messages_name_faces_and_vertices_from_one() {
+        let p = vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        ];
+        let twice = PolyMesh::new(p.clone(), [[0u32, 1, 2], [1, 2, 0]]).unwrap();
+        let e = MeshTopology::new(&twice).unwrap_err();
+        assert_eq!(e, TopologyError::DuplicateFace { face: 1, first: 0 });
+        assert_eq!(
+            e.to_string(),
+            "face 2 repeats face 1 (the same vertices in the same order)"
+        );
+        let zero = PolyMesh::new(vec![p[0], p[0], p[2]], [[0u32, 1, 2]]).unwrap();
+        assert_eq!(
+            MeshTopology::new(&zero).unwrap_err().to_string(),
+            "the edge between vertices 1 and 2 has zero length"
+        );
+        let huge: Vec<Vec3> = p.iter().map(|q| q * 1e155).collect();
+        let m = PolyMesh::new(huge, [[0u32, 1, 2]]).unwrap();
+        assert!((m.bbox_diagonal() / (1e155 * 2f64.sqrt()) - 1.0).abs() < 1e-15);
+        assert!(MeshTopology::new(&m).is_ok());
     }
 }

@@ -26,11 +26,16 @@ pub enum ObjError {
 }
 
 /// Parses an OBJ: `v x y z`, `f i j k ...` (with or without `/vt/vn` parts, negative indices
-/// relative to the end), `#` comments; `o`, `g`, `s`, `vt`, `vn`, `usemtl`, `mtllib` ignored.
+/// relative to the end), `#` comments; `v x y z r g b` (vertex colours dropped); `o`, `g`, `s`,
+/// `vt`, `vn`, `vp`, `usemtl`, `mtllib`
+/// and `l` lines ignored. Line ends may be LF, CRLF or CR alone, and a UTF-8 byte-order mark is
+/// skipped. Errors name the 1-based line and quote the offending text with control characters
+/// escaped.
 pub fn parse_obj(text: &str) -> Result<PolyMesh, ObjError> {
     let mut positions = Vec::new();
     let mut faces: Vec<Vec<u32>> = Vec::new();
-    for (ln, raw) in text.lines().enumerate() {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    for (ln, raw) in lines_any_end(text).enumerate() {
         let line = ln + 1;
         let content = raw.split('#').next().unwrap_or("").trim();
         let mut it = content.split_whitespace();
@@ -38,6 +43,7 @@ pub fn parse_obj(text: &str) -> Result<PolyMesh, ObjError> {
         let err = |message: String| ObjError::Syntax { line, message };
         match tag {
             "v" => {
+                // Only x y z: exporters append an optional w or r g b colour.
                 let mut c = [0.0; 3];
                 for (k, slot) in c.iter_mut().enumerate() {
                     let tok = it
@@ -45,9 +51,9 @@ pub fn parse_obj(text: &str) -> Result<PolyMesh, ObjError> {
                         .ok_or_else(|| err(format!("vertex needs 3 coordinates, found {k}")))?;
                     *slot = tok
                         .parse::<f64>()
-                        .map_err(|_| err(format!("`{tok}` is not a number")))?;
+                        .map_err(|_| err(format!("{} is not a number", quoted(tok))))?;
                     if !slot.is_finite() {
-                        return Err(err(format!("coordinate `{tok}` is not finite")));
+                        return Err(err(format!("coordinate {} is not finite", quoted(tok))));
                     }
                 }
                 positions.push(Vec3::new(c[0], c[1], c[2]));
@@ -58,7 +64,7 @@ pub fn parse_obj(text: &str) -> Result<PolyMesh, ObjError> {
                     let first = tok.split('/').next().unwrap_or("");
                     let i: i64 = first
                         .parse()
-                        .map_err(|_| err(format!("`{tok}` is not a vertex index")))?;
+                        .map_err(|_| err(format!("{} is not a vertex index", quoted(tok))))?;
                     let n = positions.len() as i64;
                     let idx = if i > 0 {
                         i - 1
@@ -72,6 +78,9 @@ pub fn parse_obj(text: &str) -> Result<PolyMesh, ObjError> {
                             "vertex index {i} is out of range: {n} vertices defined so far"
                         )));
                     }
+                    if f.contains(&(idx as u32)) {
+                        return Err(err(format!("the face repeats vertex {}", idx + 1)));
+                    }
                     f.push(idx as u32);
                 }
                 if f.len() < 3 {
@@ -83,7 +92,7 @@ pub fn parse_obj(text: &str) -> Result<PolyMesh, ObjError> {
                 faces.push(f);
             }
             "vt" | "vn" | "vp" | "o" | "g" | "s" | "usemtl" | "mtllib" | "l" => {}
-            other => return Err(err(format!("unknown statement `{other}`"))),
+            other => return Err(err(format!("unknown statement {}", quoted(other)))),
         }
     }
     if positions.is_empty() {
@@ -93,6 +102,22 @@ pub fn parse_obj(text: &str) -> Result<PolyMesh, ObjError> {
         return Err(ObjError::Empty("faces"));
     }
     Ok(PolyMesh::new(positions, faces)?)
+}
+
+/// The lines of `text` whatever their ends: LF, CRLF or CR alone (old Mac exporters).
+pub(crate) fn lines_any_end(text: &str) -> impl Iterator<Item = &str> {
+    text.split('\n')
+        .flat_map(|l| l.strip_suffix('\r').unwrap_or(l).split('\r'))
+}
+
+/// `text` in backquotes for a message, shortened to 40 characters, control characters and
+/// other invisible ones escaped (a binary file must not write raw bytes to a terminal).
+pub(crate) fn quoted(text: &str) -> String {
+    let mut s: String = text.chars().take(40).flat_map(char::escape_debug).collect();
+    if text.chars().count() > 40 {
+        s.push_str("...");
+    }
+    format!("`{s}`")
 }
 
 /// Writes `mesh` as OBJ: `v x y z` with Rust's shortest round-trip formatting (`{:?}`), faces
@@ -138,12 +163,41 @@ mod tests {
             ObjError::Empty("vertices")
         );
         let e = parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 1\n").unwrap_err();
-        assert!(matches!(
-            e,
-            ObjError::Mesh(MeshError::RepeatedVertex { .. })
-        ));
+        assert_eq!(e.to_string(), "line 4: the face repeats vertex 1");
         let e = parse_obj("v 0 0 0\nv 1 0 0\nv nan 1 0\n").unwrap_err();
         assert!(e.to_string().contains("not finite"));
+    }
+
+    /// What exporters write: a byte-order mark, CRLF or CR-only line ends, vertex colours,
+    /// texture and normal references, groups, smoothing and material statements.
+    #[test]
+    fn exporter_dialects_are_read() {
+        let body = "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nvt 0 0\nvn 0 0 1\ns off\n\
+                    usemtl glass\nmtllib a.mtl\ng roof\nl 1 2\nf 1/1/1 2/1/1 3/1/1\n";
+        let want = parse_obj(body).unwrap();
+        assert_eq!(want.num_faces(), 1);
+        assert_eq!(want.positions[1], Vec3::new(1.0, 0.0, 0.0));
+        for text in [
+            format!("\u{feff}{body}"),
+            body.replace('\n', "\r\n"),
+            body.replace('\n', "\r"),
+        ] {
+            assert_eq!(parse_obj(&text).unwrap(), want, "{text:?}");
+        }
+        // A line number counts CR-only ends as line ends.
+        let e = parse_obj("v 0 0 0\rv 1 0 0\rq\r").unwrap_err();
+        assert_eq!(e.to_string(), "line 3: unknown statement `q`");
+    }
+
+    /// Control characters of the input are escaped in messages, and long tokens shortened.
+    #[test]
+    fn messages_escape_what_they_quote() {
+        let e = parse_obj("v 0 0 \u{1b}[31m\n").unwrap_err().to_string();
+        assert_eq!(e, "line 1: `\\u{1b}[31m` is not a number");
+        assert!(!e.chars().any(char::is_control));
+        let long = "x".repeat(100);
+        let e = parse_obj(&format!("{long}\n")).unwrap_err().to_string();
+        assert!(e.ends_with("...`") && e.len() < 80, "{e}");
     }
 
     #[test]

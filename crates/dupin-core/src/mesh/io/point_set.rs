@@ -8,7 +8,7 @@ use thiserror::Error;
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum PointSetError {
     /// A line does not hold exactly two numbers of the expected kind.
-    #[error("line {line}: expected {expected}, found `{text}`")]
+    #[error("line {line}: expected {expected}, found {text}")]
     Malformed {
         /// Line number (1-based).
         line: usize,
@@ -26,17 +26,20 @@ pub enum PointSetError {
 }
 
 fn fields(text: &str) -> impl Iterator<Item = (usize, &str)> {
-    text.lines().enumerate().filter_map(|(i, l)| {
-        let l = l.split('#').next().unwrap_or("").trim();
-        (!l.is_empty()).then_some((i + 1, l))
-    })
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    super::obj::lines_any_end(text)
+        .enumerate()
+        .filter_map(|(i, l)| {
+            let l = l.split('#').next().unwrap_or("").trim();
+            (!l.is_empty()).then_some((i + 1, l))
+        })
 }
 
 fn malformed(line: usize, expected: &'static str, l: &str) -> PointSetError {
     PointSetError::Malformed {
         line,
         expected,
-        text: l.chars().take(80).collect(),
+        text: super::obj::quoted(l),
     }
 }
 

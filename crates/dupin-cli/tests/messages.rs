@@ -1,0 +1,108 @@
+//! What a user sees when a command line or an input file is wrong: exit code 2 and one stderr
+//! line starting `error:` that names the problem, with nothing written.
+
+mod common;
+use common::{dupin, tmp};
+
+/// Runs `dupin args`, asserts exit 2 with exactly one `error:` line, and returns that line.
+fn refused(args: &[&str]) -> String {
+    let o = dupin(args);
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+    assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+    assert!(err.starts_with("error: "), "{args:?}: {err}");
+    err.trim_end().to_string()
+}
+
+#[test]
+fn no_command_names_the_commands() {
+    let e = refused(&[]);
+    assert!(e.contains("no command given") && e.contains("phex"), "{e}");
+}
+
+#[test]
+fn a_missing_argument_is_named() {
+    let e = refused(&["planarize", "--input", "x.obj"]);
+    assert!(e.contains("--out"), "{e}");
+}
+
+#[test]
+fn negative_numbers_are_values_not_flags() {
+    let out = tmp("neg.obj");
+    let out = out.to_str().unwrap();
+    let e = refused(&["phex", "--surface", "sphere", "--size", "-1", "--out", out]);
+    assert!(e.contains("size -1"), "{e}");
+}
+
+/// A report path that cannot be written is refused before the computation, so no OBJ is left.
+#[test]
+fn unwritable_outputs_are_refused_before_any_work() {
+    let out = tmp("report-dir.obj");
+    let dir = std::env::temp_dir();
+    let e = refused(&[
+        "pq",
+        "--scene",
+        "pq-catmull-clark",
+        "--out",
+        out.to_str().unwrap(),
+        "--report",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(e.contains("is a directory"), "{e}");
+    assert!(!out.exists(), "the OBJ was written anyway");
+    let missing = tmp("no-such-folder").join("x.obj");
+    let e = refused(&[
+        "pq",
+        "--scene",
+        "pq-catmull-clark",
+        "--out",
+        missing.to_str().unwrap(),
+    ]);
+    assert!(e.contains("does not exist"), "{e}");
+}
+
+/// OBJ problems are named by their 1-based line, vertex and face numbers; control characters of
+/// the file are escaped; files with a byte-order mark or CR-only line ends are read.
+#[test]
+fn obj_messages_name_lines_and_escape_the_input() {
+    let input = tmp("msg-in.obj");
+    let out = tmp("msg-out.obj");
+    let run = |text: &str| {
+        std::fs::write(&input, text).unwrap();
+        let args = [
+            "planarize",
+            "--input",
+            input.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        let o = dupin(&args);
+        let _ = std::fs::remove_file(&out);
+        o
+    };
+    let quad = "v 0 0 0\nv 1 0 0\nv 1 1 0.1\nv 0 1 0\nf 1 2 3 4\n";
+    for text in [format!("\u{feff}{quad}"), quad.replace('\n', "\r")] {
+        let o = run(&text);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let cases = [
+        (format!("{quad}f 1 2 3 4\n"), "face 2 repeats face 1"),
+        (
+            "v 0 0 0\nv 0 0 0\nv 0 1 0\nf 1 2 3\n".to_string(),
+            "vertices 1 and 2 has zero length",
+        ),
+        (
+            format!("{quad}f 1 2 1\n"),
+            "line 6: the face repeats vertex 1",
+        ),
+        ("v 0 0 \u{7}x\n".to_string(), "`\\u{7}x` is not a number"),
+    ];
+    for (text, want) in cases {
+        let o = run(&text);
+        let e = String::from_utf8_lossy(&o.stderr).to_string();
+        assert_eq!(o.status.code(), Some(2), "{e}");
+        assert!(e.contains(want), "{text:?}: {e}");
+        assert!(!e.trim_end().chars().any(char::is_control), "{e:?}");
+    }
+    let _ = std::fs::remove_file(&input);
+}
