@@ -106,3 +106,34 @@ fn obj_messages_name_lines_and_escape_the_input() {
     }
     let _ = std::fs::remove_file(&input);
 }
+
+/// An offset distance far beyond the mesh's size is refused with the limit, not reported as a
+/// perfect offset of planarity 0 (its numbers would overflow).
+#[test]
+fn huge_offset_distances_are_refused_with_the_limit() {
+    let mesh = tmp("station.obj");
+    let out = tmp("station-offset.obj");
+    let o = dupin(&[
+        "pq",
+        "--scene",
+        "conical-station",
+        "--out",
+        mesh.to_str().unwrap(),
+    ]);
+    assert!(o.status.success());
+    for d in ["1e300", "-1e6"] {
+        let e = refused(&[
+            "offset",
+            "--input",
+            mesh.to_str().unwrap(),
+            "--distance",
+            d,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(e.contains("times the mesh's size"), "{e}");
+        assert!(e.len() < 300, "{e}");
+        assert!(!out.exists());
+    }
+    let _ = std::fs::remove_file(&mesh);
+}

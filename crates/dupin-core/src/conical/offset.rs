@@ -7,6 +7,7 @@
 
 use crate::Vec3;
 use crate::conical::{cone_axes, face_normals};
+use crate::math::Num;
 use crate::mesh::PolyMesh;
 use crate::mesh::{MeshTopology, TopologyError};
 use thiserror::Error;
@@ -18,12 +19,30 @@ pub enum OffsetError {
     #[error(transparent)]
     Topology(#[from] TopologyError),
     /// The distance is NaN or infinite.
-    #[error("offset distance {0} is not finite")]
+    #[error("offset distance {} is not finite", Num(*.0))]
     BadDistance(f64),
+    /// The distance is so large against the mesh that the offset would lose the design's
+    /// precision (and, near f64::MAX, overflow to nothing).
+    #[error(
+        "offset distance {} is more than {} times the mesh's size (bounding-box diagonal {}); \
+         use a distance within +-{}",
+        Num(*.distance), MAX_OFFSET_TO_SIZE, Num(*.size), Num(MAX_OFFSET_TO_SIZE * *.size)
+    )]
+    DistanceTooLarge {
+        /// The distance asked for.
+        distance: f64,
+        /// The mesh's bounding-box diagonal.
+        size: f64,
+    },
     /// A face has no normal (all vertices collinear).
     #[error("face {0} is degenerate (no normal)")]
     DegenerateFace(usize),
 }
+
+/// The largest offset distance, in bounding-box diagonals of the mesh: far beyond any beam or
+/// glazing depth, and near the limit where the offset planes' intersections keep the input's
+/// precision (each step of 10x costs a digit).
+pub const MAX_OFFSET_TO_SIZE: f64 = 1e3;
 
 /// The face-offset mesh at distance `distance` (positive along the face normals).
 ///
@@ -38,6 +57,10 @@ pub enum OffsetError {
 pub fn offset_mesh(mesh: &PolyMesh, distance: f64) -> Result<PolyMesh, OffsetError> {
     if !distance.is_finite() {
         return Err(OffsetError::BadDistance(distance));
+    }
+    let size = mesh.bbox_diagonal();
+    if distance.abs() > MAX_OFFSET_TO_SIZE * size {
+        return Err(OffsetError::DistanceTooLarge { distance, size });
     }
     let topo = MeshTopology::new(mesh)?;
     let normals = face_normals(mesh);
