@@ -14,7 +14,7 @@
 //! | OBJ, point sets, segments | `io/` |
 //! | Catmull-Clark, Doo-Sabin, Chaikin, Lane-Riesenfeld (conical paper, sec. 3) | `subdivision/` |
 
-mod io;
+pub mod io;
 mod picking;
 mod planarity;
 mod polygon;
