@@ -15,7 +15,7 @@ mod point_set;
 mod stl;
 
 pub use gltf::read_gltf;
-use obj::quoted;
+pub(crate) use obj::quoted;
 pub use obj::{ObjError, parse_obj, write_obj};
 pub use point_set::{PointSetError, parse_points, parse_segments};
 pub use stl::read_stl;
