@@ -25,6 +25,10 @@ pub enum OffsetError {
     DegenerateFace(usize),
 }
 
+/// Face distance of the offset a viewer shows when none is given: visible but thin against
+/// the conical scenes, which are about 5 units across (conical paper, section 4).
+pub const DEFAULT_OFFSET_DISTANCE: f64 = 0.15;
+
 /// The face-offset mesh at distance `distance` (positive along the face normals).
 ///
 /// Interior valence-4 vertices move along their cone axis ([`crate::conical::cone_axes`]) by

@@ -46,7 +46,9 @@ mod stepper;
 
 pub use error::HexDelaunayError;
 pub use min_enclosing_circle::{Circle, min_enclosing_circle};
-pub use quality::{TriangulationQuality, triangulation_quality};
+pub use quality::{
+    TriangulationQuality, angle_histogram, triangle_angles_deg, triangulation_quality,
+};
 pub use stepper::{HexCell, HexDelaunayStepper};
 
 use crate::mesh::PolyMesh;
@@ -60,6 +62,29 @@ pub enum HexDelaunayMode {
     Simple,
     /// Section 5: angles in [43.9°, 90°] (Ω with inradius 3ρ instead of 1.5ρ).
     Extended,
+}
+
+impl HexDelaunayMode {
+    /// Both modes, the default ([`HexDelaunayMode::Simple`]) first.
+    pub const ALL: [HexDelaunayMode; 2] = [HexDelaunayMode::Simple, HexDelaunayMode::Extended];
+
+    /// The mode's name: `simple` or `extended`.
+    pub fn name(self) -> &'static str {
+        match self {
+            HexDelaunayMode::Simple => "simple",
+            HexDelaunayMode::Extended => "extended",
+        }
+    }
+
+    /// The interior angle bounds (degrees, min and max) the mode guarantees away from input
+    /// segments: [30, 120] for the simple refinement (section 4), [43.9, 90] for the extended
+    /// one (section 5).
+    pub fn angle_bounds_deg(self) -> [f64; 2] {
+        match self {
+            HexDelaunayMode::Simple => [30.0, 120.0],
+            HexDelaunayMode::Extended => [43.9, 90.0],
+        }
+    }
 }
 
 /// The result of [`hex_delaunay`].
