@@ -14,7 +14,7 @@
 //! full hexagons, whose centres stay on Ω's edges) never need refining below the size the
 //! points' spacing requires.
 //!
-//! Data structure (the O(n log n) requirement): split hexagons are kept per level in
+//! Data structure (O(n log n) in the number of points): split hexagons are kept per level in
 //! 16×16 tiles of lattice coordinates (a hash map of 256-bit sets), points are re-checked from
 //! a work queue only when a nearby hexagon changes, and the dual is extracted by a recursion
 //! over the lattice triangles that costs O(1) per output triangle. See `hierarchy.rs`, `simple_refinement.rs`, `dual.rs`.
