@@ -4,15 +4,21 @@
 // figures, the offset and support layers (conical scenes), camera and backend.
 export const FREE = 'free';
 
+// Names, defaults and bounds come from Rust (`pageSchema()`, lists start with the default),
+// handed over once the wasm module has loaded.
+let SCHEMA = null;
+export function useSchema(s) { SCHEMA = s; }
+export const schema = () => SCHEMA;
+
 export function defaults() {
   return {
     scene: 'torus',
     params: {},
-    free: { surface: 'torus', method: 'progressive', init: 'tangent-duality', size: null, bound: null, lambda: null, mu: null },
+    free: { surface: 'torus', method: SCHEMA.methods[0].name, init: SCHEMA.initialisations[0].name, size: null, bound: null, lambda: null, mu: null },
     steps: 1,
-    color: 'planarity',
+    color: SCHEMA.colorModes[0],
     panelEdge: 1.5,
-    layers: { offset: false, support: false, distance: 0.15 },
+    layers: { offset: false, support: false, distance: SCHEMA.offsetDistance },
     camera: null,
     backend: 'auto',
   };
@@ -33,13 +39,13 @@ export function readHash(hash, { scenes, catalog, torusParams }) {
     const surface = catalog.find((s) => s.name === h.get('surface')) ?? catalog.find((s) => s.name === 'torus') ?? catalog[0];
     c.free.surface = surface.name;
     for (const p of surface.params) c.params[p.key] = h.has(`p.${p.key}`) ? num(h.get(`p.${p.key}`)) : p.default;
-    if (h.get('method') === 'prescribed') c.free.method = 'prescribed';
-    if (h.get('init') === 'dupin-duality') c.free.init = 'dupin-duality';
+    if (SCHEMA.methods.some((m) => m.name === h.get('method'))) c.free.method = h.get('method');
+    if (SCHEMA.initialisations.some((m) => m.name === h.get('init'))) c.free.init = h.get('init');
     for (const k of ['size', 'bound', 'lambda', 'mu']) if (h.has(k)) c.free[k] = num(h.get(k));
   }
   const steps = Number(h.get('steps'));
   if (Number.isInteger(steps) && steps >= 1 && steps <= 100000) c.steps = steps;
-  if (['planarity', 'convexity', 'regularity'].includes(h.get('color'))) c.color = h.get('color');
+  if (SCHEMA.colorModes.includes(h.get('color'))) c.color = h.get('color');
   const edge = Number(h.get('edge'));
   if (h.has('edge') && Number.isFinite(edge) && edge > 0) c.panelEdge = edge;
   c.layers.offset = h.get('offset') === '1';
@@ -53,21 +59,22 @@ export function readHash(hash, { scenes, catalog, torusParams }) {
 }
 
 export function writeHash(c) {
+  const d = defaults();
   const h = new URLSearchParams({ scene: c.scene });
   if (c.scene === 'torus') for (const [k, v] of Object.entries(c.params)) h.set(k, String(v));
   if (c.scene === FREE) {
     h.set('surface', c.free.surface);
     for (const [k, v] of Object.entries(c.params)) h.set(`p.${k}`, String(v));
     h.set('method', c.free.method);
-    if (c.free.init !== 'tangent-duality') h.set('init', c.free.init);
+    if (c.free.init !== d.free.init) h.set('init', c.free.init);
     for (const k of ['size', 'bound', 'lambda', 'mu']) if (c.free[k] !== null) h.set(k, String(c.free[k]));
   }
   if (c.scene !== 'torus') h.set('steps', String(c.steps));
-  if (c.color !== 'planarity') h.set('color', c.color);
+  if (c.color !== d.color) h.set('color', c.color);
   if (c.panelEdge !== 1.5) h.set('edge', String(c.panelEdge));
   if (c.layers.offset) h.set('offset', '1');
   if (c.layers.support) h.set('support', '1');
-  if (c.layers.distance !== 0.15) h.set('dist', String(c.layers.distance));
+  if (c.layers.distance !== d.layers.distance) h.set('dist', String(c.layers.distance));
   if (c.camera) h.set('cam', c.camera.map(String).join(','));
   if (c.backend !== 'auto') h.set('backend', c.backend);
   return '#' + h.toString();

@@ -1,7 +1,7 @@
 // Configuration controls: the scene picker and the parameter fields (torus preview, or the free
 // mode's surface, parameters with slider + numeric field, method, size, b, lambda, mu). Every
 // field has an inline message slot; `showFieldError` puts the core's error text there.
-import { FREE } from './config.js';
+import { FREE, schema } from './config.js';
 
 const el = (tag, props = {}, ...children) => {
   const e = Object.assign(document.createElement(tag), props);
@@ -92,12 +92,12 @@ export function buildFields(box, c, { catalog, torusParams, defaults, onChange }
   }, 'free-surface', true));
   const method = el('select');
   method.dataset.testid = 'free-method';
-  method.append(new Option('progressive', 'progressive'), new Option('prescribed', 'prescribed'));
+  method.append(...schema().methods.map((m) => new Option(m.label, m.name)));
   method.value = c.free.method;
   method.addEventListener('change', () => onChange((n) => { n.free.method = method.value; }, 'free-method'));
   const init = el('select', { title: 'hexagon initialisation: tangent duality (sec. 4.1, starts planar) or Dupin duality (sec. 6, the optimisation makes it planar)' });
   init.dataset.testid = 'free-init';
-  init.append(new Option('tangent duality', 'tangent-duality'), new Option('Dupin duality', 'dupin-duality'));
+  init.append(...schema().initialisations.map((m) => new Option(m.label, m.name)));
   init.value = c.free.init;
   init.addEventListener('change', () => onChange((n) => { n.free.init = init.value; }, 'free-init'));
   const labelled = (text, e) => el('label', { className: 'field' }, el('span', { className: 'field-label', textContent: text }), e);

@@ -1,7 +1,7 @@
 // 2D tab: hexagonal Delaunay triangulation (Sußner & Greiner) step by step. The refinement, the
 // cells, the dual triangulation and its angle histogram all come from wasm (`HexDelaunayLab`);
 // this file handles clicks and drags and draws into 2D canvases.
-import { HexDelaunayLab } from './pkg/dupin_web.js';
+import { HexDelaunayLab, pageSchema } from './pkg/dupin_web.js';
 
 const VIEW = 3.2; // half-height of the shown world square
 
@@ -13,6 +13,7 @@ let cells = null;
 let dual = null;
 let inputError = null;
 let panel, canvas, hist, statusEl, modeSel, toolSel, stepBtn, runBtn;
+let modes = [];      // [{ name, angleBounds: [min, max] }] from pageSchema, simple then extended
 
 const el = (tag, attrs = {}, text) => {
   const e = document.createElement(tag);
@@ -118,8 +119,10 @@ function drawHistogram() {
       g.fillRect(x(i * dual.binDeg), h - 16 - bh, Math.max(1, x(dual.binDeg) - x(0) - 1), bh);
     });
   }
-  const marks = [[43.9, '#5fd39a'], [90, '#5fd39a']];
-  if (modeSel.value === 'simple') marks.push([30, '#ff9e64'], [120, '#ff9e64']);
+  // The tightest bounds (the last mode's) always; the chosen mode's too when they are looser.
+  const tightest = modes[modes.length - 1];
+  const marks = tightest.angleBounds.map((d) => [d, '#5fd39a']);
+  if (modeSel.value !== tightest.name) marks.push(...modes.find((m) => m.name === modeSel.value).angleBounds.map((d) => [d, '#ff9e64']));
   g.font = '10px system-ui';
   for (const [deg, col] of marks) {
     g.strokeStyle = col; g.fillStyle = col;
@@ -190,7 +193,9 @@ export function initHexd2d() {
   hist = el('canvas', { 'data-testid': 'hexd-histogram', width: '300', height: '120', 'aria-label': 'Angle histogram' });
   statusEl = el('p', { 'data-testid': 'hexd-status', role: 'status', class: 'hexd-status' });
   modeSel = el('select', { 'data-testid': 'hexd-mode', 'aria-label': 'Refinement mode' });
-  modeSel.append(new Option('simple (30°–120°)', 'simple'), new Option('extended (43.9°–90°)', 'extended'));
+  modes = pageSchema().hexDelaunayModes;
+  modeSel.append(...modes.map((m) => new Option(`${m.name} (${m.angleBounds[0]}°–${m.angleBounds[1]}°)`, m.name)));
+  const bounds = (m) => `[${m.angleBounds[0]}°, ${m.angleBounds[1]}°]`;
   toolSel = el('select', { 'data-testid': 'hexd-tool', 'aria-label': 'Tool' });
   toolSel.append(new Option('points', 'points'), new Option('segments', 'segments'));
   stepBtn = el('button', { type: 'button', 'data-testid': 'hexd-step' }, 'Step');
@@ -200,7 +205,7 @@ export function initHexd2d() {
   const bar = el('div', { class: 'hexd-controls' });
   bar.append(modeSel, toolSel, stepBtn, runBtn, clear);
   const side = el('div', { class: 'hexd-side' });
-  const note = el('p', { class: 'hint' }, 'Hexagon cells (blue) are split one refinement step at a time; white: the dual triangulation. The histogram counts its angles; the simple refinement keeps them in [30°, 120°] (section 4), the extended one in [43.9°, 90°] (section 5).');
+  const note = el('p', { class: 'hint' }, `Hexagon cells (blue) are split one refinement step at a time; white: the dual triangulation. The histogram counts its angles; the ${modes[0].name} refinement keeps them in ${bounds(modes[0])} (section 4), the ${modes[1].name} one in ${bounds(modes[1])} (section 5).`);
   side.append(bar, statusEl, hist, note);
   panel.append(canvas, side);
   document.querySelector('main').append(panel);

@@ -3,8 +3,8 @@
 // DOM events, the URL hash and the frame loop; the pieces are small modules:
 //   config.js (configuration <-> hash), controls.js (picker and fields), metrics.js (panel,
 //   histogram, legend), solver.js (worker client). Other tabs plug in through `window.dupin`.
-import init, { MeshData, Viewer, colorLegend, freeDefaults, sceneNames, surfaceCatalog, torusMesh } from './pkg/dupin_web.js';
-import { FREE, defaults, readHash, sessionConfig, writeHash } from './config.js';
+import init, { MeshData, Viewer, colorLegend, freeDefaults, pageSchema, sceneNames, surfaceCatalog, torusMesh } from './pkg/dupin_web.js';
+import { FREE, defaults, readHash, sessionConfig, useSchema, writeHash } from './config.js';
 import { buildFields, clearFieldErrors, fillScenePicker, showFieldError } from './controls.js';
 import { drawHistogram, drawLegend, showMetrics } from './metrics.js';
 import { Solver } from './solver.js';
@@ -18,12 +18,12 @@ const metricsEl = $('metrics');
 const canvas = $('canvas');
 const fieldsBox = document.getElementById('params');
 
-const TORUS = { R: { label: 'R', value: 2 }, r: { label: 'r', value: 0.7 } };
+let TORUS = null;         // the torus preview's parameters { key: { label, value } } (pageSchema)
 
 let viewer = null;
 let solver = null;
 let mesh = null;          // MeshData on screen
-let config = defaults();  // what is on screen (last configuration that loaded)
+let config = null;        // what is on screen (last configuration that loaded; defaults once loaded)
 let running = false;      // a stepped scene or free configuration is loaded in the worker
 let playing = false;
 let done = true;
@@ -456,6 +456,10 @@ function restore(hash) {
 async function main() {
   try {
     await init();
+    const schema = pageSchema();
+    useSchema(schema);
+    TORUS = Object.fromEntries(schema.torus.map((p) => [p.key, { label: p.key, value: p.default }]));
+    config = defaults();
     ctx = { scenes: sceneNames(), catalog: surfaceCatalog(), defaults: freeDefaults() };
     solver = new Solver({ onState, onError, onExport, onPick });
     const backend = readHash(location.hash, { scenes: ctx.scenes, catalog: ctx.catalog, torusParams: TORUS }).backend;

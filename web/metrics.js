@@ -12,7 +12,7 @@ const mm = (rel, edge) => `${(rel * edge * 1000).toPrecision(3)} mm`;
 
 // Both writers below touch only what changed since the last call (cached per element): a step
 // changes a few numbers, and rebuilding ~50 nodes per worker message cost style, layout and
-// paint on a page thread that shares two cores with the worker and SwiftShader (issue 7).
+// paint on a page thread that shares two cores with the worker and SwiftShader.
 const panels = new WeakMap(); // dl -> { keys, dds }
 const charts = new WeakMap(); // svg -> { shape, bars: [{ rect, title, c, h }] }
 

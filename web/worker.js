@@ -12,7 +12,7 @@ import init, { Session } from './pkg/dupin_web.js';
 let session = null;
 let gen = 0;
 let steps = 0;
-let mode = 'planarity';
+let mode = null; // colour mode; null: Session.mesh's default
 let playing = false;
 let lastMetrics = null;
 let layers = null; // the page's offset/support settings, applied where the run has an offset

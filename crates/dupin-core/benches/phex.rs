@@ -1,4 +1,4 @@
-//! P-Hex pipeline benchmarks (issue 4): triangulation, initialisation (dual hexagons),
+//! P-Hex pipeline benchmarks: triangulation, initialisation (dual hexagons),
 //! optimisation and the whole pipeline for about 1k, 10k and 50k faces on the torus-bound
 //! scene (ideal triangulation with the parabolic bound, both regions of K).
 
@@ -129,7 +129,7 @@ fn bench(c: &mut Criterion) {
 
 /// Optimisation from the Dupin-duality start of the page's free-mode torus (method 2, no
 /// parabolic bound), as in `profile_10k` of dupin-web: the run where a planarity-raising CG step
-/// used to switch the optimiser to Cholesky factorisations (issue 4).
+/// used to switch the optimiser to Cholesky factorisations.
 fn bench_dupin_start(
     g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
     label: &str,

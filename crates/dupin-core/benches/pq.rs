@@ -1,4 +1,4 @@
-//! PQ perturbation benchmarks (issue: speed targets of the conical paper).
+//! PQ perturbation benchmarks: the speeds the conical paper reports are the yardstick.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use dupin_core::conical::{

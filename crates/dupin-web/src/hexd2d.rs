@@ -8,7 +8,10 @@
 //! triangles that do not meet a segment). Whatever the core refuses (crossing segments, bad
 //! points) comes back as the core's error message.
 
-use dupin_core::hex_delaunay::{HexDelaunayMode, HexDelaunayStepper, triangulation_quality};
+use crate::js::err;
+use dupin_core::hex_delaunay::{
+    HexDelaunayMode, HexDelaunayStepper, angle_histogram, triangulation_quality,
+};
 
 use dupin_core::Vec2;
 use serde::Serialize;
@@ -53,13 +56,10 @@ pub struct HexDelaunayLab {
 }
 
 fn mode_of(name: &str) -> Result<HexDelaunayMode, String> {
-    match name {
-        "simple" => Ok(HexDelaunayMode::Simple),
-        "extended" => Ok(HexDelaunayMode::Extended),
-        other => Err(format!(
-            "mode must be `simple` or `extended`, not `{other}`"
-        )),
-    }
+    HexDelaunayMode::ALL
+        .into_iter()
+        .find(|m| m.name() == name)
+        .ok_or_else(|| format!("mode must be `simple` or `extended`, not `{name}`"))
 }
 
 impl HexDelaunayLab {
@@ -109,17 +109,7 @@ impl HexDelaunayLab {
         };
         let t = s.triangulation();
         let q = triangulation_quality(&t.vertices, &t.triangles);
-        let bins = (180.0 / BIN_DEG) as usize;
-        let mut histogram = vec![0u32; bins];
-        for tri in &t.triangles {
-            let v = tri.map(|i| t.vertices[i as usize]);
-            for k in 0..3 {
-                let (a, b, c) = (v[k], v[(k + 1) % 3], v[(k + 2) % 3]);
-                let (u, w) = (b - a, c - a);
-                let deg = u.perp(&w).abs().atan2(u.dot(&w)).to_degrees();
-                histogram[((deg / BIN_DEG) as usize).min(bins - 1)] += 1;
-            }
-        }
+        let histogram = angle_histogram(&t.vertices, &t.triangles, BIN_DEG);
         Dual {
             vertices: t.vertices.iter().flat_map(|p| [p.x, p.y]).collect(),
             triangles: t.triangles.iter().flatten().copied().collect(),
@@ -141,20 +131,20 @@ impl HexDelaunayLab {
     /// `new HexDelaunayLab(mode)`, mode `simple` or `extended`.
     #[wasm_bindgen(constructor)]
     pub fn new(mode: &str) -> Result<HexDelaunayLab, JsError> {
-        HexDelaunayLab::with_mode(mode).map_err(|e| JsError::new(&e))
+        HexDelaunayLab::with_mode(mode).map_err(err)
     }
 
     /// Replaces the input and restarts at the bounding hexagon: `xy` holds x y pairs, `segments`
     /// point-index pairs. Throws the core's message (bad points, crossing segments...).
     #[wasm_bindgen(js_name = setInput)]
     pub fn set_input_js(&mut self, xy: Vec<f64>, segments: Vec<u32>) -> Result<(), JsError> {
-        self.set_input(&xy, &segments).map_err(|e| JsError::new(&e))
+        self.set_input(&xy, &segments).map_err(err)
     }
 
     /// One subdivision step; false once refinement is finished (or there is no input).
     pub fn step(&mut self) -> Result<bool, JsError> {
         match &mut self.stepper {
-            Some(s) => s.step().map_err(|e| JsError::new(&e.to_string())),
+            Some(s) => s.step().map_err(err),
             None => Ok(false),
         }
     }
@@ -171,13 +161,13 @@ impl HexDelaunayLab {
 
     /// `{ corners, sizes, occupied, domain }` of the current hexagon cells.
     pub fn cells(&self) -> Result<JsValue, JsError> {
-        serde_wasm_bindgen::to_value(&self.cells_data()).map_err(|e| JsError::new(&e.to_string()))
+        serde_wasm_bindgen::to_value(&self.cells_data()).map_err(err)
     }
 
     /// `{ vertices, triangles, minAngle, maxAngle, histogram, binDeg, delaunayViolations }` of
     /// the dual triangulation of the current cells.
     pub fn dual(&self) -> Result<JsValue, JsError> {
-        serde_wasm_bindgen::to_value(&self.dual_data()).map_err(|e| JsError::new(&e.to_string()))
+        serde_wasm_bindgen::to_value(&self.dual_data()).map_err(err)
     }
 }
 

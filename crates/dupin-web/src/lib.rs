@@ -6,9 +6,11 @@
 //! Errors cross the boundary as JS `Error`s carrying the Rust message.
 
 mod hexd2d;
+mod js;
 mod mesh_data;
 mod pick;
 mod present;
+mod schema;
 mod session;
 mod teach;
 // The canvas viewer needs wgpu's browser backends, which exist only on wasm32.
@@ -20,6 +22,7 @@ pub use mesh_data::{MeshData, torus_mesh};
 #[cfg(target_arch = "wasm32")]
 pub use present::Presenter;
 pub use present::torus_panels_js;
+pub use schema::page_schema;
 pub use session::{Session, color_legend, free_defaults, scene_names, surface_catalog_js};
 pub use teach::DupinLesson;
 #[cfg(target_arch = "wasm32")]

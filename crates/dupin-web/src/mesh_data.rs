@@ -169,7 +169,7 @@ impl MeshData {
             .map(|p| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
             .collect();
         let mesh = PolyMesh::new(positions, self.buffers.indices.chunks_exact(3))
-            .map_err(|e| JsError::new(&e.to_string()))?;
+            .map_err(crate::js::err)?;
         Ok(write_obj(&mesh))
     }
 }

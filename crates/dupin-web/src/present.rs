@@ -87,7 +87,7 @@ pub(crate) fn torus_panels(panels: u32) -> Result<PolyMesh, String> {
 /// A torus panel mesh of about `panels` quads, for trying presentation mode at scale.
 #[wasm_bindgen(js_name = torusPanels)]
 pub fn torus_panels_js(panels: u32) -> Result<MeshData, JsError> {
-    let m = torus_panels(panels).map_err(|e| JsError::new(&e))?;
+    let m = torus_panels(panels).map_err(crate::js::err)?;
     let colors = vec![[0.9f32, 0.9, 0.9]; m.num_faces()];
     Ok(MeshData::panels(m, &colors))
 }
@@ -164,13 +164,13 @@ mod canvas {
                         .map(|p| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
                         .collect();
                     PolyMesh::new(pos, mesh.buffers.indices.chunks_exact(3))
-                        .map_err(|e| JsError::new(&e.to_string()))?
+                        .map_err(crate::js::err)?
                 }
             };
             let scene = build_scene(&poly, offset);
             self.renderer
                 .set_scene(&self.device, &self.queue, &scene.glass, None, &scene.frames)
-                .map_err(|e| JsError::new(&e.to_string()))?;
+                .map_err(crate::js::err)?;
             let (c, r) = self.renderer.bounds();
             self.camera = OrbitCamera::framing(c, r);
             let info = js_sys::Object::new();

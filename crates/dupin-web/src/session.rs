@@ -1,11 +1,17 @@
 //! `Session`: the contract's step-by-step JS API over the core's P-Hex pipeline and PQ scenes.
 
+use crate::js::{err, to_js};
 use crate::mesh_data::MeshData;
 use dupin_core::conical::{PqMode, PqSceneStepInfo, PqSceneStepper, support_structure};
 use dupin_core::fabrication::{SheetOptions, panel_schedule, panel_schedule_svg};
-use dupin_core::mesh::{PolyMesh, face_planarity, max_planarity, write_obj};
+use dupin_core::mesh::{
+    ColorMode, NOT_HEX, PLANARITY_HIST_HI, PLANARITY_HIST_LO, PLANARITY_LEGEND_LOG10, PolyMesh,
+    REGULARITY_LEGEND, convexity_color, face_planarities, max_planarity, mean_planarity,
+    planarity_color, planarity_histogram, regularity_color, write_obj,
+};
 use dupin_core::phex::{
-    Initialisation, LayerRule, PhexConfig, PhexPipeline, TriangulationMethod, face_info,
+    Initialisation, LayerRule, PhexConfig, PhexPipeline, TriangulationMethod, count_invalid_faces,
+    face_info,
 };
 use dupin_core::scenes::{PHEX_SCENES, PQ_SCENES, phex_scene, pq_scene_stepper};
 use dupin_core::surface::surface_catalog;
@@ -35,6 +41,38 @@ struct SessionConfig {
     init: Option<String>,
 }
 
+/// The free mode's triangulation methods (section 5.2) as (name, label for people, value),
+/// the default first.
+pub(crate) const METHODS: [(&str, &str, TriangulationMethod); 2] = [
+    (
+        "progressive",
+        "progressive",
+        TriangulationMethod::Progressive,
+    ),
+    ("prescribed", "prescribed", TriangulationMethod::Prescribed),
+];
+
+/// The free mode's hexagon initialisations (sections 4.1 and 6) as (name, label for people,
+/// value), the default first.
+pub(crate) const INITIALISATIONS: [(&str, &str, Initialisation); 2] = [
+    (
+        "tangent-duality",
+        "tangent duality",
+        Initialisation::TangentDuality,
+    ),
+    (
+        "dupin-duality",
+        "Dupin duality",
+        Initialisation::DupinDuality,
+    ),
+];
+
+/// The value named `name` in `table`; the first entry when no name is given.
+fn by_name<T: Copy>(table: &[(&str, &str, T)], name: Option<&str>) -> Option<T> {
+    let name = name.unwrap_or(table[0].0);
+    table.iter().find(|(n, ..)| *n == name).map(|&(.., v)| v)
+}
+
 /// The fields of [`SessionConfig`], for [`refuse_unknown_keys`].
 const SESSION_CONFIG_KEYS: &[&str] = &[
     "scene", "surface", "params", "method", "size", "bound", "lambda", "mu", "init",
@@ -59,12 +97,6 @@ fn refuse_unknown_keys(value: &JsValue, what: &str, allowed: &[&str]) -> Result<
         None => Ok(()),
     }
 }
-
-/// Histogram bins of log10(face planarity): `HIST_BINS` bins over [HIST_LO, HIST_HI]; values
-/// below and above land in the first and last bin.
-const HIST_BINS: usize = 14;
-const HIST_LO: f64 = -16.0;
-const HIST_HI: f64 = -2.0;
 
 /// What `step()` and `metrics()` return.
 #[derive(Serialize, Clone)]
@@ -117,9 +149,8 @@ struct LayerConfig {
     distance: Option<f64>,
 }
 
-/// Offset distance when the layers do not give one (the conical station is about 5 units
-/// across).
-const DEFAULT_OFFSET: f64 = 0.15;
+/// Offset distance when the layers do not give one: the core's default for the page.
+pub(crate) const DEFAULT_OFFSET: f64 = dupin_core::conical::DEFAULT_OFFSET_DISTANCE;
 
 /// Offset and support beams of a mesh (conical paper, Sec. 4) and their measures.
 #[derive(Serialize)]
@@ -149,9 +180,10 @@ enum Run {
 pub struct Session {
     run: Run,
     config: SessionConfig,
-    /// Per-face planarity of the current mesh, computed once per step: the metrics and the
-    /// planarity colours of the render buffers both need it (a worker step asks for both).
-    per_face: std::cell::RefCell<Option<Vec<f64>>>,
+    /// Per-face planarity of the current mesh, computed by the first reader after a step and
+    /// cleared by the next step: the metrics and the planarity colours of the render buffers
+    /// both need it (a worker step asks for both).
+    per_face: Option<Vec<f64>>,
     /// Extra layers drawn with the panels (`setLayers`).
     layers: LayerConfig,
 }
@@ -239,8 +271,8 @@ pub fn color_legend(mode: &str) -> Result<JsValue, JsError> {
         label: String,
         color: [f32; 3],
     }
-    let stops: Vec<Stop> = match ColorMode::parse(mode)? {
-        ColorMode::Planarity => [-15.0, -12.0, -8.5, -5.0, -2.0]
+    let stops: Vec<Stop> = match ColorMode::parse(mode).map_err(err)? {
+        ColorMode::Planarity => PLANARITY_LEGEND_LOG10
             .iter()
             .map(|&e| Stop {
                 label: format!("1e{e}"),
@@ -250,19 +282,19 @@ pub fn color_legend(mode: &str) -> Result<JsValue, JsError> {
         ColorMode::Convexity => vec![
             Stop {
                 label: "convex".into(),
-                color: CONVEX,
+                color: convexity_color(true, true),
             },
             Stop {
                 label: "non-convex".into(),
-                color: NONCONVEX,
+                color: convexity_color(true, false),
             },
             Stop {
                 label: "self-intersecting".into(),
-                color: INVALID,
+                color: convexity_color(false, false),
             },
         ],
         ColorMode::Regularity => {
-            let mut v: Vec<Stop> = [0.0, 0.1, 0.2, 0.3, 0.4]
+            let mut v: Vec<Stop> = REGULARITY_LEGEND
                 .iter()
                 .map(|&d| Stop {
                     label: format!("{d:.1}"),
@@ -277,35 +309,6 @@ pub fn color_legend(mode: &str) -> Result<JsValue, JsError> {
         }
     };
     to_js(&stops)
-}
-
-fn to_js<T: Serialize>(v: &T) -> Result<JsValue, JsError> {
-    v.serialize(&serde_wasm_bindgen::Serializer::json_compatible())
-        .map_err(|e| JsError::new(&e.to_string()))
-}
-
-fn err(e: impl std::fmt::Display) -> JsError {
-    JsError::new(&e.to_string())
-}
-
-#[derive(Clone, Copy, PartialEq)]
-enum ColorMode {
-    Planarity,
-    Convexity,
-    Regularity,
-}
-
-impl ColorMode {
-    fn parse(s: &str) -> Result<Self, JsError> {
-        match s {
-            "" | "planarity" => Ok(ColorMode::Planarity),
-            "convexity" => Ok(ColorMode::Convexity),
-            "regularity" => Ok(ColorMode::Regularity),
-            other => Err(JsError::new(&format!(
-                "colour mode must be `planarity`, `convexity` or `regularity`, not `{other}`"
-            ))),
-        }
-    }
 }
 
 #[wasm_bindgen]
@@ -326,15 +329,12 @@ impl Session {
                 Run::Phex(Box::new(PhexPipeline::new(scene.config).map_err(err)?))
             }
             (None, Some(surface)) => {
-                let method = match cfg.method.as_deref().unwrap_or("progressive") {
-                    "progressive" => TriangulationMethod::Progressive,
-                    "prescribed" => TriangulationMethod::Prescribed,
-                    other => {
-                        return Err(JsError::new(&format!(
-                            "method must be `progressive` or `prescribed`, not `{other}`"
-                        )));
-                    }
-                };
+                let method = by_name(&METHODS, cfg.method.as_deref()).ok_or_else(|| {
+                    JsError::new(&format!(
+                        "method must be `progressive` or `prescribed`, not `{}`",
+                        cfg.method.as_deref().unwrap_or_default()
+                    ))
+                })?;
                 let params: Vec<(String, f64)> =
                     cfg.params.iter().map(|(k, v)| (k.clone(), *v)).collect();
                 let mut config = PhexConfig::for_surface(surface, &params, method, cfg.size);
@@ -347,15 +347,13 @@ impl Session {
                 if let Some(m) = cfg.mu {
                     config.mu = m;
                 }
-                config.initialisation = match cfg.init.as_deref().unwrap_or("tangent-duality") {
-                    "tangent-duality" => Initialisation::TangentDuality,
-                    "dupin-duality" => Initialisation::DupinDuality,
-                    other => {
-                        return Err(JsError::new(&format!(
-                            "init must be `tangent-duality` or `dupin-duality`, not `{other}`"
-                        )));
-                    }
-                };
+                config.initialisation =
+                    by_name(&INITIALISATIONS, cfg.init.as_deref()).ok_or_else(|| {
+                        JsError::new(&format!(
+                            "init must be `tangent-duality` or `dupin-duality`, not `{}`",
+                            cfg.init.as_deref().unwrap_or_default()
+                        ))
+                    })?;
                 Run::Phex(Box::new(PhexPipeline::new(config).map_err(err)?))
             }
             _ => {
@@ -367,7 +365,7 @@ impl Session {
         Ok(Session {
             run,
             config: cfg,
-            per_face: Default::default(),
+            per_face: None,
             layers: LayerConfig::default(),
         })
     }
@@ -383,7 +381,7 @@ impl Session {
     /// [`Session::step`] without building the metrics (the worker times the solver and the
     /// metrics separately, then calls `metrics()`).
     pub fn advance(&mut self) -> Result<(), JsError> {
-        self.per_face.replace(None);
+        self.per_face = None;
         match &mut self.run {
             Run::Phex(p) => {
                 if !p.done() {
@@ -411,7 +409,7 @@ impl Session {
 
     /// `{ phase, layer, iteration, faces, vertices, maxPlanarity, meanPlanarity, invalidFaces,
     /// histogram, histLog10 }`.
-    pub fn metrics(&self) -> Result<JsValue, JsError> {
+    pub fn metrics(&mut self) -> Result<JsValue, JsError> {
         to_js(&self.metrics_struct())
     }
 
@@ -427,7 +425,7 @@ impl Session {
     /// vertices: [[x, y, z]], faces: [[i, ...]] } }` (0-based faces). The P-Hex report has the
     /// contract's fields plus `per_face` (planarity, simple, convex, gaussian, shape_deviation).
     #[wasm_bindgen(js_name = exportJson)]
-    pub fn export_json(&self) -> Result<String, JsError> {
+    pub fn export_json(&mut self) -> Result<String, JsError> {
         let mesh = self.current_mesh().unwrap_or_default();
         let metrics = self.metrics_struct();
         let report = match &self.run {
@@ -497,7 +495,7 @@ impl Session {
             },
         )
         .map_err(err)?;
-        let mean_edge = mean_edge(&mesh);
+        let mean_edge = mesh.mean_edge();
         let scale = if mean_edge > 0.0 {
             panel_edge_m * 1000.0 / mean_edge
         } else {
@@ -533,8 +531,8 @@ impl Session {
     /// planar, through white, to red at 1e-2 and above, log scale; `convexity`; `regularity`:
     /// the P-Hex paper's section 4.2 deviation from the affine (quasi-)regular hexagon) and
     /// their edges.
-    pub fn mesh(&self, mode: Option<String>) -> Result<MeshData, JsError> {
-        let mode = ColorMode::parse(mode.as_deref().unwrap_or(""))?;
+    pub fn mesh(&mut self, mode: Option<String>) -> Result<MeshData, JsError> {
+        let mode = ColorMode::parse(mode.as_deref().unwrap_or("")).map_err(err)?;
         let m = self.current_mesh().unwrap_or_default();
         let colors: Vec<[f32; 3]> = match mode {
             ColorMode::Planarity => self
@@ -545,13 +543,7 @@ impl Session {
             ColorMode::Convexity => (0..m.num_faces())
                 .map(|i| {
                     let f = face_info(&m, i, 0.0);
-                    if !f.simple {
-                        INVALID
-                    } else if f.convex {
-                        CONVEX
-                    } else {
-                        NONCONVEX
-                    }
+                    convexity_color(f.simple, f.convex)
                 })
                 .collect(),
             ColorMode::Regularity => {
@@ -656,15 +648,12 @@ type Layers = (Option<PolyMesh>, Option<PolyMesh>, Vec<f32>);
 
 impl Session {
     /// Per-face planarity of `mesh` (the current mesh), cached until the next step.
-    fn face_planarities(&self, mesh: &PolyMesh) -> Vec<f64> {
-        let mut cache = self.per_face.borrow_mut();
-        match &*cache {
+    fn face_planarities(&mut self, mesh: &PolyMesh) -> Vec<f64> {
+        match &self.per_face {
             Some(v) if v.len() == mesh.num_faces() => v.clone(),
             _ => {
-                let v: Vec<f64> = (0..mesh.num_faces())
-                    .map(|i| face_planarity(mesh, i))
-                    .collect();
-                *cache = Some(v.clone());
+                let v = face_planarities(mesh);
+                self.per_face = Some(v.clone());
                 v
             }
         }
@@ -716,16 +705,12 @@ impl Session {
         }
     }
 
-    fn metrics_struct(&self) -> Metrics {
+    fn metrics_struct(&mut self) -> Metrics {
         let mesh = self.current_mesh().unwrap_or_default();
         let per_face = self.face_planarities(&mesh);
-        let mean_planarity = if per_face.is_empty() {
-            0.0
-        } else {
-            per_face.iter().sum::<f64>() / per_face.len() as f64
-        };
+        let mean_planarity = mean_planarity(&per_face);
         let histogram = planarity_histogram(&per_face);
-        let hist_log10 = [HIST_LO, HIST_HI];
+        let hist_log10 = [PLANARITY_HIST_LO, PLANARITY_HIST_HI];
         match &self.run {
             Run::Phex(p) => {
                 let m = p.metrics();
@@ -770,10 +755,8 @@ impl Session {
                     vertices: mesh.num_vertices(),
                     max_planarity,
                     mean_planarity,
-                    // Self-intersecting panels, tested in each face's least-squares plane.
-                    invalid_faces: (0..mesh.num_faces())
-                        .filter(|&i| !face_info(&mesh, i, 0.0).simple)
-                        .count(),
+                    // Self-intersecting panels, tested in each face's plane.
+                    invalid_faces: count_invalid_faces(&mesh),
                     histogram,
                     hist_log10,
                     level: Some(level),
@@ -788,62 +771,10 @@ impl Session {
     }
 }
 
-/// Face counts per bin of log10(planarity) over [HIST_LO, HIST_HI] (exact zeros and values
-/// below go to the first bin, values above to the last).
-fn planarity_histogram(per_face: &[f64]) -> Vec<u32> {
-    let mut h = vec![0u32; HIST_BINS];
-    let w = (HIST_HI - HIST_LO) / HIST_BINS as f64;
-    for &p in per_face {
-        let x = if p > 0.0 { p.log10() } else { HIST_LO };
-        let b = ((x - HIST_LO) / w)
-            .floor()
-            .clamp(0.0, (HIST_BINS - 1) as f64) as usize;
-        h[b] += 1;
-    }
-    h
-}
-
-fn mean_edge(m: &PolyMesh) -> f64 {
-    let (mut sum, mut n) = (0.0, 0usize);
-    for i in 0..m.num_faces() {
-        let f = m.face(i);
-        for k in 0..f.len() {
-            sum += (m.positions[f[(k + 1) % f.len()] as usize] - m.positions[f[k] as usize]).norm();
-            n += 1;
-        }
-    }
-    if n == 0 { 0.0 } else { sum / n as f64 }
-}
-
-const CONVEX: [f32; 3] = [0.25, 0.6, 0.35];
-const NONCONVEX: [f32; 3] = [0.9, 0.65, 0.15];
-const INVALID: [f32; 3] = [0.85, 0.15, 0.15];
-const NOT_HEX: [f32; 3] = [0.45, 0.45, 0.48];
-
-/// Shape deviation 0 (regular: blue) -> 0.4 and above (red), linear.
-fn regularity_color(d: f64) -> [f32; 3] {
-    let t = (d / 0.4).clamp(0.0, 1.0) as f32;
-    let (a, b) = ([0.20, 0.45, 0.85], [0.85, 0.20, 0.15]);
-    [0, 1, 2].map(|k| a[k] + (b[k] - a[k]) * t)
-}
-
-/// Blue (planar to 1e-15, about the rounding of f64) -> white (1e-8.5) -> red (1e-2 and
-/// worse), log scale; linear RGB. The floor is that low so the last exact (SQP) steps, which
-/// take planarity from ~1e-12 to ~1e-15 by sub-pixel moves, still show as a change.
-fn planarity_color(p: f64) -> [f32; 3] {
-    let t = ((p.max(1e-15).log10() + 15.0) / 13.0).clamp(0.0, 1.0) as f32;
-    let (blue, white, red) = ([0.20, 0.45, 0.85], [0.92, 0.92, 0.92], [0.85, 0.20, 0.15]);
-    let mix = |a: [f32; 3], b: [f32; 3], s: f32| [0, 1, 2].map(|k| a[k] + (b[k] - a[k]) * s);
-    if t < 0.5 {
-        mix(blue, white, t * 2.0)
-    } else {
-        mix(white, red, t * 2.0 - 1.0)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use dupin_core::mesh::face_planarity;
 
     /// Not a test: where a worker step of the page's 10k-face benchmark configuration goes,
     /// natively (thread CPU time per Gauss-Newton iteration, CG iterations and Cholesky
@@ -914,7 +845,7 @@ mod tests {
         let mut session = Session {
             run: Run::Phex(Box::new(PhexPipeline::new(cfg).unwrap())),
             config: serde_json::from_str(r#"{"surface": "torus"}"#).unwrap(),
-            per_face: Default::default(),
+            per_face: None,
             layers: LayerConfig::default(),
         };
         let mut optimised = 0;
@@ -945,7 +876,7 @@ mod tests {
                 started: false,
             },
             config: serde_json::from_str(&format!(r#"{{"scene": "{scene}"}}"#)).unwrap(),
-            per_face: Default::default(),
+            per_face: None,
             layers: LayerConfig::default(),
         }
     }
@@ -1030,24 +961,5 @@ mod tests {
         // Only the support layer: no offset panels.
         s.layers.offset = false;
         assert_eq!(tris(&s.mesh(None).unwrap()), tris(&plain) + beam_tris);
-    }
-
-    #[test]
-    fn histogram_counts_every_face_in_its_decade() {
-        let h = planarity_histogram(&[0.0, 1e-20, 3e-15, 2e-12, 1e-3, 1.0]);
-        assert_eq!(h.len(), HIST_BINS);
-        assert_eq!(h.iter().sum::<u32>(), 6);
-        assert_eq!((h[0], h[1], h[4], h[HIST_BINS - 1]), (2, 1, 1, 2));
-    }
-
-    #[test]
-    fn colour_ramps_are_ordered_and_clamped() {
-        assert_eq!(planarity_color(0.0), planarity_color(1e-15));
-        assert_eq!(planarity_color(1.0), planarity_color(1e-2));
-        assert!(planarity_color(1e-15)[2] > planarity_color(1e-15)[0]);
-        assert_ne!(planarity_color(1e-12), planarity_color(1e-15));
-        assert!(planarity_color(1e-2)[0] > planarity_color(1e-2)[2]);
-        assert_eq!(regularity_color(0.4), regularity_color(3.0));
-        assert!(regularity_color(0.0)[2] > regularity_color(0.0)[0]);
     }
 }

@@ -8,10 +8,12 @@
 //! Propositions 4 and 5 (section 4.2) and the ideal-triangle construction (section 5.1). All
 //! geometry is the core's; this file only arranges it for drawing.
 
+use crate::js::err;
 use crate::pick::StarPick;
 use dupin_core::mesh::is_simple_polygon;
 use dupin_core::phex::{
-    DupinConic, DupinIndicatrix, TriangleStar, dupin_conic_through, ideal_triangle,
+    DupinConic, DupinIndicatrix, TriangleStar, drag_lattice_star, drag_star_vertex,
+    dupin_conic_through, ideal_triangle, project_star,
 };
 use dupin_core::surface::{Curvature, PointType, surface_by_name};
 use dupin_core::{Vec2, Vec3};
@@ -107,10 +109,6 @@ pub struct DupinLesson {
     level: f64,
 }
 
-fn err(e: impl std::fmt::Display) -> JsError {
-    JsError::new(&e.to_string())
-}
-
 impl DupinLesson {
     /// The lesson at (u, v) of `surface` with `params`; the star starts as the ideal triangle of
     /// section 5.1 on a base edge 20 degrees off the first principal direction.
@@ -162,20 +160,11 @@ impl DupinLesson {
     /// The lesson at a mesh vertex: `curv` is the curvature at the vertex (its point is the
     /// star's centre), `ring` the six neighbours in counter-clockwise order. The neighbours are
     /// projected orthogonally onto the tangent plane in the principal frame (section 6, step 2:
-    /// the projected triangle star). Errors: planar or non-finite curvature, a projected
-    /// triangle that is degenerate.
+    /// the projected triangle star, `dupin_core::phex::project_star`). Errors: non-finite
+    /// neighbours, a projected triangle that is degenerate, planar or non-finite curvature.
     pub(crate) fn from_star(curv: &Curvature, ring: &[Vec3; 6]) -> Result<Self, String> {
-        if !ring.iter().all(|p| p.iter().all(|x| x.is_finite())) {
-            return Err("star vertices must be finite".into());
-        }
+        let r = project_star(curv, ring).map_err(|e| e.to_string())?;
         let mut l = Self::from_curvatures(curv.k1, curv.k2)?;
-        let f = curv.frame();
-        let r: [Vec2; 6] = ring.map(|p| f.to_local(&p));
-        for i in 0..6 {
-            TriangleStar::new(Vec2::zeros(), r[i], r[(i + 1) % 6]).map_err(|e| {
-                format!("{e}: triangle {i} of the star is flat in the tangent plane")
-            })?;
-        }
         let reach = r.iter().map(|q| q.norm()).fold(0.0, f64::max);
         // The indicatrix scaled to pass at the star's mean |Q| (its shape is what matters).
         let q = r.iter().map(|q| l.ind.quadratic(q).abs()).sum::<f64>() / 6.0;
@@ -209,39 +198,16 @@ impl DupinLesson {
     /// Moves ring vertex `index` (0..6: a, b, b - a, -a, -b, a - b) to `(x, y)`; the star stays
     /// a lattice star, so the opposite vertex moves symmetrically. Refuses degenerate stars.
     pub(crate) fn drag(&mut self, index: usize, x: f64, y: f64) -> Result<(), String> {
-        if !(x.is_finite() && y.is_finite()) {
-            return Err(format!("vertex position must be finite, got ({x}, {y})"));
-        }
         let q = Vec2::new(x, y);
-        if let Some(mut r) = self.ring {
+        if let Some(r) = self.ring {
             // A mesh star: only the dragged vertex moves.
-            if index >= 6 {
-                return Err(format!("star vertex index must be 0..5, got {index}"));
-            }
-            r[index] = q;
-            for i in [(index + 5) % 6, index] {
-                TriangleStar::new(Vec2::zeros(), r[i], r[(i + 1) % 6]).map_err(|e| {
-                    format!("{e}: the dragged vertex would make the star's triangles flat")
-                })?;
-            }
+            let r = drag_star_vertex(r, index, q).map_err(|e| e.to_string())?;
             self.ring = Some(r);
             (self.a, self.b) = (r[0], r[1]);
-            self.dragged = Some(q);
-            return Ok(());
+        } else {
+            (self.a, self.b) =
+                drag_lattice_star(self.a, self.b, index, q).map_err(|e| e.to_string())?;
         }
-        let (a, b) = match index {
-            0 => (q, self.b),
-            1 => (self.a, q),
-            2 => (self.a, q + self.a),
-            3 => (-q, self.b),
-            4 => (self.a, -q),
-            5 => (q + self.b, self.b),
-            _ => return Err(format!("star vertex index must be 0..5, got {index}")),
-        };
-        TriangleStar::new(Vec2::zeros(), a, b)
-            .map_err(|e| format!("{e}: the dragged vertex would make the star's triangles flat"))?;
-        self.a = a;
-        self.b = b;
         self.dragged = Some(q);
         Ok(())
     }

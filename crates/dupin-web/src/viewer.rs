@@ -55,7 +55,7 @@ impl Viewer {
         let colors = (!mesh.colors.is_empty()).then_some(mesh.colors.as_slice());
         self.renderer
             .set_mesh(&self.device, &self.queue, &mesh.buffers, colors)
-            .map_err(|e| JsError::new(&e.to_string()))?;
+            .map_err(crate::js::err)?;
         if mesh.edges.is_empty() {
             self.renderer.clear_lines();
         } else {
@@ -86,7 +86,7 @@ impl Viewer {
     #[wasm_bindgen(js_name = setCamera)]
     pub fn set_camera(&mut self, v: Vec<f32>) -> Result<(), JsError> {
         // The orbit camera's own pitch limits apply.
-        self.camera = crate::pick::camera_from(&v).map_err(|e| JsError::new(&e))?;
+        self.camera = crate::pick::camera_from(&v).map_err(crate::js::err)?;
         Ok(())
     }
 

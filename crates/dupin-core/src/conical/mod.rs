@@ -32,7 +32,7 @@ pub use cones::{
 pub use developable_strip::{
     PqStrip, StripClosure, StripRule, developable_subdivision, trefoil_moebius,
 };
-pub use offset::{MAX_OFFSET_TO_SIZE, OffsetError, offset_mesh};
+pub use offset::{DEFAULT_OFFSET_DISTANCE, MAX_OFFSET_TO_SIZE, OffsetError, offset_mesh};
 pub use perturbation::{
     PqError, PqMode, PqOptions, PqPerturbation, PqPhase, PqResult, PqStepInfo, Refinement,
     pq_perturb,

@@ -44,6 +44,10 @@ pub enum OffsetError {
 /// precision (each step of 10x costs a digit).
 pub const MAX_OFFSET_TO_SIZE: f64 = 1e3;
 
+/// Face distance of the offset a viewer shows when none is given: visible but thin against
+/// the conical scenes, which are about 5 units across (conical paper, section 4).
+pub const DEFAULT_OFFSET_DISTANCE: f64 = 0.15;
+
 /// The face-offset mesh at distance `distance` (positive along the face normals).
 ///
 /// Interior valence-4 vertices move along their cone axis ([`crate::conical::cone_axes`]) by

@@ -1,6 +1,6 @@
 //! Panel schedule for fabrication: every (planar) face of a panel mesh flattened into its
 //! least-squares plane, numbered, with its edge lengths, and packed on rectangular sheets for
-//! cutting (the "share and export" part of the configurator issue; the panels are the planar
+//! cutting (what the configurator's export hands to fabrication; the panels are the planar
 //! faces the P-Hex paper's section 7 and the conical paper's section 3 produce).
 //!
 //! Flattening is an orthogonal projection onto the plane of the face's covariance matrix (the
@@ -9,9 +9,8 @@
 //! small factor of optimal for panels of similar size, which is what panel meshes have. No crate
 //! does this small job for plain 2D polygons, so it is written here.
 
-use crate::mesh::PolyMesh;
+use crate::mesh::{PolyMesh, least_squares_plane};
 use crate::{Vec2, Vec3};
-use nalgebra::{Matrix3, SymmetricEigen};
 use std::fmt::Write;
 
 /// Errors of [`panel_schedule`].
@@ -90,14 +89,7 @@ fn flatten_face(mesh: &PolyMesh, i: usize) -> Result<Vec<Vec2>, PanelScheduleErr
     {
         return Err(PanelScheduleError::DegenerateFace(i));
     }
-    let c = pts.iter().sum::<Vec3>() / n as f64;
-    let mut cov = Matrix3::zeros();
-    for p in &pts {
-        let d = p - c;
-        cov += d * d.transpose();
-    }
-    let eig = SymmetricEigen::new(cov);
-    let mut normal = eig.eigenvectors.column(eig.eigenvalues.imin()).into_owned();
+    let (c, mut normal) = least_squares_plane(pts.iter().copied());
     // Orient the normal like the face's vertex order (Newell), so panels are not mirrored.
     let mut newell = Vec3::zeros();
     for k in 0..n {

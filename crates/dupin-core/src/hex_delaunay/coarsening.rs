@@ -39,8 +39,8 @@
 use super::extended_refinement::{in_half_hexagon, ring, tops_mask};
 use super::hierarchy::WINDOW_DISC2;
 use super::lattice::{Axial, DIRS, add, hex_norm};
+use super::pslg::near_segment;
 use super::simple_refinement::Refinement;
-use crate::Vec2;
 
 /// What one coarsening pass did.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -88,22 +88,12 @@ fn blossom_fits(r: &Refinement, segments: &[[u32; 2]], k: u32, t: Axial) -> bool
         let reach = 3.0 * f.radius(k);
         let centres = std::iter::once(t).chain(DIRS.iter().map(|&d| add(t, d)));
         for y in centres {
-            if near_segment(r, segments, f.position(k, y), reach) {
+            if near_segment(&r.points, segments, f.position(k, y), reach) {
                 return false;
             }
         }
     }
     true
-}
-
-/// Whether a segment passes within `dist` of `c` (a scan of the segments, as for runs).
-fn near_segment(r: &Refinement, segments: &[[u32; 2]], c: Vec2, dist: f64) -> bool {
-    segments.iter().any(|&[i, j]| {
-        let (a, b) = (r.points[i as usize], r.points[j as usize]);
-        let d = b - a;
-        let s = ((c - a).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
-        (a + d * s - c).norm() <= dist
-    })
 }
 
 /// One coarsening pass (section 5.3) over a finished extended refinement: forms every blossom
@@ -139,7 +129,7 @@ pub fn coarsen(r: &mut Refinement, segments: &[[u32; 2]]) -> Coarsening {
 mod tests {
     use super::super::tests::{check_with, paper_data_sets};
     use super::super::{HexDelaunayMode, HexDelaunayStepper};
-    use super::*;
+    use crate::Vec2;
 
     /// The stepper shows the coarsening as its own step; each blossom saves 36 triangles
     /// (96 → 60) against the same run without coarsening, and every guarantee holds after it.

@@ -38,6 +38,7 @@ use super::error::HexDelaunayError;
 use super::fin_vertices::{FinPatch, Run, run_patch, top_new};
 use super::hierarchy::{Cell, HexSet, Hierarchy, window_bit};
 use super::lattice::{Axial, DIRS, add, hex_norm, in_domain, on_boundary};
+use super::pslg::near_segment;
 use super::simple_refinement::Refinement;
 use crate::Vec2;
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -498,17 +499,6 @@ impl<'a> Pass<'a> {
         any
     }
 
-    /// Whether a segment passes within `dist` of `c`. A scan of all segments: O(segments) per
-    /// run, only with a PSLG (a spatial index would make it O(1); not needed for our inputs).
-    fn near_segment(&self, c: Vec2, dist: f64) -> bool {
-        self.segments.iter().any(|&[i, j]| {
-            let (a, b) = (self.r.points[i as usize], self.r.points[j as usize]);
-            let d = b - a;
-            let t = ((c - a).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
-            (a + d * t - c).norm() <= dist
-        })
-    }
-
     /// The verdict on the MOVED_CENTER_3 run around the top `t` at level `k` (memoised).
     fn run(&mut self, k: u32, t: Axial) -> RunVerdict {
         if let Some(&v) = self.runs.get(&(k, t)) {
@@ -539,7 +529,12 @@ impl<'a> Pass<'a> {
             || on_boundary(k, t)
             || DIRS.iter().any(|&d| !h.is_present(k, add(t, d)))
             || self.in_some_ring(k, t)
-            || self.near_segment(f.position(k, t), 3.0 * f.radius(k))
+            || near_segment(
+                &self.r.points,
+                self.segments,
+                f.position(k, t),
+                3.0 * f.radius(k),
+            )
         {
             return Rejected;
         }
@@ -559,7 +554,12 @@ impl<'a> Pass<'a> {
             // next to a segment broke its insertion on the IMR letters).
             if on_boundary(k, y)
                 || self.occupied_within(k, y, 2)
-                || self.near_segment(f.position(k, y), 3.0 * f.radius(k))
+                || near_segment(
+                    &self.r.points,
+                    self.segments,
+                    f.position(k, y),
+                    3.0 * f.radius(k),
+                )
             {
                 return Rejected;
             }

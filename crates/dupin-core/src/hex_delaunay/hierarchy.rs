@@ -1,8 +1,8 @@
 //! The hexagon hierarchy of section 3: split (subdivide) with join of semi-hexagons, the
 //! balancing rule, and point location.
 //!
-//! State: for every level `k`, the set of split full hexagons, keyed by lattice coordinates (the
-//! issue's O(n log n) design: every query is O(1) expected, no list scans). The set is stored in
+//! State: for every level `k`, the set of split full hexagons, keyed by lattice coordinates (so the
+//! refinement stays O(n log n): every query is O(1) expected, no list scans). The set is stored in
 //! 16×16 tiles of lattice coordinates, one 256-bit set per tile in a hash map ([`TileSet`]):
 //! the rules ask about a hexagon's neighbours, which mostly share its tile, so the map has
 //! ~100x fewer entries than a set of hexagons and stays in cache, and a query is one probe.

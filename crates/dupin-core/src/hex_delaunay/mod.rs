@@ -14,7 +14,7 @@
 //! full hexagons, whose centres stay on Ω's edges) never need refining below the size the
 //! points' spacing requires.
 //!
-//! Data structure (the O(n log n) requirement): split hexagons are kept per level in
+//! Data structure (O(n log n) in the number of points): split hexagons are kept per level in
 //! 16×16 tiles of lattice coordinates (a hash map of 256-bit sets), points are re-checked from
 //! a work queue only when a nearby hexagon changes, and the dual is extracted by a recursion
 //! over the lattice triangles that costs O(1) per output triangle. See `hierarchy.rs`, `simple_refinement.rs`, `dual.rs`.
@@ -46,7 +46,9 @@ mod stepper;
 
 pub use error::HexDelaunayError;
 pub use min_enclosing_circle::{Circle, min_enclosing_circle};
-pub use quality::{TriangulationQuality, triangulation_quality};
+pub use quality::{
+    TriangulationQuality, angle_histogram, triangle_angles_deg, triangulation_quality,
+};
 pub use stepper::{HexCell, HexDelaunayStepper};
 
 use crate::mesh::PolyMesh;
@@ -60,6 +62,29 @@ pub enum HexDelaunayMode {
     Simple,
     /// Section 5: angles in [43.9°, 90°] (Ω with inradius 3ρ instead of 1.5ρ).
     Extended,
+}
+
+impl HexDelaunayMode {
+    /// Both modes, the default ([`HexDelaunayMode::Simple`]) first.
+    pub const ALL: [HexDelaunayMode; 2] = [HexDelaunayMode::Simple, HexDelaunayMode::Extended];
+
+    /// The mode's name: `simple` or `extended`.
+    pub fn name(self) -> &'static str {
+        match self {
+            HexDelaunayMode::Simple => "simple",
+            HexDelaunayMode::Extended => "extended",
+        }
+    }
+
+    /// The interior angle bounds (degrees, min and max) the mode guarantees away from input
+    /// segments: [30, 120] for the simple refinement (section 4), [43.9, 90] for the extended
+    /// one (section 5).
+    pub fn angle_bounds_deg(self) -> [f64; 2] {
+        match self {
+            HexDelaunayMode::Simple => [30.0, 120.0],
+            HexDelaunayMode::Extended => [43.9, 90.0],
+        }
+    }
 }
 
 /// The result of [`hex_delaunay`].

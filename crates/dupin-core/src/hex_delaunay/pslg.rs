@@ -82,6 +82,19 @@ pub fn split_at_points(points: &[Vec2], segments: &[[u32; 2]]) -> Vec<[u32; 2]> 
     out
 }
 
+/// Whether a segment of `segments` (index pairs into `points`) passes within `dist` of `c`.
+/// A scan of all segments: O(segments) per query, only with a PSLG (section 7; a spatial index
+/// would make it O(1), not needed for our inputs). The extended refinement's runs and the
+/// coarsening's blossoms keep away from segments with it.
+pub(crate) fn near_segment(points: &[Vec2], segments: &[[u32; 2]], c: Vec2, dist: f64) -> bool {
+    segments.iter().any(|&[i, j]| {
+        let (a, b) = (points[i as usize], points[j as usize]);
+        let d = b - a;
+        let t = ((c - a).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
+        (a + d * t - c).norm() <= dist
+    })
+}
+
 /// Whether the closed segment `a b` meets the closed hexagon of centre `c`, circumradius `r`
 /// (corners at 0°, 60°, ...), inflated by a hair so that touching counts: separating axes.
 fn hexagon_meets_segment(c: Vec2, r: f64, a: Vec2, b: Vec2) -> bool {

@@ -48,6 +48,26 @@ fn angle(at: Vec2, p: Vec2, q: Vec2) -> f64 {
     c.abs().atan2(d).to_degrees()
 }
 
+/// Interior angles of triangle (a, b, c) in degrees, at a, b and c, in [0, 180].
+pub fn triangle_angles_deg(a: Vec2, b: Vec2, c: Vec2) -> [f64; 3] {
+    [angle(a, b, c), angle(b, c, a), angle(c, a, b)]
+}
+
+/// Counts of the triangles' interior angles ([`triangle_angles_deg`]) per `bin_deg`-wide bin
+/// over [0, 180) (180 itself in the last bin): the angle distribution the paper's bounds
+/// (sections 4 and 5) are about.
+pub fn angle_histogram(vertices: &[Vec2], triangles: &[[u32; 3]], bin_deg: f64) -> Vec<u32> {
+    let bins = (180.0 / bin_deg) as usize;
+    let mut histogram = vec![0u32; bins];
+    for t in triangles {
+        let [a, b, c] = t.map(|i| vertices[i as usize]);
+        for deg in triangle_angles_deg(a, b, c) {
+            histogram[((deg / bin_deg) as usize).min(bins - 1)] += 1;
+        }
+    }
+    histogram
+}
+
 /// Measures a triangulation given as positions and counter-clockwise triangles.
 pub fn triangulation_quality(vertices: &[Vec2], triangles: &[[u32; 3]]) -> TriangulationQuality {
     let mut q = TriangulationQuality {
@@ -75,8 +95,7 @@ pub fn triangulation_quality(vertices: &[Vec2], triangles: &[[u32; 3]]) -> Trian
             q.inverted += 1;
         }
         q.area += 0.5 * ((b - a).perp(&(cc - a)));
-        let angs = [angle(a, b, cc), angle(b, cc, a), angle(cc, a, b)];
-        for x in angs {
+        for x in triangle_angles_deg(a, b, cc) {
             q.min_angle_deg = q.min_angle_deg.min(x);
             q.max_angle_deg = q.max_angle_deg.max(x);
         }

@@ -8,7 +8,9 @@ use rand_chacha::ChaCha8Rng;
 /// 30-30-120 triangle, 1 / (8 sin²15° sin 60°).
 const SIMPLE_ASPECT: f64 = 2.154_700_538_379_252;
 
-/// The input families of the issue.
+/// The input families the refinement is tested on: uniform and clustered points and the
+/// degenerate sets (collinear, cocircular, lattice-aligned, duplicates, close pairs, one or two
+/// points) where lattice rounding and the hierarchy's rules are most easily wrong.
 #[derive(Debug, Clone, Copy)]
 pub(crate) enum Family {
     Uniform,
@@ -294,7 +296,7 @@ fn simple_guarantees_over_seeded_families() {
 }
 
 #[test]
-#[ignore = "the issue's full 10^4 inputs per family; run with --ignored (release-like core)"]
+#[ignore = "the full 10^4 inputs per family (minutes); run with --ignored (release-like core)"]
 fn simple_guarantees_over_seeded_families_full() {
     run_families(10_000);
 }
@@ -605,7 +607,7 @@ fn extended_guarantees_over_seeded_families() {
 }
 
 #[test]
-#[ignore = "the issue's full 10^4 inputs per family; run with --ignored --release"]
+#[ignore = "the full 10^4 inputs per family (minutes); run with --ignored --release"]
 fn extended_guarantees_over_seeded_families_full() {
     run_families_extended(10_000, 4000);
 }

@@ -7,13 +7,15 @@
 //! |---|---|
 //! | compact polygon mesh | `polymesh.rs` |
 //! | halfedges, manifold and orientation checks | `topology.rs` |
-//! | least-squares plane, `max_planarity` (contract) | `planarity.rs` |
+//! | least-squares plane, `max_planarity` (contract), mean and histogram of planarity | `planarity.rs` |
+//! | face colour maps: planarity, convexity, regularity (P-Hex secs. 4.1, 4.2) and legend stops | `colors.rs` |
 //! | simple polygons, exact predicates (P-Hex sec. 4.2) | `polygon.rs` |
 //! | vertex under a ray, triangle star of a vertex (P-Hex sec. 4.1) | `picking.rs` |
 //! | triangle buffers for renderers | `render_buffers.rs` |
 //! | OBJ, point sets, segments | `io/` |
 //! | Catmull-Clark, Doo-Sabin, Chaikin, Lane-Riesenfeld (conical paper, sec. 3) | `subdivision/` |
 
+mod colors;
 pub mod io;
 mod picking;
 mod planarity;
@@ -23,9 +25,16 @@ mod render_buffers;
 mod subdivision;
 mod topology;
 
+pub use colors::{
+    CONVEX, ColorMode, ColorModeError, INVALID, NONCONVEX, NOT_HEX, PLANARITY_LEGEND_LOG10,
+    REGULARITY_LEGEND, convexity_color, planarity_color, regularity_color,
+};
 pub use io::{ObjError, PointSetError, parse_obj, parse_points, parse_segments, write_obj};
 pub use picking::{VertexPick, VertexStarError, pick_vertex, vertex_ring};
-pub use planarity::{face_planarity, least_squares_plane, max_planarity};
+pub use planarity::{
+    PLANARITY_HIST_BINS, PLANARITY_HIST_HI, PLANARITY_HIST_LO, face_planarities, face_planarity,
+    least_squares_plane, max_planarity, mean_planarity, planarity_histogram,
+};
 pub use polygon::{PolygonError, is_simple_polygon, segments_intersect, strictly_inside_triangle};
 pub use polymesh::{MeshError, PolyMesh};
 pub use render_buffers::{TriangleBuffers, polymesh_buffers, polymesh_edges};

@@ -101,9 +101,56 @@ pub fn max_planarity(mesh: &PolyMesh) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// [`face_planarity`] of every face of `mesh`, in face order.
+pub fn face_planarities(mesh: &PolyMesh) -> Vec<f64> {
+    (0..mesh.num_faces())
+        .map(|i| face_planarity(mesh, i))
+        .collect()
+}
+
+/// Mean of per-face planarity errors (as [`face_planarities`] returns them); 0 for no faces.
+/// With [`max_planarity`] it tells one bad panel from a uniformly bent mesh.
+pub fn mean_planarity(per_face: &[f64]) -> f64 {
+    if per_face.is_empty() {
+        0.0
+    } else {
+        per_face.iter().sum::<f64>() / per_face.len() as f64
+    }
+}
+
+/// Number of bins of [`planarity_histogram`].
+pub const PLANARITY_HIST_BINS: usize = 14;
+/// log10 of the lower end of [`planarity_histogram`]'s axis (rounding of f64).
+pub const PLANARITY_HIST_LO: f64 = -16.0;
+/// log10 of the upper end of [`planarity_histogram`]'s axis (a visibly bent panel).
+pub const PLANARITY_HIST_HI: f64 = -2.0;
+
+/// Face counts per bin of log10(planarity): [`PLANARITY_HIST_BINS`] equal bins over
+/// [[`PLANARITY_HIST_LO`], [`PLANARITY_HIST_HI`]]; exact zeros and values below go to the
+/// first bin, values above to the last.
+pub fn planarity_histogram(per_face: &[f64]) -> Vec<u32> {
+    let (bins, lo, hi) = (PLANARITY_HIST_BINS, PLANARITY_HIST_LO, PLANARITY_HIST_HI);
+    let mut h = vec![0u32; bins];
+    let w = (hi - lo) / bins as f64;
+    for &p in per_face {
+        let x = if p > 0.0 { p.log10() } else { lo };
+        let b = ((x - lo) / w).floor().clamp(0.0, (bins - 1) as f64) as usize;
+        h[b] += 1;
+    }
+    h
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn histogram_counts_every_face_in_its_decade() {
+        let h = planarity_histogram(&[0.0, 1e-20, 3e-15, 2e-12, 1e-3, 1.0]);
+        assert_eq!(h.len(), PLANARITY_HIST_BINS);
+        assert_eq!(h.iter().sum::<u32>(), 6);
+        assert_eq!((h[0], h[1], h[4], h[PLANARITY_HIST_BINS - 1]), (2, 1, 1, 2));
+    }
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 

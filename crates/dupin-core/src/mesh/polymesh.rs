@@ -145,6 +145,22 @@ impl PolyMesh {
         robust_norm(hi - lo)
     }
 
+    /// Mean edge length over all faces, each face's edges counted once per face (an interior
+    /// edge twice); 0 for a mesh without faces. The mesh's scale, e.g. to size panels.
+    pub fn mean_edge(&self) -> f64 {
+        let (mut sum, mut n) = (0.0, 0usize);
+        for i in 0..self.num_faces() {
+            let f = self.face(i);
+            for k in 0..f.len() {
+                sum += (self.positions[f[(k + 1) % f.len()] as usize]
+                    - self.positions[f[k] as usize])
+                    .norm();
+                n += 1;
+            }
+        }
+        if n == 0 { 0.0 } else { sum / n as f64 }
+    }
+
     /// Mean length of the edges of face `i`.
     pub fn face_mean_edge(&self, i: usize) -> f64 {
         let f = self.face(i);

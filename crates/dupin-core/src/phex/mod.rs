@@ -25,14 +25,14 @@ pub use dual_hexagons::{
 };
 pub use duality::{
     DupinCenterError, DupinCenterMethod, DupinConic, DupinHexagon, DupinIndicatrix, IdealTriangle,
-    IdealTriangleError, IndicatrixError, TangentDualPoint, TangentDualityError, TriangleStar,
-    TriangleStarError, approximate_dupin_center, dupin_center, dupin_center_3d,
-    dupin_conic_through, ideal_apex_3d, ideal_triangle, is_affine_quasi_regular_hexagon,
-    is_affine_regular_hexagon, tangent_dual_point,
+    IdealTriangleError, IndicatrixError, StarEditError, TangentDualPoint, TangentDualityError,
+    TriangleStar, TriangleStarError, approximate_dupin_center, drag_lattice_star, drag_star_vertex,
+    dupin_center, dupin_center_3d, dupin_conic_through, ideal_apex_3d, ideal_triangle,
+    is_affine_quasi_regular_hexagon, is_affine_regular_hexagon, project_star, tangent_dual_point,
 };
 pub use pipeline::{PhexConfig, PhexMetrics, PhexPhase, PhexPipeline, PhexResult, phex_run};
 pub use planarity_optimisation::{PlanarityOptimiser, PlanarityOptions, PlanarityStep};
-pub use report::{FaceInfo, PhexReport, face_info, phex_report};
+pub use report::{FaceInfo, PhexReport, count_invalid_faces, face_info, phex_report};
 pub use triangulation::{
     ConjugateFields, DEFAULT_BOUND, LayerRule, MAX_RATIO, MAX_RATIO_ELLIPTIC, Triangulation,
     TriangulationMethod, TriangulationSpec, bounded_ratio, convex_loop_triangulation,

@@ -1012,8 +1012,7 @@ mod tests {
         assert!(opt.cg_iterations() > 0 && opt.cg_iterations() <= CG_MAX_ITERATIONS);
     }
 
-    /// Regression (issue 4, 10k-face torus from the Dupin-duality start in the page's free
-    /// mode): after the volumes are resolved, a truncated-CG step lowered the cost through the
+    /// Regression (10k-face torus from the Dupin-duality start in the page's free mode): after the volumes are resolved, a truncated-CG step lowered the cost through the
     /// fairness term but raised max_planarity, which used to switch the optimiser to Cholesky
     /// factorisations. Now that step is rejected and retried with a looser CG forcing term, and
     /// the run reaches the tolerance by CG alone. The same start at 1512 faces (size 0.4),

@@ -75,10 +75,6 @@ fn project(pts: &[Vec3]) -> (Vec<Vec2>, Vec3) {
     )
 }
 
-fn cross2(a: &Vec2, b: &Vec2) -> f64 {
-    a.x * b.y - a.y * b.x
-}
-
 /// Diagnostics of face `i` of `mesh`, with `gaussian` the curvature there.
 pub fn face_info(mesh: &PolyMesh, i: usize, gaussian: f64) -> FaceInfo {
     let pts: Vec<Vec3> = mesh
@@ -90,7 +86,7 @@ pub fn face_info(mesh: &PolyMesh, i: usize, gaussian: f64) -> FaceInfo {
     let n = q.len();
     let simple = is_simple_polygon(&q).unwrap_or(false);
     let turns: Vec<f64> = (0..n)
-        .map(|k| cross2(&(q[(k + 1) % n] - q[k]), &(q[(k + 2) % n] - q[(k + 1) % n])))
+        .map(|k| (q[(k + 1) % n] - q[k]).perp(&(q[(k + 2) % n] - q[(k + 1) % n])))
         .collect();
     let convex = simple && (turns.iter().all(|&t| t > 0.0) || turns.iter().all(|&t| t < 0.0));
     let shape_deviation = (n == 6).then(|| {
@@ -117,6 +113,15 @@ pub fn face_info(mesh: &PolyMesh, i: usize, gaussian: f64) -> FaceInfo {
         gaussian,
         shape_deviation,
     }
+}
+
+/// Number of faces of `mesh` that are not simple polygons in their plane ([`FaceInfo::simple`]):
+/// the report's `invalid_faces` (P-Hex paper, section 4.1: a valid hexagon does not
+/// self-intersect), for any polygon mesh.
+pub fn count_invalid_faces(mesh: &PolyMesh) -> usize {
+    (0..mesh.num_faces())
+        .filter(|&i| !face_info(mesh, i, 0.0).simple)
+        .count()
 }
 
 /// Builds the report of `mesh` on `surface`. `face_gaussian[i]` is the Gaussian curvature at

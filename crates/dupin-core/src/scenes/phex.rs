@@ -329,7 +329,8 @@ mod tests {
     /// away from parabolic curves, for every valid scene.
     pub(crate) const SHAPE_BOUND: f64 = 0.8;
 
-    /// Acceptance of the issue; returns the failures as text. Convexity is checked on the
+    /// What every valid P-Hex scene must meet to count as a result of the paper (planar, valid,
+    /// regular hexagons on the surface); returns the failures as text. Convexity is checked on the
     /// hexagons away from parabolic curves (|K| >= AWAY max |K|): convex where K > 0,
     /// non-convex where K < 0. Boundary faces (4 or 5 vertices, half stars) are only held to
     /// validity, planarity, surface distance and edge length.

@@ -9,10 +9,12 @@
 //! | 4.1 | tangent duality: the tangent planes' common point | `tangent_duality.rs` |
 //! | 4.2, Props. 4-5 | valid triangle stars, the Dupin hexagon | `triangle_star.rs` |
 //! | 5.1 | the ideal triangle, the line DE, affine regular hexagons | `ideal_triangle.rs` |
+//! | 4.2, 6 | a mesh star projected onto the tangent plane; moving a star's ring vertex | `star_editing.rs` |
 
 mod dupin_center;
 mod ideal_triangle;
 mod indicatrix;
+mod star_editing;
 mod tangent_duality;
 mod triangle_star;
 
@@ -25,5 +27,6 @@ pub use ideal_triangle::{
     is_affine_quasi_regular_hexagon, is_affine_regular_hexagon,
 };
 pub use indicatrix::{DupinConic, DupinIndicatrix, IndicatrixError};
+pub use star_editing::{StarEditError, drag_lattice_star, drag_star_vertex, project_star};
 pub use tangent_duality::{TangentDualPoint, TangentDualityError, tangent_dual_point};
 pub use triangle_star::{DupinHexagon, TriangleStar, TriangleStarError};

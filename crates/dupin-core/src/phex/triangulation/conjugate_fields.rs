@@ -12,7 +12,9 @@
 //! defined up to sign, so each step is oriented against the previous one, which no ODE crate
 //! does for us).
 
-use super::layers::{LayerRule, Triangulation, TriangulationSpec, bounded_ratio, ideal_ratio};
+use super::layers::{
+    LayerRule, Triangulation, TriangulationSpec, bounded_ratio, ideal_ratio, to_uv,
+};
 use crate::phex::PhexError;
 use crate::surface::Surface;
 use crate::{Vec2, Vec3};
@@ -119,18 +121,6 @@ impl<'a> ConjugateFields<'a> {
     }
 }
 
-fn to_uv(swap: bool, along: f64, across: f64) -> Vec2 {
-    if swap {
-        Vec2::new(across, along)
-    } else {
-        Vec2::new(along, across)
-    }
-}
-
-fn cross2(a: Vec2, b: Vec2) -> f64 {
-    a.x * b.y - a.y * b.x
-}
-
 /// A polyline with the bounding boxes of its chunks of [`CHUNK`] segments (crossing tests skip
 /// whole chunks; a layer's flow line has thousands of segments).
 struct Polyline {
@@ -166,12 +156,12 @@ impl Polyline {
             for w in self.pts[c * CHUNK..end].windows(2) {
                 let (a, b) = (w[0], w[1]);
                 let (r, s) = (q - p, b - a);
-                let den = cross2(r, s);
+                let den = r.perp(&s);
                 if den == 0.0 {
                     continue;
                 }
-                let t = cross2(a - p, s) / den;
-                let u = cross2(a - p, r) / den;
+                let t = (a - p).perp(&s) / den;
+                let u = (a - p).perp(&r) / den;
                 if (0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u) {
                     best = Some(best.map_or(t, |x: f64| x.min(t)));
                 }

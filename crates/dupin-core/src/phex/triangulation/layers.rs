@@ -108,7 +108,9 @@ pub fn bounded_ratio(r: f64, b: f64) -> f64 {
     }
 }
 
-fn to_uv(swap: bool, along: f64, across: f64) -> Vec2 {
+/// The parameter point at `along` the layer direction and `across` it: (along, across), or
+/// (across, along) when the spec's `swap` makes v the layer direction.
+pub(super) fn to_uv(swap: bool, along: f64, across: f64) -> Vec2 {
     if swap {
         Vec2::new(across, along)
     } else {
