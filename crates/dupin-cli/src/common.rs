@@ -49,6 +49,27 @@ pub fn check_writable(path: &Path) -> Result<(), CliError> {
     Ok(())
 }
 
+/// Reads a mesh file (OBJ, STL, glTF or GLB, told by its name or its first bytes), naming the
+/// file in any error and noting welded-away triangles on stderr.
+#[allow(dead_code)]
+pub fn read_mesh_file(path: &Path) -> Result<dupin_core::mesh::PolyMesh, CliError> {
+    use dupin_core::mesh::io::{ImportOptions, read_mesh};
+    let bytes = std::fs::read(path).map_err(|source| CliError::Io {
+        path: path.display().to_string(),
+        source,
+    })?;
+    let name = path.display().to_string();
+    let m = read_mesh(&name, &bytes, &ImportOptions::default())
+        .map_err(|e| CliError::input(&name, e))?;
+    if m.dropped_triangles > 0 {
+        eprintln!(
+            "note: {name}: {} degenerate triangles dropped (two corners at one point)",
+            m.dropped_triangles
+        );
+    }
+    Ok(m.mesh)
+}
+
 /// Reads a whole text file.
 #[allow(dead_code)]
 pub fn read_text(path: &Path) -> Result<String, CliError> {

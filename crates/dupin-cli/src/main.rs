@@ -6,6 +6,7 @@ use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::process::ExitCode;
 
 mod common;
+mod export;
 mod hexdelaunay;
 mod offset;
 mod phex;
@@ -35,6 +36,8 @@ enum Command {
     Phex(phex::PhexArgs),
     /// Build a PQ scene of the conical paper (see --list-scenes).
     Pq(pq::PqArgs),
+    /// Write a panel mesh as fabrication files: DXF sheets, CSV list, SVG or GLB.
+    Export(export::ExportArgs),
 }
 
 fn run(cli: Cli) -> Result<(), common::CliError> {
@@ -45,6 +48,7 @@ fn run(cli: Cli) -> Result<(), common::CliError> {
         Command::Offset(a) => offset::run(a),
         Command::Phex(a) => phex::run(a),
         Command::Pq(a) => pq::run(a),
+        Command::Export(a) => export::run(a),
     }
 }
 

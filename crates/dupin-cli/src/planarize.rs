@@ -1,10 +1,10 @@
 //! `dupin planarize`: PQ / conical / circular perturbation of any polygon mesh (conical paper,
 //! Sec. 2.2 and 5).
 
-use crate::common::{CliError, read_text, write_report, write_text};
+use crate::common::{CliError, read_mesh_file, write_report, write_text};
 use clap::{Args, ValueEnum};
 use dupin_core::conical::{PqMode, PqOptions, Refinement, pq_perturb};
-use dupin_core::mesh::{parse_obj, write_obj};
+use dupin_core::mesh::write_obj;
 use serde_json::json;
 use std::path::PathBuf;
 
@@ -31,7 +31,7 @@ pub enum RefineArg {
 /// Arguments of `dupin planarize`.
 #[derive(Debug, Args)]
 pub struct PlanarizeArgs {
-    /// Input OBJ (any polygon mesh).
+    /// Input mesh: OBJ (any polygons), STL or glTF/GLB (triangles).
     #[arg(long)]
     pub input: PathBuf,
     /// Property to enforce.
@@ -65,9 +65,7 @@ pub struct PlanarizeArgs {
 
 /// Runs `dupin planarize`.
 pub fn run(args: PlanarizeArgs) -> Result<(), CliError> {
-    let text = read_text(&args.input)?;
-    let mesh =
-        parse_obj(&text).map_err(|e| CliError::input(&args.input.display().to_string(), e))?;
+    let mesh = read_mesh_file(&args.input)?;
     let mode = match args.mode {
         ModeArg::Planar => PqMode::Planar,
         ModeArg::Conical => PqMode::Conical,
