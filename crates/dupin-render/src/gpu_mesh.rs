@@ -1,7 +1,7 @@
 //! What both renderers share: the vertex format, validated uploads of plain buffers, the cached
 //! depth buffer, the offscreen target of a snapshot, pipeline and pass boilerplate.
 
-use crate::mesh_renderer::RenderError;
+use crate::error::RenderError;
 use crate::readback::{PendingSnapshot, read_back};
 use dupin_core::mesh::TriangleBuffers;
 

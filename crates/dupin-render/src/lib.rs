@@ -6,6 +6,7 @@
 //! for tests. The core never knows about this crate.
 
 mod camera;
+mod error;
 mod gpu_mesh;
 mod mesh_renderer;
 #[cfg(not(target_arch = "wasm32"))]
@@ -14,7 +15,8 @@ mod presentation;
 mod readback;
 
 pub use camera::OrbitCamera;
-pub use mesh_renderer::{BACKGROUND, MeshRenderer, RenderError};
+pub use error::RenderError;
+pub use mesh_renderer::{BACKGROUND, MeshRenderer};
 #[cfg(not(target_arch = "wasm32"))]
 pub use offscreen::{
     OffscreenImage, PresentationOffscreen, render_offscreen, render_presentation_offscreen,

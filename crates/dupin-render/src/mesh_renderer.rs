@@ -1,10 +1,10 @@
 //! The mesh renderer: one lit triangle pipeline, one flat line pipeline, a depth buffer.
 
 use crate::camera::OrbitCamera;
+use crate::error::RenderError;
 use crate::gpu_mesh::{self, DepthBuffer, GpuMesh, PipelineSpec, Vertex};
 use crate::readback::PendingSnapshot;
 use dupin_core::mesh::TriangleBuffers;
-use thiserror::Error;
 
 /// Background colour of every view (linear RGB), also used by tests to count covered pixels.
 pub const BACKGROUND: wgpu::Color = wgpu::Color {
@@ -15,23 +15,6 @@ pub const BACKGROUND: wgpu::Color = wgpu::Color {
 };
 
 const DEFAULT_COLOR: [f32; 3] = [0.55, 0.70, 0.85];
-
-/// Why rendering could not start or finish.
-#[derive(Debug, Error)]
-pub enum RenderError {
-    /// No GPU adapter (hardware, software rasteriser, WebGPU or WebGL2) was found.
-    #[error("no graphics adapter available: {0}")]
-    NoAdapter(String),
-    /// The adapter refused to create a device.
-    #[error("could not create a graphics device: {0}")]
-    Device(String),
-    /// Mesh buffers are inconsistent (lengths not multiples of 3, indices out of range).
-    #[error("invalid mesh buffers: {0}")]
-    InvalidBuffers(String),
-    /// Reading back the rendered image failed.
-    #[error("could not read back the image: {0}")]
-    Readback(String),
-}
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]

@@ -1,7 +1,8 @@
 //! Native offscreen rendering to RGBA pixels (lavapipe/llvmpipe in CI, any GPU elsewhere).
 
 use crate::camera::OrbitCamera;
-use crate::mesh_renderer::{MeshRenderer, RenderError};
+use crate::error::RenderError;
+use crate::mesh_renderer::MeshRenderer;
 use crate::presentation::{FrameInstances, PresentationRenderer};
 use crate::readback::PendingSnapshot;
 use dupin_core::mesh::TriangleBuffers;

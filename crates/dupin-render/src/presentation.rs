@@ -10,8 +10,9 @@
 //! [`PresentationRenderer::set_shadows`] changed something and reused by every orbit frame.
 
 use crate::camera::OrbitCamera;
+use crate::error::RenderError;
 use crate::gpu_mesh::{self, DEPTH_FORMAT, DepthBuffer, GpuMesh, PipelineSpec, Vertex};
-use crate::mesh_renderer::{RenderError, background_for};
+use crate::mesh_renderer::background_for;
 use crate::readback::PendingSnapshot;
 use dupin_core::mesh::TriangleBuffers;
 use glam::{Mat4, Vec3, camera::rh};

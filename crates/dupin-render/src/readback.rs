@@ -1,6 +1,6 @@
 //! Reading a rendered frame back to RGBA bytes, in bands small enough for every WebGPU.
 
-use crate::mesh_renderer::RenderError;
+use crate::error::RenderError;
 
 /// Copies `texture` (`width` x `height`, `format`) into readback buffers in bands of rows.
 pub(crate) fn read_back(

@@ -16,8 +16,9 @@
 //! it holds only the front of the depth-first traversal, stays small and cache-resident, and
 //! the extraction's time per triangle does not grow with the mesh.
 
-use super::hierarchy::{HexSet, Hierarchy, window_bit};
+use super::hierarchy::{Hierarchy, window_bit};
 use super::lattice::{Axial, DIRS, add, normalize, on_boundary};
+use super::tile_set::HexSet;
 use crate::Vec2;
 use rustc_hash::{FxHashMap, FxHashSet};
 use std::collections::hash_map::Entry;
@@ -57,7 +58,7 @@ pub struct DualBuilder<'h> {
     pub positions: Vec<Vec2>,
     /// Triangles, counter-clockwise.
     pub triangles: Vec<[u32; 3]>,
-    /// Keys whose fans are not emitted (the MOVED_CENTER_3 run centres that `fin_vertices.rs`
+    /// Keys whose fans are not emitted (the MOVED_CENTER_3 run centres that `extended/fin_vertices.rs`
     /// re-triangulates), their vertices as a bit set, and how many triangles were left out.
     drop: &'h FxHashSet<Key>,
     dropped: Vec<u64>,

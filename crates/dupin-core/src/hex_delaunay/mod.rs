@@ -6,6 +6,19 @@
 //! angle lies in [30°, 120°], with [`HexDelaunayMode::Extended`] (section 5) in
 //! [43.8979°, 90°]; both meshes are Delaunay.
 //!
+//! | section | concept | file |
+//! |---|---|---|
+//! | 3.1 | hexagon coordinates and levels, the lattice frame and Ω | `lattice.rs` |
+//! | 3 | the hexagon hierarchy: split, join, balancing, point location; split counters, merge and break (3.2) | `hierarchy.rs` |
+//! | 3 | the split sets: 16×16 tiles of bits per level | `tile_set.rs` |
+//! | 4.1 | the bounding circle (Welzl) | `min_enclosing_circle.rs` |
+//! | 4.1 | simple refinement: rules 1 to 5 on a work queue, angles in [30°, 120°] | `simple_refinement.rs` |
+//! | 4.2 | the dual triangulation of the hexagon mesh | `dual.rs` |
+//! | 5 | extended refinement (5.1, 5.2, 5.4), MOVED_CENTER_3/4 fin vertices (5.4), local coarsening into blossoms (5.3) | `extended/` |
+//! | 7 | PSLG input: segments refine, snap and become edge chains (both modes) | `pslg.rs` |
+//! | 4 to 7 | the stepper, input checks and Ω's set-up; the one-shot [`hex_delaunay`] | `stepper.rs`, this file |
+//! | 4, 5 | angle and Delaunay checks of a result | `quality.rs` |
+//!
 //! Bounding hexagon (section 4.1): the minimum enclosing circle (Welzl) of the points, radius
 //! ρ, is the inner circle of the hexagon the paper places around the points; here Ω is that
 //! hexagon enlarged by half (inradius 1.5ρ) and turned by 30°, so that (a) its corners are
@@ -17,7 +30,8 @@
 //! Data structure (O(n log n) in the number of points): split hexagons are kept per level in
 //! 16×16 tiles of lattice coordinates (a hash map of 256-bit sets), points are re-checked from
 //! a work queue only when a nearby hexagon changes, and the dual is extracted by a recursion
-//! over the lattice triangles that costs O(1) per output triangle. See `hierarchy.rs`, `simple_refinement.rs`, `dual.rs`.
+//! over the lattice triangles that costs O(1) per output triangle. See `hierarchy.rs`,
+//! `tile_set.rs`, `simple_refinement.rs`, `dual.rs`.
 //!
 //! PSLG input (section 7, `pslg.rs`): segments refine the hexagons they meet, the centres of
 //! met hexagons move onto them, and each segment becomes a chain of output edges
@@ -25,17 +39,16 @@
 //! hold for every triangle that does not meet a segment ([`HexTriangulation::meets_segments`]).
 //!
 //! Split counters, merge and break (section 3.2) are in `hierarchy.rs`; the extended mode ends
-//! with the local coarsening into blossoms (section 5.3, `coarsening.rs`); MOVED_CENTER_3/4 are
-//! relocated under a local check (`extended_refinement.rs`, `fin_vertices.rs`). Section 6.3's
-//! shortest-edge bound d·√7/(12√3) does not hold with the paper's construction (a
-//! counterexample in docs/hexdelaunay.md); every edge is at least √7·d/(4(3√3 + 2)).
+//! with the local coarsening into blossoms (section 5.3, `extended/coarsening.rs`);
+//! MOVED_CENTER_3/4 are relocated under a local check (`extended/refinement.rs`,
+//! `extended/fin_vertices.rs`). Section 6.3's shortest-edge bound d·√7/(12√3) does not hold
+//! with the paper's construction (a counterexample in docs/hexdelaunay.md); every edge is at
+//! least √7·d/(4(3√3 + 2)).
 //! Incremental insertion is [`HexDelaunayStepper::insert`].
 
-mod coarsening;
 mod dual;
 mod error;
-mod extended_refinement;
-mod fin_vertices;
+mod extended;
 mod hierarchy;
 mod lattice;
 mod min_enclosing_circle;
@@ -43,6 +56,7 @@ mod pslg;
 mod quality;
 mod simple_refinement;
 mod stepper;
+mod tile_set;
 
 pub use error::HexDelaunayError;
 pub use min_enclosing_circle::{Circle, min_enclosing_circle};
@@ -164,7 +178,7 @@ pub fn hex_delaunay(
 ) -> Result<HexTriangulation, HexDelaunayError> {
     let mut s = HexDelaunayStepper::new(points, segments, mode)?;
     s.run()?;
-    s.try_triangulation()
+    s.take_triangulation()
 }
 
 #[cfg(test)]

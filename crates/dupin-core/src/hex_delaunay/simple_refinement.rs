@@ -25,8 +25,9 @@
 //! triangles, n points.
 
 use super::error::HexDelaunayError;
-use super::hierarchy::{Cell, HexSet, Hierarchy, Merge, MergeError};
+use super::hierarchy::{Cell, Hierarchy, Merge, MergeError};
 use super::lattice::{Axial, DIRS, add};
+use super::tile_set::HexSet;
 use crate::Vec2;
 use rustc_hash::FxHashMap;
 use std::collections::VecDeque;

@@ -1,13 +1,12 @@
 //! The stepper: the refinement one observable subdivision step at a time, for the page's 2D
 //! view, plus the input checks and bounding-hexagon set-up shared with the one-shot function.
 
-use super::coarsening::coarsen;
 use super::dual::{DualBuilder, Key, pack, unpack};
 use super::error::HexDelaunayError;
-use super::extended_refinement::{
-    ExtendedState, Relocation, after_coarsening, extended_pass, relocated_centres,
+use super::extended::{
+    ExtendedState, Relocation, after_coarsening, apply_fin_patches, coarsen, extended_pass,
+    relocated_centres, take_relocated_centres,
 };
-use super::fin_vertices::apply_fin_patches;
 use super::hierarchy::{Cell, Hierarchy};
 use super::lattice::{Axial, DIRS, Frame, add, parents_of_midpoint};
 use super::min_enclosing_circle::min_enclosing_circle;
@@ -170,7 +169,7 @@ impl HexDelaunayStepper {
     /// (section 7.2, see `pslg.rs`) is one step.
     ///
     /// Extended mode: once every rule is at its fixed point, one step is the local coarsening
-    /// into blossoms (section 5.3, see `coarsening.rs`; [`last_merges`](Self::last_merges)
+    /// into blossoms (section 5.3, see `extended/coarsening.rs`; [`last_merges`](Self::last_merges)
     /// lists what it merged, [`last_splits`](Self::last_splits) is empty), after which the
     /// rules are checked again (a full extended pass, then the segment pass).
     pub fn step(&mut self) -> Result<bool, HexDelaunayError> {
@@ -423,14 +422,45 @@ impl HexDelaunayStepper {
     pub fn triangulation(&self) -> HexTriangulation {
         match self.try_triangulation() {
             Ok(t) => t,
-            Err(_) => self.dual(false).0,
+            Err(_) => self.dual(false, self.relocation()).0,
         }
     }
 
     /// [`triangulation`](Self::triangulation), failing if a segment cannot be inserted.
     pub fn try_triangulation(&self) -> Result<HexTriangulation, HexDelaunayError> {
+        self.triangulation_with(self.relocation())
+    }
+
+    /// [`try_triangulation`](Self::try_triangulation), taking the extended mode's cached
+    /// relocations out of the stepper instead of copying them, so that they are not held twice
+    /// while the dual is built (the one-shot [`super::hex_delaunay`]'s peak memory).
+    pub(super) fn take_triangulation(&mut self) -> Result<HexTriangulation, HexDelaunayError> {
+        let relocation = match self.mode {
+            HexDelaunayMode::Extended if self.is_done() => {
+                take_relocated_centres(&self.refinement, &mut self.extended, &self.segments)
+            }
+            _ => Relocation::default(),
+        };
+        self.triangulation_with(relocation)
+    }
+
+    /// The relocations (section 5.4) the dual uses: none until the extended refinement is done.
+    fn relocation(&self) -> Relocation {
+        match self.mode {
+            HexDelaunayMode::Extended if self.is_done() => {
+                relocated_centres(&self.refinement, &self.extended, &self.segments)
+            }
+            _ => Relocation::default(),
+        }
+    }
+
+    /// The triangulation with the given relocations, segments inserted once refinement is done.
+    fn triangulation_with(
+        &self,
+        relocation: Relocation,
+    ) -> Result<HexTriangulation, HexDelaunayError> {
         let with_segments = self.is_done() && !self.segments.is_empty();
-        let (mut t, segs, orig) = self.dual(with_segments);
+        let (mut t, segs, orig) = self.dual(with_segments, relocation);
         if with_segments {
             undo_inverting_snaps(&mut t.vertices, &t.triangles, &orig);
             let mut fixed = vec![false; t.vertices.len()];
@@ -444,16 +474,15 @@ impl HexDelaunayStepper {
 
     /// The dual, with the segments' hexagons snapped onto them if `snap`; also returns the
     /// segments as vertex pairs and the unsnapped positions of the snapped vertices.
-    fn dual(&self, snap: bool) -> (HexTriangulation, Vec<[u32; 2]>, FxHashMap<u32, Vec2>) {
+    fn dual(
+        &self,
+        snap: bool,
+        relocation: Relocation,
+    ) -> (HexTriangulation, Vec<[u32; 2]>, FxHashMap<u32, Vec2>) {
         let h = &self.refinement.hierarchy;
         let Relocation {
             mut moved, patches, ..
-        } = match self.mode {
-            HexDelaunayMode::Extended if self.is_done() => {
-                relocated_centres(&self.refinement, &self.extended, &self.segments)
-            }
-            _ => Relocation::default(),
-        };
+        } = relocation;
         let centres: FxHashSet<Key> = patches.iter().flat_map(|p| p.centres.clone()).collect();
         // Section 7.3: unoccupied hexagons met by one segment move onto it; their previous
         // positions are kept so that a snap inverting a triangle can be undone.

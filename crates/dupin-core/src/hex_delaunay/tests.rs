@@ -564,7 +564,7 @@ fn paper_data_sets_take_fewer_triangles_than_table_1() {
         println!("{name}: simple {simple}, extended {extended} triangles (paper: {paper})");
         assert!(simple < paper, "{name}: {simple} triangles, paper {paper}");
         // The extended mode still splits MOVED_CENTER_3 runs that fail its local check and
-        // forms few blossoms (see extended_refinement.rs, coarsening.rs), so it is not below
+        // forms few blossoms (see extended/refinement.rs, extended/coarsening.rs), so it is not below
         // the paper's counts everywhere; its counts are reported in BENCHMARKS.md, its
         // guarantees checked above.
     }
@@ -683,7 +683,7 @@ fn explore_edge_ratio() {
 /// of split, the angle bound fails (at level 6 already, 37.5°, if that pair is kept too).
 #[test]
 fn shortest_edge_counterexample() {
-    use super::extended_refinement::KEEP_FAILED_CHECKS_FROM;
+    use super::extended::KEEP_FAILED_CHECKS_FROM;
     let pts = [
         Vec2::new(-0.02704048987050455, 0.2759392856805694),
         Vec2::new(-0.08342531198940248, 0.8513278090847259),

@@ -41,267 +41,198 @@ pub struct PhexScene {
     pub expect_valid: bool,
 }
 
-#[allow(clippy::too_many_arguments)] // a table row: one argument per column
-fn cfg(
-    surface: &str,
-    params: &[(&str, f64)],
+/// One row of the scene table: the triangulation settings a scene chooses; the rest of its
+/// [`PhexConfig`] is the same for every scene ([`SceneSpec::config`]).
+#[derive(Debug, Clone, Copy)]
+struct SceneSpec {
+    surface: &'static str,
     method: TriangulationMethod,
     rule: LayerRule,
     swap: bool,
     across: (f64, f64),
     along: Option<(f64, f64)>,
     size: f64,
-) -> PhexConfig {
-    PhexConfig {
-        surface: surface.to_string(),
-        params: params.iter().map(|(k, v)| (k.to_string(), *v)).collect(),
-        twist: 0.0,
-        method,
-        rule,
-        swap,
-        across: Some(across),
-        along,
-        size: Some(size),
-        iterations: 10,
-        optimize: true,
-        loop_subdivision: false,
-        initialisation: Initialisation::TangentDuality,
-        boundary_faces: true,
+    field_angle: Option<f64>,
+    loop_subdivision: bool,
+    expect_valid: bool,
+}
+
+impl SceneSpec {
+    /// The settings most scenes share: method 2 (prescribed conjugation) with the ideal layer
+    /// height and the default bound, base curve along u, the whole along range, no field
+    /// angle, expected valid. `surface`, `across` and `size` are always set.
+    const DEFAULT: SceneSpec = SceneSpec {
+        surface: "",
+        method: TriangulationMethod::Prescribed,
+        rule: LayerRule::Ideal {
+            bound: DEFAULT_BOUND,
+        },
+        swap: false,
+        across: (0.0, 0.0),
+        along: None,
+        size: 0.0,
         field_angle: None,
-        lambda: PlanarityOptions::default().fairness,
-        mu: PlanarityOptions::default().distance,
+        loop_subdivision: false,
+        expect_valid: true,
+    };
+
+    /// The run configuration: these settings, no parameters or twist, 10 optimisation
+    /// iterations with the default weights, tangent-duality initialisation, boundary faces.
+    fn config(self) -> PhexConfig {
+        PhexConfig {
+            surface: self.surface.to_string(),
+            params: Vec::new(),
+            twist: 0.0,
+            method: self.method,
+            rule: self.rule,
+            swap: self.swap,
+            across: Some(self.across),
+            along: self.along,
+            size: Some(self.size),
+            iterations: 10,
+            optimize: true,
+            loop_subdivision: self.loop_subdivision,
+            initialisation: Initialisation::TangentDuality,
+            boundary_faces: true,
+            field_angle: self.field_angle,
+            lambda: PlanarityOptions::default().fairness,
+            mu: PlanarityOptions::default().distance,
+        }
     }
+}
+
+/// The table row of the named scene.
+fn scene_spec(name: &str) -> Option<SceneSpec> {
+    use LayerRule::*;
+    use TriangulationMethod::*;
+    let d = SceneSpec::DEFAULT;
+    Some(match name {
+        "cyclide-architecture" => SceneSpec {
+            surface: "dupin-cyclide",
+            across: (-1.2, 1.2),
+            size: 0.12,
+            ..d
+        },
+        "sphere-radial" => SceneSpec {
+            surface: "sphere",
+            method: Progressive,
+            across: (0.0, 1.2),
+            size: 0.1,
+            ..d
+        },
+        "sphere-diverging" => SceneSpec {
+            surface: "sphere",
+            method: Progressive,
+            across: (1.1, -0.9),
+            size: 0.08,
+            ..d
+        },
+        // Fig. 20 right: layers along loxodromes (10 degrees from the parallels) stacked
+        // along the orthogonal (conjugate) loxodromes.
+        "sphere-spiral" => SceneSpec {
+            surface: "sphere",
+            across: (-1.1, 1.1),
+            size: 0.07,
+            field_angle: Some(10f64.to_radians()),
+            ..d
+        },
+        "hyperboloid-invalid" => SceneSpec {
+            surface: "hyperboloid",
+            rule: Fixed(0.2),
+            across: (-1.0, 1.0),
+            size: 0.25,
+            expect_valid: false,
+            ..d
+        },
+        "hyperboloid-valid" => SceneSpec {
+            surface: "hyperboloid",
+            across: (-1.0, 1.0),
+            size: 0.15,
+            ..d
+        },
+        "cyclide-progressive" => SceneSpec {
+            surface: "dupin-cyclide",
+            method: Progressive,
+            across: (-0.8, 0.8),
+            size: 0.12,
+            ..d
+        },
+        "cyclide-prescribed" => SceneSpec {
+            surface: "dupin-cyclide",
+            across: (0.0, TAU),
+            size: 0.12,
+            ..d
+        },
+        "vase-bottom-up" => SceneSpec {
+            surface: "vase",
+            across: (0.1, 3.0),
+            size: 0.12,
+            ..d
+        },
+        "vase-longitudinal" => SceneSpec {
+            surface: "vase",
+            swap: true,
+            across: (0.0, TAU),
+            along: Some((0.0, 3.0)),
+            size: 0.12,
+            ..d
+        },
+        "torus-no-bound" => SceneSpec {
+            surface: "torus",
+            rule: Ideal { bound: 0.0 },
+            across: (0.0, PI),
+            size: 0.15,
+            expect_valid: false,
+            ..d
+        },
+        "torus-bound" => SceneSpec {
+            surface: "torus",
+            across: (0.0, TAU),
+            size: 0.15,
+            ..d
+        },
+        "minimal-surface" => SceneSpec {
+            surface: "enneper",
+            across: (-1.0, 1.0),
+            along: Some((-1.0, 1.0)),
+            size: 0.08,
+            ..d
+        },
+        "convex-loop" => SceneSpec {
+            surface: "ellipsoid",
+            across: (0.0, 1.0),
+            size: 0.06,
+            loop_subdivision: true,
+            ..d
+        },
+        "freeform-parabolic" => SceneSpec {
+            surface: FREEFORM,
+            across: (-1.5, 1.5),
+            along: Some((-2.0, 2.0)),
+            size: 0.08,
+            ..d
+        },
+        "cylinder-developable" => SceneSpec {
+            surface: "cylinder",
+            rule: Fixed(0.866),
+            swap: true,
+            across: (0.0, TAU),
+            along: Some((0.0, 2.0)),
+            size: 0.12,
+            ..d
+        },
+        _ => return None,
+    })
 }
 
 /// Builds the named scene.
 ///
 /// Errors: [`PhexError::UnknownScene`] with the list of names.
 pub fn phex_scene(name: &str) -> Result<PhexScene, PhexError> {
-    use LayerRule::*;
-    use TriangulationMethod::*;
-    let ideal = Ideal {
-        bound: DEFAULT_BOUND,
-    };
-    let (config, expect_valid) = match name {
-        "cyclide-architecture" => (
-            cfg(
-                "dupin-cyclide",
-                &[],
-                Prescribed,
-                ideal,
-                false,
-                (-1.2, 1.2),
-                None,
-                0.12,
-            ),
-            true,
-        ),
-        "sphere-radial" => (
-            cfg(
-                "sphere",
-                &[],
-                Progressive,
-                ideal,
-                false,
-                (0.0, 1.2),
-                None,
-                0.1,
-            ),
-            true,
-        ),
-        "sphere-diverging" => (
-            cfg(
-                "sphere",
-                &[],
-                Progressive,
-                ideal,
-                false,
-                (1.1, -0.9),
-                None,
-                0.08,
-            ),
-            true,
-        ),
-        "sphere-spiral" => {
-            let mut c = cfg(
-                "sphere",
-                &[],
-                Prescribed,
-                ideal,
-                false,
-                (-1.1, 1.1),
-                None,
-                0.07,
-            );
-            // Fig. 20 right: layers along loxodromes (10 degrees from the parallels) stacked
-            // along the orthogonal (conjugate) loxodromes.
-            c.field_angle = Some(10f64.to_radians());
-            (c, true)
-        }
-        "hyperboloid-invalid" => (
-            cfg(
-                "hyperboloid",
-                &[],
-                Prescribed,
-                Fixed(0.2),
-                false,
-                (-1.0, 1.0),
-                None,
-                0.25,
-            ),
-            false,
-        ),
-        "hyperboloid-valid" => (
-            cfg(
-                "hyperboloid",
-                &[],
-                Prescribed,
-                ideal,
-                false,
-                (-1.0, 1.0),
-                None,
-                0.15,
-            ),
-            true,
-        ),
-        "cyclide-progressive" => (
-            cfg(
-                "dupin-cyclide",
-                &[],
-                Progressive,
-                ideal,
-                false,
-                (-0.8, 0.8),
-                None,
-                0.12,
-            ),
-            true,
-        ),
-        "cyclide-prescribed" => (
-            cfg(
-                "dupin-cyclide",
-                &[],
-                Prescribed,
-                ideal,
-                false,
-                (0.0, TAU),
-                None,
-                0.12,
-            ),
-            true,
-        ),
-        "vase-bottom-up" => (
-            cfg(
-                "vase",
-                &[],
-                Prescribed,
-                ideal,
-                false,
-                (0.1, 3.0),
-                None,
-                0.12,
-            ),
-            true,
-        ),
-        "vase-longitudinal" => (
-            cfg(
-                "vase",
-                &[],
-                Prescribed,
-                ideal,
-                true,
-                (0.0, TAU),
-                Some((0.0, 3.0)),
-                0.12,
-            ),
-            true,
-        ),
-        "torus-no-bound" => (
-            cfg(
-                "torus",
-                &[],
-                Prescribed,
-                Ideal { bound: 0.0 },
-                false,
-                (0.0, PI),
-                None,
-                0.15,
-            ),
-            false,
-        ),
-        "torus-bound" => (
-            cfg(
-                "torus",
-                &[],
-                Prescribed,
-                ideal,
-                false,
-                (0.0, TAU),
-                None,
-                0.15,
-            ),
-            true,
-        ),
-        "minimal-surface" => (
-            cfg(
-                "enneper",
-                &[],
-                Prescribed,
-                ideal,
-                false,
-                (-1.0, 1.0),
-                Some((-1.0, 1.0)),
-                0.08,
-            ),
-            true,
-        ),
-        "convex-loop" => {
-            let mut c = cfg(
-                "ellipsoid",
-                &[],
-                Prescribed,
-                ideal,
-                false,
-                (0.0, 1.0),
-                None,
-                0.06,
-            );
-            c.loop_subdivision = true;
-            (c, true)
-        }
-        "freeform-parabolic" => (
-            cfg(
-                FREEFORM,
-                &[],
-                Prescribed,
-                ideal,
-                false,
-                (-1.5, 1.5),
-                Some((-2.0, 2.0)),
-                0.08,
-            ),
-            true,
-        ),
-        "cylinder-developable" => (
-            cfg(
-                "cylinder",
-                &[],
-                Prescribed,
-                Fixed(0.866),
-                true,
-                (0.0, TAU),
-                Some((0.0, 2.0)),
-                0.12,
-            ),
-            true,
-        ),
-        _ => {
-            return Err(PhexError::UnknownScene {
-                name: name.to_string(),
-                known: PHEX_SCENES.join(", "),
-            });
-        }
-    };
+    let spec = scene_spec(name).ok_or_else(|| PhexError::UnknownScene {
+        name: name.to_string(),
+        known: PHEX_SCENES.join(", "),
+    })?;
     let name = PHEX_SCENES
         .iter()
         .find(|n| **n == name)
@@ -309,8 +240,8 @@ pub fn phex_scene(name: &str) -> Result<PhexScene, PhexError> {
         .unwrap_or("");
     Ok(PhexScene {
         name,
-        config,
-        expect_valid,
+        config: spec.config(),
+        expect_valid: spec.expect_valid,
     })
 }
 

@@ -258,93 +258,59 @@ impl BlockNormal {
         elim: usize,
     ) -> Result<(), SolverError> {
         let nb = layout.num_blocks();
-        let mut elim = elim.min(nb);
-        if elim == 0 {
-            elim = nb;
-        }
-        if elim < nb {
-            let two = (0..sys.num_rows()).any(|r| {
-                sys.row(r)
-                    .iter()
-                    .filter(|e| e.block as usize >= elim)
-                    .count()
-                    > 1
-            });
-            if two {
-                elim = nb;
-            }
-        }
+        let nk = kept_blocks(sys, nb, elim);
         if let Some(m) = &self.map
-            && m.elim == elim
+            && m.elim == nk
             && m.pattern.same_pattern(sys)
         {
             return Ok(());
         }
         self.map = None;
-        let nk = elim;
-        // The block pairs of S, in the order the row map reads their slots back: the kept
-        // diagonals, every row's kept pairs, every local block's couplings.
-        let mut pairs: Vec<(u32, u32)> = (0..nk as u32).map(|b| (b, b)).collect();
-        let mut pair_start = Vec::with_capacity(sys.num_rows() + 1);
-        let mut row_elim = Vec::with_capacity(sys.num_rows());
-        let mut transposed = Vec::new();
-        let mut couplings: Vec<(u32, u32)> = Vec::new();
-        pair_start.push(0u32);
-        for r in 0..sys.num_rows() {
-            let row = sys.row(r);
-            let mut local = NONE;
-            for (i, a) in row.iter().enumerate() {
-                if a.block as usize >= nk {
-                    local = i as u32;
-                    continue;
-                }
-                for b in &row[i..] {
-                    if b.block as usize >= nk {
-                        continue;
-                    }
-                    transposed.push(b.block < a.block);
-                    pairs.push((a.block.min(b.block), a.block.max(b.block)));
-                }
-            }
-            if local != NONE {
-                let e = row[local as usize].block - nk as u32;
-                for a in row.iter().filter(|a| (a.block as usize) < nk) {
-                    couplings.push((e, a.block));
-                }
-            }
-            row_elim.push(local);
-            pair_start.push(transposed.len() as u32);
-        }
-        let ne = nb - nk;
-        couplings.sort_unstable();
-        couplings.dedup();
-        let mut e_start = vec![0u32; ne + 1];
-        for &(e, _) in &couplings {
-            e_start[e as usize + 1] += 1;
-        }
-        for e in 0..ne {
-            e_start[e + 1] += e_start[e];
-        }
-        let e_cols: Vec<u32> = couplings.iter().map(|p| p.1).collect();
-        let mut e_pair_start = vec![0u32];
-        let first_e_pair = pairs.len();
-        for e in 0..ne {
-            let cols = &e_cols[e_start[e] as usize..e_start[e + 1] as usize];
-            for (i, &ci) in cols.iter().enumerate() {
-                for &cj in &cols[i..] {
-                    pairs.push((ci, cj));
-                }
-            }
-            e_pair_start.push((pairs.len() - first_e_pair) as u32);
-        }
-        // Reuse the analysed structure if it holds every pair and this pattern fills it.
+        let p = BlockPairs::of(sys, nb, nk);
+        let slots = self.slots(layout, nk, &p.pairs)?;
+        let diag_slot = slots[..nk].to_vec();
+        let row_pairs = &slots[nk..p.first_e_pair];
+        let pair_slot: Vec<u32> = row_pairs
+            .iter()
+            .zip(&p.transposed)
+            .map(|(&s, &t)| if t { s | TRANSPOSED } else { s })
+            .collect();
+        let e_pair = slots[p.first_e_pair..].to_vec();
+        let b_index = coupling_index(sys, nk, &p.row_elim, &p.e_start, &p.e_cols);
+        self.reset_storage(nb - nk, p.e_cols.len());
+        let mut pattern = BlockSystem::default();
+        pattern.clone_from(sys);
+        self.map = Some(RowMap {
+            pattern,
+            elim: nk,
+            diag_slot,
+            pair_start: p.pair_start,
+            pair_slot,
+            row_elim: p.row_elim,
+            b_index,
+            e_start: p.e_start,
+            e_cols: p.e_cols,
+            e_pair_start: p.e_pair_start,
+            e_pair,
+        });
+        Ok(())
+    }
+
+    /// The slot of every pair in the analysed structure: the current one if it holds every
+    /// pair and this pattern fills it (at least 90 % of its slots), else a new analysis.
+    fn slots(
+        &mut self,
+        layout: &BlockLayout,
+        nk: usize,
+        pairs: &[(u32, u32)],
+    ) -> Result<Vec<u32>, SolverError> {
         let reused = self.structure.as_ref().and_then(|s| {
             if s.nk != nk {
                 return None;
             }
             let mut slots = Vec::with_capacity(pairs.len());
             let mut used = vec![false; s.slots()];
-            for &(i, j) in &pairs {
+            for &(i, j) in pairs {
                 let k = s.find(i, j)?;
                 used[k as usize] = true;
                 slots.push(k);
@@ -352,45 +318,22 @@ impl BlockNormal {
             let filled = used.iter().filter(|&&u| u).count();
             (10 * filled >= 9 * s.slots()).then_some(slots)
         });
-        let slots = match reused {
+        Ok(match reused {
             Some(slots) => slots,
             None => {
                 self.structure = None;
-                let (s, slots) = Structure::analyse(layout, nk, &pairs)?;
+                let (s, slots) = Structure::analyse(layout, nk, pairs)?;
                 self.analyses += 1;
                 self.structure = Some(s);
                 slots
             }
-        };
-        let diag_slot = slots[..nk].to_vec();
-        let row_pairs = &slots[nk..first_e_pair];
-        let pair_slot: Vec<u32> = row_pairs
-            .iter()
-            .zip(&transposed)
-            .map(|(&s, &t)| if t { s | TRANSPOSED } else { s })
-            .collect();
-        let e_pair = slots[first_e_pair..].to_vec();
-        let mut b_index = Vec::new();
-        for (r, &local) in row_elim.iter().enumerate() {
-            let row = sys.row(r);
-            if local == NONE {
-                b_index.extend(std::iter::repeat_n(NONE, row.len()));
-                continue;
-            }
-            let e = (row[local as usize].block as usize) - nk;
-            let (s, t) = (e_start[e] as usize, e_start[e + 1] as usize);
-            for a in row {
-                b_index.push(if (a.block as usize) < nk {
-                    let k = e_cols[s..t]
-                        .binary_search(&a.block)
-                        .expect("every coupling is listed");
-                    (s + k) as u32
-                } else {
-                    NONE
-                });
-            }
-        }
-        let st = self.structure.as_ref().expect("structure set above");
+        })
+    }
+
+    /// Zeroed numeric storage for the analysed structure, `ne` local blocks and `nb_blocks`
+    /// coupling blocks; nothing factored.
+    fn reset_storage(&mut self, ne: usize, nb_blocks: usize) {
+        let st = self.structure.as_ref().expect("structure set by `slots`");
         self.acc.clear();
         self.acc.resize(st.slots(), [0.0; 16]);
         self.c.clear();
@@ -398,29 +341,13 @@ impl BlockNormal {
         self.inv.clear();
         self.inv.resize(ne, Block::zeros());
         self.b.clear();
-        self.b.resize(e_cols.len(), Block::zeros());
+        self.b.resize(nb_blocks, Block::zeros());
         let nnz = st.chol.nnz();
         self.base.clear();
         self.base.resize(nnz, 0.0);
         self.values.clear();
         self.values.resize(nnz, 0.0);
         self.factored = false;
-        let mut pattern = BlockSystem::default();
-        pattern.clone_from(sys);
-        self.map = Some(RowMap {
-            pattern,
-            elim: nk,
-            diag_slot,
-            pair_start,
-            pair_slot,
-            row_elim,
-            b_index,
-            e_start,
-            e_cols,
-            e_pair_start,
-            e_pair,
-        });
-        Ok(())
     }
 
     /// Assembles `JᵀJ` of `sys` (kept part, local blocks and couplings) and returns the
@@ -642,6 +569,148 @@ impl BlockNormal {
             ))
         }
     }
+}
+
+/// The number of kept blocks for local blocks `elim..`: `nb` (nothing eliminated) when
+/// `elim` is 0 or when a row touches two local blocks.
+fn kept_blocks(sys: &BlockSystem, nb: usize, elim: usize) -> usize {
+    let mut elim = elim.min(nb);
+    if elim == 0 {
+        elim = nb;
+    }
+    if elim < nb {
+        let two = (0..sys.num_rows()).any(|r| {
+            sys.row(r)
+                .iter()
+                .filter(|e| e.block as usize >= elim)
+                .count()
+                > 1
+        });
+        if two {
+            elim = nb;
+        }
+    }
+    elim
+}
+
+/// The block pairs of S, in the order the row map reads their slots back: the kept
+/// diagonals, every row's kept pairs, every local block's couplings; with the rows' and the
+/// local blocks' indices into them.
+struct BlockPairs {
+    pairs: Vec<(u32, u32)>,
+    /// Per row, the start of its kept pairs in `transposed` (and after the diagonals, in
+    /// `pairs`).
+    pair_start: Vec<u32>,
+    /// Per row kept pair, whether its second entry has the smaller block.
+    transposed: Vec<bool>,
+    /// Per row, the position of its local-block entry, or `NONE`.
+    row_elim: Vec<u32>,
+    /// Per local block, the kept blocks it couples (sorted): `e_cols[e_start[e]..]`.
+    e_start: Vec<u32>,
+    e_cols: Vec<u32>,
+    /// Per local block, the start of its coupling pairs after `first_e_pair`.
+    e_pair_start: Vec<u32>,
+    first_e_pair: usize,
+}
+
+impl BlockPairs {
+    fn of(sys: &BlockSystem, nb: usize, nk: usize) -> Self {
+        let mut pairs: Vec<(u32, u32)> = (0..nk as u32).map(|b| (b, b)).collect();
+        let mut pair_start = Vec::with_capacity(sys.num_rows() + 1);
+        let mut row_elim = Vec::with_capacity(sys.num_rows());
+        let mut transposed = Vec::new();
+        let mut couplings: Vec<(u32, u32)> = Vec::new();
+        pair_start.push(0u32);
+        for r in 0..sys.num_rows() {
+            let row = sys.row(r);
+            let mut local = NONE;
+            for (i, a) in row.iter().enumerate() {
+                if a.block as usize >= nk {
+                    local = i as u32;
+                    continue;
+                }
+                for b in &row[i..] {
+                    if b.block as usize >= nk {
+                        continue;
+                    }
+                    transposed.push(b.block < a.block);
+                    pairs.push((a.block.min(b.block), a.block.max(b.block)));
+                }
+            }
+            if local != NONE {
+                let e = row[local as usize].block - nk as u32;
+                for a in row.iter().filter(|a| (a.block as usize) < nk) {
+                    couplings.push((e, a.block));
+                }
+            }
+            row_elim.push(local);
+            pair_start.push(transposed.len() as u32);
+        }
+        let ne = nb - nk;
+        couplings.sort_unstable();
+        couplings.dedup();
+        let mut e_start = vec![0u32; ne + 1];
+        for &(e, _) in &couplings {
+            e_start[e as usize + 1] += 1;
+        }
+        for e in 0..ne {
+            e_start[e + 1] += e_start[e];
+        }
+        let e_cols: Vec<u32> = couplings.iter().map(|p| p.1).collect();
+        let mut e_pair_start = vec![0u32];
+        let first_e_pair = pairs.len();
+        for e in 0..ne {
+            let cols = &e_cols[e_start[e] as usize..e_start[e + 1] as usize];
+            for (i, &ci) in cols.iter().enumerate() {
+                for &cj in &cols[i..] {
+                    pairs.push((ci, cj));
+                }
+            }
+            e_pair_start.push((pairs.len() - first_e_pair) as u32);
+        }
+        BlockPairs {
+            pairs,
+            pair_start,
+            transposed,
+            row_elim,
+            e_start,
+            e_cols,
+            e_pair_start,
+            first_e_pair,
+        }
+    }
+}
+
+/// Per entry of a row with a local block: the index of its coupling block `B` (`NONE` for
+/// the local entry and for rows without one).
+fn coupling_index(
+    sys: &BlockSystem,
+    nk: usize,
+    row_elim: &[u32],
+    e_start: &[u32],
+    e_cols: &[u32],
+) -> Vec<u32> {
+    let mut b_index = Vec::new();
+    for (r, &local) in row_elim.iter().enumerate() {
+        let row = sys.row(r);
+        if local == NONE {
+            b_index.extend(std::iter::repeat_n(NONE, row.len()));
+            continue;
+        }
+        let e = (row[local as usize].block as usize) - nk;
+        let (s, t) = (e_start[e] as usize, e_start[e + 1] as usize);
+        for a in row {
+            b_index.push(if (a.block as usize) < nk {
+                let k = e_cols[s..t]
+                    .binary_search(&a.block)
+                    .expect("every coupling is listed");
+                (s + k) as u32
+            } else {
+                NONE
+            });
+        }
+    }
+    b_index
 }
 
 #[cfg(test)]

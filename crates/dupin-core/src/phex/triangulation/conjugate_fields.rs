@@ -186,28 +186,14 @@ pub fn triangulate_along_fields(
     angle: f64,
     size: f64,
 ) -> Result<Triangulation, PhexError> {
-    if !angle.is_finite() {
-        return Err(PhexError::BadParameter("field angle must be finite".into()));
-    }
-    if !(size.is_finite() && size > 0.0) {
-        return Err(PhexError::BadSize(format!(
-            "size {size} must be a positive length"
-        )));
-    }
-    let (a0, a1) = spec.along;
-    if !(a1 > a0) || !spec.start.is_finite() || !spec.end.is_finite() {
-        return Err(PhexError::BadParameter("empty or non-finite region".into()));
-    }
+    check_parameters(spec, angle, size)?;
     let f = ConjugateFields::new(s, angle);
-    let dir = if spec.end >= spec.start { 1.0 } else { -1.0 };
-    let across_of = |p: Vec2| if spec.swap { p.x } else { p.y };
-    let along_of = |p: Vec2| if spec.swap { p.y } else { p.x };
-    let (lo, hi) = (spec.start.min(spec.end), spec.start.max(spec.end));
-    let in_band = move |p: Vec2| {
-        let a = if spec.swap { p.x } else { p.y };
-        a >= lo - 1e-9 && a <= hi + 1e-9
-    };
-    let seed = to_uv(spec.swap, 0.5 * (a0 + a1), 0.5 * (spec.start + spec.end));
+    let region = Region::new(s, &f, spec, size);
+    let seed = to_uv(
+        spec.swap,
+        0.5 * (spec.along.0 + spec.along.1),
+        0.5 * (spec.start + spec.end),
+    );
     if f.directions(seed).is_none() {
         return Err(PhexError::NoValidTriangulation(format!(
             "the first field at {:.1} degrees is asymptotic (self-conjugate) or undefined at the \
@@ -215,25 +201,7 @@ pub fn triangulate_along_fields(
             angle.to_degrees()
         )));
     }
-    let step = size / 8.0;
-    let along_ref = to_uv(spec.swap, 1.0, 0.0);
-    // Base flow line: through the middle of the region, over the along span, inside the band.
-    let fwd = f.trace(seed, 0, along_ref, step, 1e6 * size, &|p| {
-        in_band(p) && along_of(p) <= a1 + 1e-9
-    });
-    let bwd = f.trace(seed, 0, -along_ref, step, 1e6 * size, &|p| {
-        in_band(p) && along_of(p) >= a0 - 1e-9
-    });
-    let mut line: Vec<Vec2> = bwd.into_iter().rev().collect();
-    line.extend(fwd.into_iter().skip(1));
-    let base = resample(s, &f.dom, &line, size)?;
-    let n = base.len() - 1;
-    if !(6..=4000).contains(&n) {
-        return Err(PhexError::BadSize(format!(
-            "the base flow line gives {n} samples; use between 6 and 4000 (change --size or \
-             --field-angle: the base line leaves the region early)"
-        )));
-    }
+    let base = region.base_line(seed)?;
     let mut t = Triangulation {
         uv: vec![],
         positions: vec![],
@@ -243,35 +211,9 @@ pub fn triangulate_along_fields(
         closed_along: false,
         layer_steps: vec![],
     };
-    let push = |t: &mut Triangulation, uv: Vec2| -> Result<u32, PhexError> {
-        let (u, v) = f.dom.normalize(uv.x, uv.y);
-        let d = s.derivatives(u, v);
-        let nrm = d.pu.cross(&d.pv).try_normalize(1e-300).ok_or_else(|| {
-            PhexError::NoValidTriangulation(format!(
-                "the parametrisation is singular at ({u:.3}, {v:.3}); shrink the region"
-            ))
-        })?;
-        if !d.p.iter().all(|c| c.is_finite()) {
-            return Err(PhexError::NoValidTriangulation(
-                "the surface is not finite in the region".into(),
-            ));
-        }
-        t.uv.push(uv);
-        t.positions.push(d.p);
-        t.normals.push(nrm);
-        Ok((t.uv.len() - 1) as u32)
-    };
-    // Layers on a staggered lattice: point g of an even layer sits at x = g, of an odd one at
-    // x = g + 1/2; `first` is the lattice index of a layer's first point. Points leaving the
-    // band are trimmed, so the layers fill the region even when the fields are tilted.
-    struct Layer {
-        first: i64,
-        pts: Vec<Vec2>,
-        ids: Vec<u32>,
-    }
     let mut ids = vec![];
     for &p in &base {
-        ids.push(push(&mut t, p)?);
+        ids.push(region.push(&mut t, p)?);
     }
     t.layers.push(ids.clone());
     let base = Layer {
@@ -282,7 +224,7 @@ pub fn triangulate_along_fields(
     // Layers from the base line toward `end`, then toward `start`.
     let mut down = vec![];
     for sign in [1.0, -1.0] {
-        let across_ref = to_uv(spec.swap, 0.0, dir * sign);
+        let across_ref = to_uv(spec.swap, 0.0, region.dir * sign);
         let mut layers = vec![Layer {
             first: 0,
             pts: base.pts.clone(),
@@ -290,172 +232,25 @@ pub fn triangulate_along_fields(
         }];
         let mut prev_ratio: Option<f64> = None;
         for m in 1..spec.max_layers {
-            let cur = &layers[m - 1];
-            let get = |l: &Layer, g: i64| {
-                let i = g - l.first;
-                (i >= 0 && (i as usize) < l.pts.len()).then(|| l.pts[i as usize])
-            };
-            let (c0, c1) = (cur.first, cur.first + cur.pts.len() as i64);
-            // Feet (lattice index, point, ideal height) of the D_G flow lines: odd layers over the
-            // segments (g, g+1), even ones over (g-1, g) plus the ends over layer m-2.
-            let mut feet: Vec<(i64, Vec2, Option<f64>)> = vec![];
-            let mut ratios = vec![];
-            let (g0, g1) = if m % 2 == 1 {
-                (c0, c1 - 1)
-            } else {
-                (c0, c1 + 1)
-            };
-            for g in g0..g1 {
-                let (ia, ib) = if m % 2 == 1 { (g, g + 1) } else { (g - 1, g) };
-                match (get(cur, ia), get(cur, ib)) {
-                    (Some(a), Some(b)) => {
-                        let ab = (pos(s, &f.dom, b) - pos(s, &f.dom, a)).norm();
-                        let r = match spec.rule {
-                            LayerRule::Fixed(r) => r,
-                            LayerRule::Ideal { bound } => match ideal_ratio(s, a, b) {
-                                Some(r) => bounded_ratio(r, bound),
-                                // Section 5.3: re-use the previous step across a parabolic stretch.
-                                None => prev_ratio.unwrap_or(0.75f64.sqrt()),
-                            },
-                        };
-                        ratios.push(r);
-                        feet.push((g, (a + b) / 2.0, Some(r * ab)));
-                    }
-                    _ => {
-                        if let Some(p) = get(&layers[m - 2], g) {
-                            feet.push((g, p, None));
-                        }
-                    }
-                }
-            }
-            if ratios.is_empty() {
-                break;
-            }
-            // Ideal apexes C_i along the D_G flow lines.
-            let mut ideal = vec![];
-            for (_, foot, h) in &feet {
-                if let Some(h) = h {
-                    let l = f.trace(*foot, 1, across_ref, h / 8.0, *h, &|_| true);
-                    ideal.push((l.len() == 9).then(|| l[8]));
-                }
-            }
-            let Some(mid) = ideal
-                .iter()
-                .flatten()
-                .nth(ideal.iter().flatten().count() / 2)
-            else {
+            let Some(next) = region.next_layer(&layers, m, across_ref, prev_ratio) else {
                 break;
             };
-            let prev_len: f64 = cur
-                .pts
-                .windows(2)
-                .map(|w| (pos(s, &f.dom, w[1]) - pos(s, &f.dom, w[0])).norm())
-                .sum();
-            let hmax = feet.iter().filter_map(|x| x.2).fold(0.0, f64::max);
-            // Pass 1 through the median ideal apex; pass 2 through the one that came out lowest
-            // relative to its ideal height, so that all are at least ideal (above DE).
-            let mut sp = *mid;
-            let mut found: Vec<Option<Vec2>> = vec![];
-            for pass in 0..2 {
-                let reach = 1.5 * prev_len + 4.0 * hmax;
-                let fwd = f.trace(sp, 0, along_ref, step, reach, &|_| true);
-                let bwd = f.trace(sp, 0, -along_ref, step, reach, &|_| true);
-                let mut l1: Vec<Vec2> = bwd.into_iter().rev().collect();
-                l1.extend(fwd.into_iter().skip(1));
-                let l1 = Polyline::new(l1);
-                found.clear();
-                let mut rel = vec![];
-                for (_, foot, h) in &feet {
-                    let lim = 4.0 * h.unwrap_or(hmax).max(hmax);
-                    let x = hit(&f, *foot, across_ref, step, lim, &l1);
-                    found.push(x.map(|x| x.0));
-                    if let Some(h) = h {
-                        rel.push(x.map_or(f64::INFINITY, |x| x.1 / h));
-                    }
-                }
-                let (imin, &low) = rel
-                    .iter()
-                    .enumerate()
-                    .min_by(|a, b| a.1.total_cmp(b.1))
-                    .unwrap_or((0, &1.0));
-                match ideal.get(imin) {
-                    Some(Some(p)) if pass == 0 && low < 0.999 => sp = *p,
-                    _ => break,
-                }
-            }
-            // The longest run of consecutive points inside the band and before `end`.
-            let ok = |p: &Option<Vec2>| p.is_some_and(in_band);
-            let (mut best, mut run_start) = ((0usize, 0usize), None);
-            for i in 0..=found.len() {
-                if i < found.len() && ok(&found[i]) {
-                    run_start.get_or_insert(i);
-                } else if let Some(st) = run_start.take()
-                    && i - st > best.1 - best.0
-                {
-                    best = (st, i);
-                }
-            }
-            if best.1 - best.0 < 2 {
-                break;
-            }
-            prev_ratio = Some(ratios.iter().sum::<f64>() / ratios.len() as f64);
-            let pts: Vec<Vec2> = found[best.0..best.1].iter().flatten().copied().collect();
-            let first = feet[best.0].0;
-            let mean_step = pts
-                .iter()
-                .zip(&feet[best.0..best.1])
-                .map(|(p, (_, q, _))| (across_of(*p) - across_of(*q)).abs())
-                .sum::<f64>()
-                / pts.len() as f64;
+            prev_ratio = Some(next.ratio);
             let mut new_ids = vec![];
-            for &p in &pts {
-                new_ids.push(push(&mut t, p)?);
+            for &p in &next.pts {
+                new_ids.push(region.push(&mut t, p)?);
             }
             let layer = Layer {
-                first,
-                pts,
+                first: next.first,
+                pts: next.pts,
                 ids: new_ids.clone(),
             };
-            let id = |l: &Layer, g: i64| {
-                let i = g - l.first;
-                (i >= 0 && (i as usize) < l.ids.len()).then(|| l.ids[i as usize])
-            };
-            let cur = &layers[m - 1];
-            let tri = |t: &mut Triangulation, a: Option<u32>, b: Option<u32>, c: Option<u32>| {
-                let (Some(a), Some(b), Some(c)) = (a, b, c) else {
-                    return;
-                };
-                // Orient along the surface normal (the fields' orientation is arbitrary).
-                let (pa, pb, pc) = (
-                    t.positions[a as usize],
-                    t.positions[b as usize],
-                    t.positions[c as usize],
-                );
-                if (pb - pa).cross(&(pc - pa)).dot(&t.normals[a as usize]) >= 0.0 {
-                    t.triangles.push([a, b, c]);
-                } else {
-                    t.triangles.push([a, c, b]);
-                }
-            };
-            let lo = cur.first.min(layer.first) - 1;
-            let hi =
-                (cur.first + cur.ids.len() as i64).max(layer.first + layer.ids.len() as i64) + 1;
-            for g in lo..hi {
-                if m % 2 == 1 {
-                    // New point g (x = g + 1/2) over the segment (g, g+1).
-                    tri(&mut t, id(cur, g), id(cur, g + 1), id(&layer, g));
-                    tri(&mut t, id(&layer, g), id(cur, g + 1), id(&layer, g + 1));
-                } else {
-                    // New point g (x = g) over the segment (g-1, g) of the odd layer.
-                    tri(&mut t, id(cur, g - 1), id(cur, g), id(&layer, g));
-                    tri(&mut t, id(&layer, g), id(cur, g), id(&layer, g + 1));
-                }
-            }
+            stitch(&mut t, &layers[m - 1], &layer, m);
             if sign > 0.0 {
                 t.layers.push(new_ids);
-                t.layer_steps.push(mean_step);
+                t.layer_steps.push(next.mean_step);
             } else {
-                down.push((new_ids, mean_step));
+                down.push((new_ids, next.mean_step));
             }
             layers.push(layer);
         }
@@ -477,6 +272,334 @@ pub fn triangulate_along_fields(
         )));
     }
     Ok(t)
+}
+
+/// The finite angle, positive size and non-empty region [`triangulate_along_fields`] needs.
+fn check_parameters(spec: &TriangulationSpec, angle: f64, size: f64) -> Result<(), PhexError> {
+    if !angle.is_finite() {
+        return Err(PhexError::BadParameter("field angle must be finite".into()));
+    }
+    if !(size.is_finite() && size > 0.0) {
+        return Err(PhexError::BadSize(format!(
+            "size {size} must be a positive length"
+        )));
+    }
+    let (a0, a1) = spec.along;
+    if !(a1 > a0) || !spec.start.is_finite() || !spec.end.is_finite() {
+        return Err(PhexError::BadParameter("empty or non-finite region".into()));
+    }
+    Ok(())
+}
+
+/// A layer on the staggered lattice: point g of an even layer sits at x = g, of an odd one at
+/// x = g + 1/2; `first` is the lattice index of the layer's first point. Points leaving the
+/// band are trimmed, so the layers fill the region even when the fields are tilted.
+struct Layer {
+    first: i64,
+    pts: Vec<Vec2>,
+    ids: Vec<u32>,
+}
+
+impl Layer {
+    /// The point at lattice index `g`, if the layer has one.
+    fn get(&self, g: i64) -> Option<Vec2> {
+        let i = g - self.first;
+        (i >= 0 && (i as usize) < self.pts.len()).then(|| self.pts[i as usize])
+    }
+
+    /// The vertex at lattice index `g`, if the layer has one.
+    fn id(&self, g: i64) -> Option<u32> {
+        let i = g - self.first;
+        (i >= 0 && (i as usize) < self.ids.len()).then(|| self.ids[i as usize])
+    }
+}
+
+/// The foot of a D_G flow line: lattice index, point, ideal height (`None` at a layer's end,
+/// over layer m-2).
+type Foot = (i64, Vec2, Option<f64>);
+
+/// The points of a new layer before they become vertices.
+struct NextLayer {
+    /// Lattice index of the first point.
+    first: i64,
+    pts: Vec<Vec2>,
+    /// Mean parameter step across from the feet to the new points.
+    mean_step: f64,
+    /// Mean layer ratio of the step (re-used across a parabolic stretch).
+    ratio: f64,
+}
+
+/// What every layer of one triangulation shares: the surface, the fields, the band between
+/// `start` and `end` and the tracing step.
+struct Region<'a> {
+    s: &'a dyn Surface,
+    f: &'a ConjugateFields<'a>,
+    spec: &'a TriangulationSpec,
+    size: f64,
+    /// +1 when the layers go toward increasing across-parameters from `start` to `end`.
+    dir: f64,
+    lo: f64,
+    hi: f64,
+    step: f64,
+    along_ref: Vec2,
+}
+
+impl<'a> Region<'a> {
+    fn new(
+        s: &'a dyn Surface,
+        f: &'a ConjugateFields<'a>,
+        spec: &'a TriangulationSpec,
+        size: f64,
+    ) -> Self {
+        Region {
+            s,
+            f,
+            spec,
+            size,
+            dir: if spec.end >= spec.start { 1.0 } else { -1.0 },
+            lo: spec.start.min(spec.end),
+            hi: spec.start.max(spec.end),
+            step: size / 8.0,
+            along_ref: to_uv(spec.swap, 1.0, 0.0),
+        }
+    }
+
+    fn across_of(&self, p: Vec2) -> f64 {
+        if self.spec.swap { p.x } else { p.y }
+    }
+
+    fn along_of(&self, p: Vec2) -> f64 {
+        if self.spec.swap { p.y } else { p.x }
+    }
+
+    fn in_band(&self, p: Vec2) -> bool {
+        let a = if self.spec.swap { p.x } else { p.y };
+        a >= self.lo - 1e-9 && a <= self.hi + 1e-9
+    }
+
+    fn pos(&self, p: Vec2) -> Vec3 {
+        pos(self.s, &self.f.dom, p)
+    }
+
+    /// The base flow line through `seed`, the middle of the region, over the along span,
+    /// inside the band, sampled every `size`.
+    fn base_line(&self, seed: Vec2) -> Result<Vec<Vec2>, PhexError> {
+        let (a0, a1) = self.spec.along;
+        let (f, step, size) = (self.f, self.step, self.size);
+        let fwd = f.trace(seed, 0, self.along_ref, step, 1e6 * size, &|p| {
+            self.in_band(p) && self.along_of(p) <= a1 + 1e-9
+        });
+        let bwd = f.trace(seed, 0, -self.along_ref, step, 1e6 * size, &|p| {
+            self.in_band(p) && self.along_of(p) >= a0 - 1e-9
+        });
+        let mut line: Vec<Vec2> = bwd.into_iter().rev().collect();
+        line.extend(fwd.into_iter().skip(1));
+        let base = resample(self.s, &f.dom, &line, size)?;
+        let n = base.len() - 1;
+        if !(6..=4000).contains(&n) {
+            return Err(PhexError::BadSize(format!(
+                "the base flow line gives {n} samples; use between 6 and 4000 (change --size or \
+                 --field-angle: the base line leaves the region early)"
+            )));
+        }
+        Ok(base)
+    }
+
+    /// Adds the vertex at the parameters `uv` (position and unit normal).
+    fn push(&self, t: &mut Triangulation, uv: Vec2) -> Result<u32, PhexError> {
+        let (u, v) = self.f.dom.normalize(uv.x, uv.y);
+        let d = self.s.derivatives(u, v);
+        let nrm = d.pu.cross(&d.pv).try_normalize(1e-300).ok_or_else(|| {
+            PhexError::NoValidTriangulation(format!(
+                "the parametrisation is singular at ({u:.3}, {v:.3}); shrink the region"
+            ))
+        })?;
+        if !d.p.iter().all(|c| c.is_finite()) {
+            return Err(PhexError::NoValidTriangulation(
+                "the surface is not finite in the region".into(),
+            ));
+        }
+        t.uv.push(uv);
+        t.positions.push(d.p);
+        t.normals.push(nrm);
+        Ok((t.uv.len() - 1) as u32)
+    }
+
+    /// Layer `m` over `layers[m - 1]` (section 5.2), toward `across_ref`: the D_G flow lines'
+    /// feet, their ideal apexes, the D_F flow line through the lowest of them and the longest
+    /// run of its crossings inside the band. `None` when no layer fits.
+    fn next_layer(
+        &self,
+        layers: &[Layer],
+        m: usize,
+        across_ref: Vec2,
+        prev_ratio: Option<f64>,
+    ) -> Option<NextLayer> {
+        let (feet, ratios) = self.feet(layers, m, prev_ratio);
+        if ratios.is_empty() {
+            return None;
+        }
+        let found = self.crossings(&layers[m - 1], &feet, across_ref)?;
+        let (b0, b1) = self.longest_run(&found)?;
+        let pts: Vec<Vec2> = found[b0..b1].iter().flatten().copied().collect();
+        let first = feet[b0].0;
+        let mean_step = pts
+            .iter()
+            .zip(&feet[b0..b1])
+            .map(|(p, (_, q, _))| (self.across_of(*p) - self.across_of(*q)).abs())
+            .sum::<f64>()
+            / pts.len() as f64;
+        Some(NextLayer {
+            first,
+            pts,
+            mean_step,
+            ratio: ratios.iter().sum::<f64>() / ratios.len() as f64,
+        })
+    }
+
+    /// Feet (lattice index, point, ideal height) of the D_G flow lines of layer `m`: odd layers
+    /// over the segments (g, g+1), even ones over (g-1, g) plus the ends over layer m-2; and
+    /// the layer ratios used.
+    fn feet(&self, layers: &[Layer], m: usize, prev_ratio: Option<f64>) -> (Vec<Foot>, Vec<f64>) {
+        let cur = &layers[m - 1];
+        let (c0, c1) = (cur.first, cur.first + cur.pts.len() as i64);
+        let mut feet: Vec<Foot> = vec![];
+        let mut ratios = vec![];
+        let (g0, g1) = if m % 2 == 1 {
+            (c0, c1 - 1)
+        } else {
+            (c0, c1 + 1)
+        };
+        for g in g0..g1 {
+            let (ia, ib) = if m % 2 == 1 { (g, g + 1) } else { (g - 1, g) };
+            match (cur.get(ia), cur.get(ib)) {
+                (Some(a), Some(b)) => {
+                    let ab = (self.pos(b) - self.pos(a)).norm();
+                    let r = match self.spec.rule {
+                        LayerRule::Fixed(r) => r,
+                        LayerRule::Ideal { bound } => match ideal_ratio(self.s, a, b) {
+                            Some(r) => bounded_ratio(r, bound),
+                            // Section 5.3: re-use the previous step across a parabolic stretch.
+                            None => prev_ratio.unwrap_or(0.75f64.sqrt()),
+                        },
+                    };
+                    ratios.push(r);
+                    feet.push((g, (a + b) / 2.0, Some(r * ab)));
+                }
+                _ => {
+                    if let Some(p) = layers[m - 2].get(g) {
+                        feet.push((g, p, None));
+                    }
+                }
+            }
+        }
+        (feet, ratios)
+    }
+
+    /// Where the D_G flow lines from `feet` cross the next D_F flow line: pass 1 through the
+    /// median ideal apex; pass 2 through the one that came out lowest relative to its ideal
+    /// height, so that all are at least ideal (above DE). `None` without an ideal apex.
+    fn crossings(&self, cur: &Layer, feet: &[Foot], across_ref: Vec2) -> Option<Vec<Option<Vec2>>> {
+        let (f, step) = (self.f, self.step);
+        // Ideal apexes C_i along the D_G flow lines.
+        let mut ideal = vec![];
+        for (_, foot, h) in feet {
+            if let Some(h) = h {
+                let l = f.trace(*foot, 1, across_ref, h / 8.0, *h, &|_| true);
+                ideal.push((l.len() == 9).then(|| l[8]));
+            }
+        }
+        let mid = ideal
+            .iter()
+            .flatten()
+            .nth(ideal.iter().flatten().count() / 2)?;
+        let prev_len: f64 = cur
+            .pts
+            .windows(2)
+            .map(|w| (self.pos(w[1]) - self.pos(w[0])).norm())
+            .sum();
+        let hmax = feet.iter().filter_map(|x| x.2).fold(0.0, f64::max);
+        let mut sp = *mid;
+        let mut found: Vec<Option<Vec2>> = vec![];
+        for pass in 0..2 {
+            let reach = 1.5 * prev_len + 4.0 * hmax;
+            let fwd = f.trace(sp, 0, self.along_ref, step, reach, &|_| true);
+            let bwd = f.trace(sp, 0, -self.along_ref, step, reach, &|_| true);
+            let mut l1: Vec<Vec2> = bwd.into_iter().rev().collect();
+            l1.extend(fwd.into_iter().skip(1));
+            let l1 = Polyline::new(l1);
+            found.clear();
+            let mut rel = vec![];
+            for (_, foot, h) in feet {
+                let lim = 4.0 * h.unwrap_or(hmax).max(hmax);
+                let x = hit(f, *foot, across_ref, step, lim, &l1);
+                found.push(x.map(|x| x.0));
+                if let Some(h) = h {
+                    rel.push(x.map_or(f64::INFINITY, |x| x.1 / h));
+                }
+            }
+            let (imin, &low) = rel
+                .iter()
+                .enumerate()
+                .min_by(|a, b| a.1.total_cmp(b.1))
+                .unwrap_or((0, &1.0));
+            match ideal.get(imin) {
+                Some(Some(p)) if pass == 0 && low < 0.999 => sp = *p,
+                _ => break,
+            }
+        }
+        Some(found)
+    }
+
+    /// The longest run of consecutive crossings inside the band and before `end`, as a range;
+    /// `None` when it has fewer than 2 points.
+    fn longest_run(&self, found: &[Option<Vec2>]) -> Option<(usize, usize)> {
+        let ok = |p: &Option<Vec2>| p.is_some_and(|p| self.in_band(p));
+        let (mut best, mut run_start) = ((0usize, 0usize), None);
+        for i in 0..=found.len() {
+            if i < found.len() && ok(&found[i]) {
+                run_start.get_or_insert(i);
+            } else if let Some(st) = run_start.take()
+                && i - st > best.1 - best.0
+            {
+                best = (st, i);
+            }
+        }
+        (best.1 - best.0 >= 2).then_some(best)
+    }
+}
+
+/// The triangles between layer `m - 1` (`cur`) and layer `m`, oriented along the surface
+/// normal (the fields' orientation is arbitrary).
+fn stitch(t: &mut Triangulation, cur: &Layer, layer: &Layer, m: usize) {
+    let tri = |t: &mut Triangulation, a: Option<u32>, b: Option<u32>, c: Option<u32>| {
+        let (Some(a), Some(b), Some(c)) = (a, b, c) else {
+            return;
+        };
+        let (pa, pb, pc) = (
+            t.positions[a as usize],
+            t.positions[b as usize],
+            t.positions[c as usize],
+        );
+        if (pb - pa).cross(&(pc - pa)).dot(&t.normals[a as usize]) >= 0.0 {
+            t.triangles.push([a, b, c]);
+        } else {
+            t.triangles.push([a, c, b]);
+        }
+    };
+    let lo = cur.first.min(layer.first) - 1;
+    let hi = (cur.first + cur.ids.len() as i64).max(layer.first + layer.ids.len() as i64) + 1;
+    for g in lo..hi {
+        if m % 2 == 1 {
+            // New point g (x = g + 1/2) over the segment (g, g+1).
+            tri(t, cur.id(g), cur.id(g + 1), layer.id(g));
+            tri(t, layer.id(g), cur.id(g + 1), layer.id(g + 1));
+        } else {
+            // New point g (x = g) over the segment (g-1, g) of the odd layer.
+            tri(t, cur.id(g - 1), cur.id(g), layer.id(g));
+            tri(t, layer.id(g), cur.id(g), layer.id(g + 1));
+        }
+    }
 }
 
 fn pos(s: &dyn Surface, dom: &crate::surface::Domain, p: Vec2) -> Vec3 {

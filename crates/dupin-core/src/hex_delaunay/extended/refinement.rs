@@ -33,16 +33,16 @@
 //! triangles, starts and ends the run (a few in all: one more each time it finds something
 //! the incremental passes left).
 
-use super::dual::{Key, pack};
-use super::error::HexDelaunayError;
 use super::fin_vertices::{FinPatch, Run, run_patch, top_new};
-use super::hierarchy::{Cell, HexSet, Hierarchy, window_bit};
-use super::lattice::{Axial, DIRS, add, hex_norm, in_domain, on_boundary};
-use super::pslg::near_segment;
-use super::simple_refinement::Refinement;
 use crate::Vec2;
+use crate::hex_delaunay::dual::{Key, pack};
+use crate::hex_delaunay::error::HexDelaunayError;
+use crate::hex_delaunay::hierarchy::{Cell, Hierarchy, window_bit};
+use crate::hex_delaunay::lattice::{Axial, DIRS, add, hex_norm, in_domain, on_boundary};
+use crate::hex_delaunay::pslg::near_segment;
+use crate::hex_delaunay::simple_refinement::Refinement;
+use crate::hex_delaunay::tile_set::HexSet;
 use rustc_hash::{FxHashMap, FxHashSet};
-use std::sync::Mutex;
 
 const SQRT3: f64 = 1.732_050_807_568_877_2;
 
@@ -62,7 +62,7 @@ fn mean_shift(shifts: &mut [Vec2]) -> Vec2 {
 thread_local! {
     /// Test switch for the shortest-edge counterexample (docs/hexdelaunay.md): from this level
     /// on (0: never), waived ring conflicts whose local check fails are kept, not split.
-    pub(super) static KEEP_FAILED_CHECKS_FROM: std::cell::Cell<u32> =
+    pub(in crate::hex_delaunay) static KEEP_FAILED_CHECKS_FROM: std::cell::Cell<u32> =
         const { std::cell::Cell::new(0) };
 }
 
@@ -1029,7 +1029,7 @@ pub fn after_coarsening(
     tops: &[(u32, Axial)],
 ) -> bool {
     state.changes = None;
-    let cached = lock(&state.relocation).take();
+    let cached = state.relocation.take();
     let Some((splits, points, mut relocation)) = cached else {
         return false;
     };
@@ -1064,7 +1064,7 @@ pub fn after_coarsening(
             .map(|(top, i)| (top, std::mem::take(&mut pass.patches[i])))
             .collect(),
     );
-    *lock(&state.relocation) = Some((h.split_count, r.points.len(), relocation));
+    state.relocation = Some((h.split_count, r.points.len(), relocation));
     true
 }
 
@@ -1073,44 +1073,41 @@ pub fn after_coarsening(
 /// of affected hexagons, one pass per wave of splits). A run ends only after a full pass finds
 /// nothing, so the result is a fixed point of the full rules, at O(changes) cost per
 /// incremental pass.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 pub struct ExtendedState {
     changes: Option<Vec<(u32, Axial)>>,
     /// The relocations of the last full pass that found nothing, with the split count and
-    /// number of points it saw: the dual takes them instead of a further full pass. Taken
-    /// from behind `&self` (a Mutex, not a RefCell, keeps the stepper `Sync`) so that they
-    /// are not held twice while the dual is built (peak memory).
-    relocation: Mutex<Option<(usize, usize, Relocation)>>,
-}
-
-impl Clone for ExtendedState {
-    fn clone(&self) -> Self {
-        ExtendedState {
-            changes: self.changes.clone(),
-            relocation: Mutex::new(lock(&self.relocation).clone()),
-        }
-    }
-}
-
-/// The cached relocations (a panic while holding the lock cannot leave them half-written).
-fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+    /// number of points it saw: the dual takes them ([`take_relocated_centres`], by `&mut`)
+    /// or copies them ([`relocated_centres`]) instead of running a further full pass.
+    relocation: Option<(usize, usize, Relocation)>,
 }
 
 impl ExtendedState {
     /// Forces a full pass next (after insertions).
     pub fn reset(&mut self) {
         self.changes = None;
-        *lock(&self.relocation) = None;
+        self.relocation = None;
     }
 
     /// Records splits made outside the extended passes (simple rules, balancing).
     pub fn record(&mut self, made: &[(u32, Axial)]) {
         if !made.is_empty() {
-            *lock(&self.relocation) = None;
+            self.relocation = None;
         }
         if let Some(c) = &mut self.changes {
             c.extend_from_slice(made);
+        }
+    }
+
+    /// The cached relocations if they are those of `r` as it is now (same splits and points).
+    fn cached(&self, r: &Refinement) -> Option<&Relocation> {
+        match &self.relocation {
+            Some((splits, points, relocation))
+                if *splits == r.hierarchy.split_count && *points == r.points.len() =>
+            {
+                Some(relocation)
+            }
+            _ => None,
         }
     }
 }
@@ -1151,7 +1148,7 @@ pub fn extended_pass(
     state: &mut ExtendedState,
     segments: &[[u32; 2]],
 ) -> Result<Vec<(u32, Axial)>, HexDelaunayError> {
-    *lock(&state.relocation) = None;
+    state.relocation = None;
     loop {
         let full = state.changes.is_none();
         let (split, present) = match state.changes.take() {
@@ -1164,7 +1161,7 @@ pub fn extended_pass(
                 if marks.0.is_empty() && marks.1.is_empty() {
                     // The fixed point: these are the dual's relocations.
                     let seen = (r.hierarchy.split_count, r.points.len());
-                    *lock(&state.relocation) = Some((seen.0, seen.1, relocation));
+                    state.relocation = Some((seen.0, seen.1, relocation));
                 }
                 marks
             }
@@ -1189,15 +1186,28 @@ pub fn extended_pass(
 /// Lower angle bound of the extended refinement, degrees (tan α = 5/(3√3), section 5.4).
 pub const ANGLE_MIN: f64 = 43.897_886_248_013_99;
 
-/// The relocations (section 5.4) of the finished extended refinement: those of the last full
-/// pass if nothing changed since (same splits and points; taken, so a second call makes a
-/// new one), else a new full pass.
+/// The relocations (section 5.4) of the finished extended refinement: a copy of those of the
+/// last full pass if nothing changed since (same splits and points), else a new full pass.
 pub fn relocated_centres(
     r: &Refinement,
     state: &ExtendedState,
     segments: &[[u32; 2]],
 ) -> Relocation {
-    match lock(&state.relocation).take() {
+    match state.cached(r) {
+        Some(relocation) => relocation.clone(),
+        None => full_pass(r, segments).1,
+    }
+}
+
+/// [`relocated_centres`], taking the cached relocations out of `state` instead of copying
+/// them (so that they are not held twice while the dual is built: peak memory); a second
+/// call makes a new full pass.
+pub fn take_relocated_centres(
+    r: &Refinement,
+    state: &mut ExtendedState,
+    segments: &[[u32; 2]],
+) -> Relocation {
+    match state.relocation.take() {
         Some((splits, points, relocation))
             if splits == r.hierarchy.split_count && points == r.points.len() =>
         {

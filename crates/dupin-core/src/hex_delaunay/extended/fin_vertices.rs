@@ -16,7 +16,7 @@
 //!   7/6 C_T − 1/6 C_k1 (the middle one), n = 4: 4/3 C_T − 1/3 C_M (the middle two), n = 6:
 //!   not moved. For n = 2 and 4, C_M is the mean of the *new* centres (as in the shared-fin
 //!   formula); with the original centres no placement of the rest keeps α (checked by hand
-//!   and by the local check in `extended_refinement.rs`).
+//!   and by the local check in `refinement.rs`).
 //!
 //! Topology (the paper gives it only by its Fig. 9/10; ours is the Delaunay triangulation of
 //! these vertices): each centre's fin vertex joins the joined hexagons beside its fin and the
@@ -24,8 +24,8 @@
 //! the top; for n >= 2 each Ĉ joins its fin vertices, its run neighbours' Ĉ and the top.
 //! A blossom is 60 triangles.
 
-use super::dual::Key;
 use crate::Vec2;
+use crate::hex_delaunay::dual::Key;
 use rustc_hash::FxHashMap;
 
 /// A vertex of a patch: an existing dual vertex by key, or a new one.
@@ -281,8 +281,8 @@ pub fn apply_fin_patches(
 
 #[cfg(test)]
 mod tests {
+    use super::super::refinement::ANGLE_MIN;
     use super::*;
-    use crate::hex_delaunay::extended_refinement::ANGLE_MIN;
 
     const S3: f64 = 1.732_050_807_568_877_2;
 

@@ -14,7 +14,7 @@
 //! the six neighbours, three each, facing away from `t`. In the dual the disc of radius 4
 //! around `2t` is 60 triangles instead of 96. The paper's condition: all hexagons in the
 //! 4-ring of the blossom's centre are FIXED_CENTER_REGULAR. Ours, which that means on the
-//! lattice plus the conditions of our run check (`extended_refinement.rs`, `analyse_run`):
+//! lattice plus the conditions of our run check (`refinement.rs`, `analyse_run`):
 //!
 //! - the disc of radius 5 around `2t` at level `k + 1` has no split hexagon (the 4-ring has no
 //!   fins) and lies off Ω's boundary;
@@ -36,11 +36,11 @@
 //! split hexagons, with no search per candidate. Candidates are taken in order and checked on
 //! the current hierarchy, so two blossoms never overlap (their 5-discs are disjoint).
 
-use super::extended_refinement::{in_half_hexagon, ring, tops_mask};
-use super::hierarchy::WINDOW_DISC2;
-use super::lattice::{Axial, DIRS, add, hex_norm};
-use super::pslg::near_segment;
-use super::simple_refinement::Refinement;
+use super::refinement::{in_half_hexagon, ring, tops_mask};
+use crate::hex_delaunay::hierarchy::WINDOW_DISC2;
+use crate::hex_delaunay::lattice::{Axial, DIRS, add, hex_norm};
+use crate::hex_delaunay::pslg::near_segment;
+use crate::hex_delaunay::simple_refinement::Refinement;
 
 /// What one coarsening pass did.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -52,7 +52,7 @@ pub struct Coarsening {
 }
 
 /// Whether a blossom can be formed around `t` at level `k` (see the module docs), for a
-/// candidate `t` of [`Hierarchy::for_each_blossom_top`](super::hierarchy::Hierarchy).
+/// candidate `t` of [`Hierarchy::for_each_blossom_top`](crate::hex_delaunay::hierarchy::Hierarchy).
 fn blossom_fits(r: &Refinement, segments: &[[u32; 2]], k: u32, t: Axial) -> bool {
     let h = &r.hierarchy;
     // `t` comes from `for_each_blossom_top`; merges since (earlier blossoms of this level)
@@ -127,9 +127,9 @@ pub fn coarsen(r: &mut Refinement, segments: &[[u32; 2]]) -> Coarsening {
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::{check_with, paper_data_sets};
-    use super::super::{HexDelaunayMode, HexDelaunayStepper};
     use crate::Vec2;
+    use crate::hex_delaunay::tests::{check_with, paper_data_sets};
+    use crate::hex_delaunay::{HexDelaunayMode, HexDelaunayStepper};
 
     /// The stepper shows the coarsening as its own step; each blossom saves 36 triangles
     /// (96 → 60) against the same run without coarsening, and every guarantee holds after it.
