@@ -61,6 +61,15 @@ impl SparseCholesky {
         upper: SymbolicSparseColMatRef<'_, u32>,
         fwd: &[u32],
     ) -> Result<Self, SolverError> {
+        Self::analyse_within(upper, fwd, super::MAX_FACTOR_BYTES)
+    }
+
+    /// [`Self::analyse`] with a memory limit for the factor, in bytes.
+    pub(crate) fn analyse_within(
+        upper: SymbolicSparseColMatRef<'_, u32>,
+        fwd: &[u32],
+        limit: usize,
+    ) -> Result<Self, SolverError> {
         let n = upper.ncols();
         let fwd = fwd.to_vec();
         if fwd.len() != n {
@@ -144,6 +153,19 @@ impl SparseCholesky {
             },
         )
         .map_err(|e| fe(&e))?;
+        // The factor's size is known from the pattern: refuse before allocating it (an
+        // allocation failure aborts the process, and in a browser kills the worker).
+        let needed = symbolic
+            .len_val()
+            .saturating_mul(std::mem::size_of::<f64>());
+        if needed > limit {
+            return Err(SolverError::TooLarge { needed, limit });
+        }
+        let mut factor = Vec::new();
+        factor
+            .try_reserve_exact(symbolic.len_val())
+            .map_err(|_| SolverError::TooLarge { needed, limit })?;
+        factor.resize(symbolic.len_val(), 0.0);
         let req = symbolic
             .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
             .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
@@ -152,7 +174,7 @@ impl SparseCholesky {
             inv,
             lower,
             positions,
-            factor: vec![0.0; symbolic.len_val()],
+            factor,
             scratch: MemBuffer::try_new(req).map_err(|e| fe(&e))?,
             symbolic,
             work: vec![0.0; n],
@@ -300,5 +322,26 @@ mod tests {
             }
         }
         assert!(SparseCholesky::analyse(upper.as_ref(), &[0, 0]).is_err());
+    }
+
+    /// A factor larger than the limit is refused from its pattern, before any numeric work,
+    /// with both sizes in the message.
+    #[test]
+    fn factors_beyond_the_memory_limit_are_refused() {
+        // A dense 30 x 30 pattern: its factor holds at least 465 entries, 3720 bytes.
+        let n = 30u32;
+        let col_ptr: Vec<u32> = (0..=n).map(|c| c * (c + 1) / 2).collect();
+        let row_idx: Vec<u32> = (0..n).flat_map(|c| 0..=c).collect();
+        let upper =
+            SymbolicSparseColMat::new_checked(n as usize, n as usize, col_ptr, None, row_idx);
+        let fwd: Vec<u32> = (0..n).collect();
+        assert!(SparseCholesky::analyse_within(upper.as_ref(), &fwd, 100_000).is_ok());
+        match SparseCholesky::analyse_within(upper.as_ref(), &fwd, 1000) {
+            Err(e @ SolverError::TooLarge { needed, limit }) => {
+                assert!(needed >= 3720 && limit == 1000, "{needed}");
+                assert!(e.to_string().contains("GB, more than the limit"), "{e}");
+            }
+            other => panic!("expected TooLarge, got {:?}", other.map(|_| ())),
+        }
     }
 }

@@ -33,6 +33,10 @@ pub use sqp::{ConstrainedLeastSquares, Sqp, SqpOptions, SqpStep};
 
 use thiserror::Error;
 
+/// The most memory a sparse Cholesky factor may take: what a 2-core, 8 GB laptop and a
+/// browser tab (whose wasm memory stops at 4 GB) survive beside the rest of the computation.
+pub const MAX_FACTOR_BYTES: usize = 2_000_000_000;
+
 /// Why a solver step failed.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum SolverError {
@@ -55,6 +59,20 @@ pub enum SolverError {
     /// even after damping).
     #[error("sparse factorisation failed: {0}")]
     Factorization(String),
+    /// The factorisation would need more memory than the limit (estimated from the sparsity
+    /// pattern before any numeric work).
+    #[error(
+        "the sparse factorisation needs {:.1} GB, more than the limit of {:.1} GB; use a coarser \
+         mesh or split it into parts",
+        *.needed as f64 / 1e9,
+        *.limit as f64 / 1e9
+    )]
+    TooLarge {
+        /// Bytes the factor would take.
+        needed: usize,
+        /// The limit in bytes ([`MAX_FACTOR_BYTES`]).
+        limit: usize,
+    },
     /// No step reduced the objective, even with the largest damping tried.
     #[error("no descent step found (damping {damping:e})")]
     NoDescent {
