@@ -2,19 +2,18 @@
 //! back and checked against the 3D panels.
 
 mod common;
-use common::{dupin, tmp};
+use common::{dupin, dupin_ok, tmp};
 
 /// The panels of a P-Hex scene (planar hexagons) as an OBJ, in metres.
 fn panels(name: &str) -> (std::path::PathBuf, Vec<[f64; 3]>, Vec<Vec<usize>>) {
     let obj = tmp(&format!("export-{name}.obj"));
-    let o = dupin(&[
+    dupin_ok(&[
         "phex",
         "--scene",
         "torus-bound",
         "--out",
         obj.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let text = std::fs::read_to_string(&obj).unwrap();
     let mut v = Vec::new();
     let mut f = Vec::new();
@@ -70,7 +69,7 @@ fn polylines(dxf: &str) -> Vec<(String, Vec<[f64; 2]>)> {
 fn dxf_panels_are_true_size_in_mm_and_do_not_overlap() {
     let (obj, v, faces) = panels("dxf");
     let dxf_path = tmp("export.dxf");
-    let o = dupin(&[
+    dupin_ok(&[
         "export",
         "--input",
         obj.to_str().unwrap(),
@@ -79,7 +78,6 @@ fn dxf_panels_are_true_size_in_mm_and_do_not_overlap() {
         "--out",
         dxf_path.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let dxf = std::fs::read_to_string(&dxf_path).unwrap();
     assert!(dxf.contains("$INSUNITS\n 70\n4\n"));
     let polys = polylines(&dxf);
@@ -175,7 +173,7 @@ fn csv_glb_and_svg_carry_every_panel() {
     // The GLB's panels read back as triangles (the fans of the faces).
     let glb = std::fs::read(out("glb")).unwrap();
     assert_eq!(&glb[..4], b"glTF");
-    let o = dupin(&[
+    let o = dupin_ok(&[
         "planarize",
         "--input",
         out("glb").to_str().unwrap(),
@@ -184,7 +182,6 @@ fn csv_glb_and_svg_carry_every_panel() {
         "--out",
         tmp("export-glb-back.obj").to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let stdout = String::from_utf8_lossy(&o.stdout);
     let triangles: usize = faces.iter().map(|f| f.len() - 2).sum();
     assert!(stdout.contains(&format!("{triangles} faces")), "{stdout}");

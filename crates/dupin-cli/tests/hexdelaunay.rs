@@ -1,7 +1,8 @@
 //! End-to-end tests of `dupin hexdelaunay`.
 
+mod common;
+use common::{dupin_text as run, refused, run_reported};
 use std::path::PathBuf;
-use std::process::Command;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 static COUNTER: AtomicUsize = AtomicUsize::new(0);
@@ -13,18 +14,6 @@ fn temp(name: &str, content: Option<&str>) -> PathBuf {
         std::fs::write(&p, c).unwrap();
     }
     p
-}
-
-fn run(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_dupin"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
 }
 
 fn bad(points: &str, segments: Option<&str>, extra: &[&str]) -> String {
@@ -42,10 +31,7 @@ fn bad(points: &str, segments: Option<&str>, extra: &[&str]) -> String {
         args.extend(["--segments", s.to_str().unwrap()]);
     }
     args.extend(extra);
-    let (code, stdout, stderr) = run(&args);
-    assert_eq!(code, 2, "stdout {stdout} stderr {stderr}");
-    assert_eq!(stderr.lines().count(), 1, "{stderr}");
-    assert!(stderr.starts_with("error:"), "{stderr}");
+    let (_, stderr) = refused(&args);
     assert!(!stderr.contains("panicked"));
     stderr
 }
@@ -54,21 +40,12 @@ fn bad(points: &str, segments: Option<&str>, extra: &[&str]) -> String {
 fn triangulates_and_reports_contract_fields() {
     let text = "# points\n0 0\n1 0\n0.25 0.5\n\n0.7 0.9\n0.7 0.9\n0.123456789012345678 0.3\n";
     let pts = temp("pts.txt", Some(text));
-    let out = temp("out.obj", None);
-    let rep = temp("r.json", None);
-    let (code, stdout, stderr) = run(&[
-        "hexdelaunay",
-        "--points",
-        pts.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--report",
-        rep.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{stderr}");
-    assert_eq!(stdout.lines().count(), 1);
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&rep).unwrap()).unwrap();
+    let run = run_reported(
+        "hexd-simple",
+        &["hexdelaunay", "--points", pts.to_str().unwrap()],
+    );
+    let r = run.ok();
+    assert_eq!(run.stdout().lines().count(), 1);
     let keys: Vec<&String> = r.as_object().unwrap().keys().collect();
     let mut expected = [
         "input_points",
@@ -88,7 +65,7 @@ fn triangulates_and_reports_contract_fields() {
     assert!(r["max_angle_deg"].as_f64().unwrap() <= 120.01);
     assert_eq!(r["delaunay"], true);
     assert!(r["seconds"].as_f64().unwrap() >= 0.0);
-    let mesh = dupin_core::mesh::parse_obj(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let mesh = run.mesh();
     assert_eq!(mesh.num_vertices() as u64, r["vertices"].as_u64().unwrap());
     assert_eq!(mesh.num_faces() as u64, r["triangles"].as_u64().unwrap());
     for p in dupin_core::mesh::parse_points(text).unwrap() {
@@ -106,28 +83,23 @@ fn triangulates_and_reports_contract_fields() {
 fn extended_mode_keeps_43_9_to_90_degrees() {
     let text = "0 0\n1 0\n0.25 0.5\n0.7 0.9\n0.7 0.9\n0.123456789012345678 0.3\n0.5 0.5\n";
     let pts = temp("pts.txt", Some(text));
-    let out = temp("out.obj", None);
-    let rep = temp("r.json", None);
-    let (code, stdout, stderr) = run(&[
-        "hexdelaunay",
-        "--points",
-        pts.to_str().unwrap(),
-        "--mode",
-        "extended",
-        "--out",
-        out.to_str().unwrap(),
-        "--report",
-        rep.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{stderr}");
-    assert!(stdout.contains("hexdelaunay"));
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&rep).unwrap()).unwrap();
+    let run = run_reported(
+        "hexd-extended",
+        &[
+            "hexdelaunay",
+            "--points",
+            pts.to_str().unwrap(),
+            "--mode",
+            "extended",
+        ],
+    );
+    let r = run.ok();
+    assert!(run.stdout().contains("hexdelaunay"));
     assert_eq!(r["input_points"], 7);
     assert!(r["min_angle_deg"].as_f64().unwrap() >= 43.89, "{r}");
     assert!(r["max_angle_deg"].as_f64().unwrap() <= 90.0001, "{r}");
     assert_eq!(r["delaunay"], true);
-    let mesh = dupin_core::mesh::parse_obj(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let mesh = run.mesh();
     assert_eq!(mesh.num_faces() as u64, r["triangles"].as_u64().unwrap());
     for p in dupin_core::mesh::parse_points(text).unwrap() {
         assert!(
@@ -177,9 +149,7 @@ fn pslg_segments_become_edges_and_report_the_exempt_triangles() {
     let pts = format!("{data}imr_points.txt");
     let segs = format!("{data}imr_segments.txt");
     for (mode, lo, hi) in [("simple", 29.99, 120.01), ("extended", 43.89, 90.0001)] {
-        let out = temp("out.obj", None);
-        let rep = temp("r.json", None);
-        let (code, stdout, stderr) = run(&[
+        let args: &[&str] = &[
             "hexdelaunay",
             "--points",
             &pts,
@@ -187,15 +157,11 @@ fn pslg_segments_become_edges_and_report_the_exempt_triangles() {
             &segs,
             "--mode",
             mode,
-            "--out",
-            out.to_str().unwrap(),
-            "--report",
-            rep.to_str().unwrap(),
-        ]);
-        assert_eq!(code, 0, "{stderr}");
+        ];
+        let run = run_reported("hexd-pslg", args);
+        let r = run.ok();
+        let stdout = run.stdout();
         assert!(stdout.contains("75 segments"), "{stdout}");
-        let r: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(&rep).unwrap()).unwrap();
         assert_eq!(r["input_points"], 75);
         assert_eq!(r["segments"], 75);
         assert!(r["segment_edges"].as_u64().unwrap() >= 75, "{r}");
@@ -203,7 +169,7 @@ fn pslg_segments_become_edges_and_report_the_exempt_triangles() {
         assert!(r["away_min_angle_deg"].as_f64().unwrap() >= lo, "{r}");
         assert!(r["away_max_angle_deg"].as_f64().unwrap() <= hi, "{r}");
         assert_eq!(r["away_delaunay"], true, "{r}");
-        let mesh = dupin_core::mesh::parse_obj(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        let mesh = run.mesh();
         assert_eq!(mesh.num_faces() as u64, r["triangles"].as_u64().unwrap());
         // Each segment's endpoints are exact vertices and the segment is covered by edges:
         // the edges lying on it (all vertices within 2e-9 of its length) sum to its length.

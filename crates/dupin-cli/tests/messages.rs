@@ -2,14 +2,11 @@
 //! line starting `error:` that names the problem, with nothing written.
 
 mod common;
-use common::{dupin, tmp};
+use common::{dupin, dupin_ok, tmp};
 
-/// Runs `dupin args`, asserts exit 2 with exactly one `error:` line, and returns that line.
+/// Runs `dupin args`, asserts exit 2 with exactly one `error: ` line, and returns that line.
 fn refused(args: &[&str]) -> String {
-    let o = dupin(args);
-    let err = String::from_utf8_lossy(&o.stderr).to_string();
-    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
-    assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+    let (_, err) = common::refused(args);
     assert!(err.starts_with("error: "), "{args:?}: {err}");
     err.trim_end().to_string()
 }
@@ -113,14 +110,13 @@ fn obj_messages_name_lines_and_escape_the_input() {
 fn huge_offset_distances_are_refused_with_the_limit() {
     let mesh = tmp("station.obj");
     let out = tmp("station-offset.obj");
-    let o = dupin(&[
+    dupin_ok(&[
         "pq",
         "--scene",
         "conical-station",
         "--out",
         mesh.to_str().unwrap(),
     ]);
-    assert!(o.status.success());
     for d in ["1e300", "-1e6"] {
         let e = refused(&[
             "offset",

@@ -1,7 +1,7 @@
 //! End-to-end tests of `dupin phex`.
 
 mod common;
-use common::{dupin, listed_scenes, tmp};
+use common::{command_line, dupin_ok, listed_scenes, refused, run_reported, tmp};
 
 #[test]
 fn lists_every_contract_scene() {
@@ -30,21 +30,9 @@ fn lists_every_contract_scene() {
 
 #[test]
 fn scene_writes_obj_and_contract_report() {
-    let mesh = tmp("hv.obj");
-    let report = tmp("hv.json");
-    let o = dupin(&[
-        "phex",
-        "--scene",
-        "hyperboloid-valid",
-        "--out",
-        mesh.to_str().unwrap(),
-        "--report",
-        report.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    assert_eq!(String::from_utf8_lossy(&o.stdout).lines().count(), 1);
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let run = run_reported("hv", &["phex", "--scene", "hyperboloid-valid"]);
+    let r = run.ok();
+    assert_eq!(run.stdout().lines().count(), 1);
     for key in [
         "vertices",
         "faces",
@@ -61,17 +49,13 @@ fn scene_writes_obj_and_contract_report() {
     assert!(r["max_planarity"].as_f64().unwrap() <= 1e-10);
     assert_eq!(r["invalid_faces"].as_u64().unwrap(), 0);
     assert!(r["face_sizes"]["6"].as_u64().unwrap() > 100);
-    let obj = std::fs::read_to_string(&mesh).unwrap();
-    let parsed = dupin_core::mesh::parse_obj(&obj).unwrap();
-    assert_eq!(parsed.num_faces() as u64, r["faces"].as_u64().unwrap());
-    let _ = std::fs::remove_file(mesh);
-    let _ = std::fs::remove_file(report);
+    assert_eq!(run.mesh().num_faces() as u64, r["faces"].as_u64().unwrap());
 }
 
 #[test]
 fn surface_with_parameters_and_options() {
     let mesh = tmp("torus.obj");
-    let o = dupin(&[
+    dupin_ok(&[
         "phex",
         "--surface",
         "torus",
@@ -87,132 +71,41 @@ fn surface_with_parameters_and_options() {
         "--out",
         mesh.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let _ = std::fs::remove_file(mesh);
 }
 
 #[test]
 fn bad_input_exits_2_with_one_error_line() {
     let mesh = tmp("bad.obj");
-    let m = mesh.to_str().unwrap();
-    for args in [
-        vec!["phex", "--scene", "no-such-scene", "--out", m],
-        vec!["phex", "--surface", "no-such-surface", "--out", m],
-        vec!["phex", "--surface", "torus", "--set", "r=5", "--out", m],
-        vec![
-            "phex",
-            "--scene",
-            "torus-bound",
-            "--size",
-            "100",
-            "--out",
-            m,
-        ],
-        vec![
-            "phex",
-            "--scene",
-            "torus-bound",
-            "--size",
-            "1e-9",
-            "--out",
-            m,
-        ],
-        vec!["phex", "--scene", "torus-bound", "--size", "-1", "--out", m],
-        vec![
-            "phex",
-            "--scene",
-            "torus-bound",
-            "--method",
-            "magic",
-            "--out",
-            m,
-        ],
-        vec!["phex", "--scene", "torus-bound"],
+    // One command line a case, OUT standing for the output file.
+    for line in [
+        "--scene no-such-scene --out OUT",
+        "--surface no-such-surface --out OUT",
+        "--surface torus --set r=5 --out OUT",
+        "--scene torus-bound --size 100 --out OUT",
+        "--scene torus-bound --size 1e-9 --out OUT",
+        "--scene torus-bound --size -1 --out OUT",
+        "--scene torus-bound --method magic --out OUT",
+        "--scene torus-bound",
         // A first field along an asymptotic (self-conjugate) direction: no valid triangulation.
-        vec![
-            "phex",
-            "--surface",
-            "hyperboloid",
-            "--field-angle",
-            "45",
-            "--out",
-            m,
-        ],
-        vec![
-            "phex",
-            "--scene",
-            "torus-bound",
-            "--field-angle",
-            "120",
-            "--out",
-            m,
-        ],
-        vec![
-            "phex",
-            "--scene",
-            "sphere-radial",
-            "--field-angle",
-            "10",
-            "--out",
-            m,
-        ],
-        vec![
-            "phex",
-            "--scene",
-            "torus-bound",
-            "--iterations",
-            "5000",
-            "--out",
-            m,
-        ],
-        vec![
-            "phex",
-            "--surface",
-            "freeform-translational",
-            "--set",
-            "amplitude=7",
-            "--out",
-            m,
-        ],
-        vec![
-            "phex",
-            "--surface",
-            "freeform-translational",
-            "--set",
-            "wobble=0.1",
-            "--out",
-            m,
-        ],
+        "--surface hyperboloid --field-angle 45 --out OUT",
+        "--scene torus-bound --field-angle 120 --out OUT",
+        "--scene sphere-radial --field-angle 10 --out OUT",
+        "--scene torus-bound --iterations 5000 --out OUT",
+        "--surface freeform-translational --set amplitude=7 --out OUT",
+        "--surface freeform-translational --set wobble=0.1 --out OUT",
     ] {
-        let o = dupin(&args);
-        assert_eq!(o.status.code(), Some(2), "{args:?}");
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
-        assert!(err.starts_with("error:"), "{args:?}: {err}");
+        refused(&command_line("phex", line, mesh.to_str().unwrap()));
     }
 }
 
 #[test]
 fn field_angle_extension_and_boundary_faces() {
-    let mesh = tmp("fa.obj");
-    let report = tmp("fa.json");
     let run = |surface: &str, extra: &[&str]| {
-        let mut args = vec![
-            "phex",
-            "--surface",
-            surface,
-            "--size",
-            "0.2",
-            "--out",
-            mesh.to_str().unwrap(),
-            "--report",
-            report.to_str().unwrap(),
-        ];
+        let mut args = vec!["phex", "--surface", surface, "--size", "0.2"];
         args.extend_from_slice(extra);
-        let o = dupin(&args);
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let r: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+        let run = run_reported("fa", &args);
+        let r = run.ok();
         assert!(r["max_planarity"].as_f64().unwrap() <= 1e-10, "{r}");
         assert_eq!(r["invalid_faces"].as_u64().unwrap(), 0, "{r}");
         r["faces"].as_u64().unwrap()
@@ -223,6 +116,4 @@ fn field_angle_extension_and_boundary_faces() {
     let with = run("sphere", &[]);
     let without = run("sphere", &["--no-boundary-faces"]);
     assert!(with > without, "{with} vs {without}");
-    let _ = std::fs::remove_file(mesh);
-    let _ = std::fs::remove_file(report);
 }

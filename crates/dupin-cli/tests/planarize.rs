@@ -1,8 +1,7 @@
 //! End-to-end tests of `dupin planarize`.
 
 mod common;
-use common::{dupin, json, tmp};
-use std::process::Output;
+use common::{Run, run_reported, tmp};
 
 /// A 6 x 6 quad grid on the saddle z = xy, rotated 30 degrees: far from planar.
 fn skew_grid_obj() -> String {
@@ -32,56 +31,14 @@ fn skew_grid_obj() -> String {
     out
 }
 
-/// What one `dupin planarize` run left behind: the process output, the output OBJ and the
-/// JSON report when written. The temp files are removed.
-struct Run {
-    o: Output,
-    out: Option<String>,
-    report: Option<serde_json::Value>,
-}
-
-impl Run {
-    fn stderr(&self) -> String {
-        String::from_utf8_lossy(&self.o.stderr).into_owned()
-    }
-
-    /// Asserts success and returns the report.
-    fn ok(&self) -> &serde_json::Value {
-        assert!(self.o.status.success(), "{}", self.stderr());
-        self.report.as_ref().expect("a report")
-    }
-
-    /// Asserts exit code 2 and returns the error text.
-    fn fails(&self) -> String {
-        assert_eq!(self.o.status.code(), Some(2), "{}", self.stderr());
-        self.stderr()
-    }
-}
-
 /// Runs `dupin planarize --input <obj> <args> --out .. --report ..` on `obj` (test `name`).
 fn planarize(name: &str, obj: &str, args: &[&str]) -> Run {
-    let (input, out, report) = (
-        tmp(&format!("{name}.obj")),
-        tmp(&format!("{name}-out.obj")),
-        tmp(&format!("{name}.json")),
-    );
-    for p in [&out, &report] {
-        let _ = std::fs::remove_file(p);
-    }
+    let input = tmp(&format!("{name}.obj"));
     std::fs::write(&input, obj).unwrap();
     let mut all = vec!["planarize", "--input", input.to_str().unwrap()];
     all.extend_from_slice(args);
-    all.extend(["--out", out.to_str().unwrap()]);
-    all.extend(["--report", report.to_str().unwrap()]);
-    let o = dupin(&all);
-    let run = Run {
-        o,
-        out: std::fs::read_to_string(&out).ok(),
-        report: report.exists().then(|| json(&report)),
-    };
-    for p in [input, out, report] {
-        let _ = std::fs::remove_file(p);
-    }
+    let run = run_reported(name, &all);
+    let _ = std::fs::remove_file(input);
     run
 }
 
@@ -101,7 +58,7 @@ fn vertex(obj: &str, i: usize) -> Vec<f64> {
 fn planarizes_a_skew_grid_and_reports_exact_fields() {
     let run = planarize("grid", &skew_grid_obj(), &[]);
     let r = run.ok();
-    assert_eq!(String::from_utf8_lossy(&run.o.stdout).lines().count(), 1);
+    assert_eq!(run.stdout().lines().count(), 1);
     for key in [
         "vertices",
         "faces",

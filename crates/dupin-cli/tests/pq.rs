@@ -1,7 +1,7 @@
 //! End-to-end tests of `dupin pq` and `dupin offset`.
 
 mod common;
-use common::{dupin, json, listed_scenes, tmp};
+use common::{dupin, listed_scenes, run_reported, tmp};
 
 #[test]
 fn lists_the_contract_scenes() {
@@ -19,47 +19,34 @@ fn lists_the_contract_scenes() {
 
 #[test]
 fn conical_station_then_offset_with_support() {
-    let mesh = tmp("station.obj");
-    let report = tmp("station.json");
-    let o = dupin(&[
-        "pq",
-        "--scene",
-        "conical-station",
-        "--out",
-        mesh.to_str().unwrap(),
-        "--report",
-        report.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let r = json(&report);
+    let station = run_reported("station", &["pq", "--scene", "conical-station"]);
+    let r = station.ok();
     assert!(r["max_planarity"].as_f64().unwrap() <= 1e-10);
     assert!(r["conical_residual"].as_f64().unwrap() <= 1e-10);
+    let mesh = tmp("station.obj");
+    std::fs::write(&mesh, station.out.as_deref().unwrap()).unwrap();
 
-    let off = tmp("station-off.obj");
     let beams = tmp("station-beams.obj");
-    let rep2 = tmp("offset.json");
-    let o = dupin(&[
-        "offset",
-        "--input",
-        mesh.to_str().unwrap(),
-        "--distance",
-        "0.05",
-        "--out",
-        off.to_str().unwrap(),
-        "--support",
-        beams.to_str().unwrap(),
-        "--report",
-        rep2.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let r = json(&rep2);
+    let offset = run_reported(
+        "station-off",
+        &[
+            "offset",
+            "--input",
+            mesh.to_str().unwrap(),
+            "--distance",
+            "0.05",
+            "--support",
+            beams.to_str().unwrap(),
+        ],
+    );
+    let r = offset.ok();
     assert!(r["max_distance_error"].as_f64().unwrap() <= 1e-9 * 0.05 * 10.0);
     assert!(r["warnings"].as_array().unwrap().is_empty());
     assert!(std::fs::read_to_string(&beams).unwrap().contains("\nf "));
     // Every beam planar, the boundary ones included.
     let sp = r["support_max_planarity"].as_f64().unwrap();
     assert!(sp <= 1e-10, "support_max_planarity {sp}");
-    for p in [mesh, report, off, beams, rep2] {
+    for p in [mesh, beams] {
         let _ = std::fs::remove_file(p);
     }
 }
@@ -84,25 +71,22 @@ fn unknown_scene_and_bad_distance_exit_2() {
     assert_eq!(o.status.code(), Some(2));
     // A non-planar input is offset anyway, with warnings in the report (exit 0).
     std::fs::write(&input, "v 0 0 0\nv 1 0 0\nv 1 1 0.3\nv 0 1 0\nf 1 2 3 4\n").unwrap();
-    let rep = tmp("warn.json");
-    let o = dupin(&[
-        "offset",
-        "--input",
-        input.to_str().unwrap(),
-        "--distance",
-        "0.1",
-        "--out",
-        out.to_str().unwrap(),
-        "--report",
-        rep.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let w = json(&rep)["warnings"].as_array().unwrap().clone();
+    let warned = run_reported(
+        "warn",
+        &[
+            "offset",
+            "--input",
+            input.to_str().unwrap(),
+            "--distance",
+            "0.1",
+        ],
+    );
+    let w = warned.ok()["warnings"].as_array().unwrap().clone();
     assert!(
         w.iter().any(|x| x.as_str().unwrap().contains("not planar")),
         "{w:?}"
     );
-    for p in [input, out, rep] {
+    for p in [input, out] {
         let _ = std::fs::remove_file(p);
     }
 }

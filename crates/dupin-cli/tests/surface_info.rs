@@ -1,19 +1,9 @@
 //! End-to-end tests of `dupin surface-info` against the outside contract.
 
-use std::process::Command;
+mod common;
+use common::{command_line, dupin_text as dupin, json as json_file, refused, tmp};
 
-fn dupin(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_dupin"))
-        .args(args)
-        .output()
-        .expect("run dupin");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
+/// The one JSON object `surface-info` prints on stdout.
 fn json(s: &str) -> serde_json::Value {
     serde_json::from_str(s.trim()).expect("one JSON object on stdout")
 }
@@ -150,7 +140,7 @@ fn list_names_every_surface_with_parameters() {
 
 #[test]
 fn report_file_has_the_fields_and_seconds() {
-    let path = std::env::temp_dir().join(format!("dupin-surface-info-{}.json", std::process::id()));
+    let path = tmp("surface-info.json");
     let p = path.to_str().unwrap();
     let (code, out, _) = dupin(&[
         "surface-info",
@@ -162,8 +152,7 @@ fn report_file_has_the_fields_and_seconds() {
         p,
     ]);
     assert_eq!(code, 0);
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let r = json_file(&path);
     std::fs::remove_file(&path).ok();
     let o = json(&out);
     for key in [
@@ -176,61 +165,22 @@ fn report_file_has_the_fields_and_seconds() {
 
 #[test]
 fn bad_input_exits_2_with_one_error_line() {
-    for args in [
-        vec!["surface-info", "--surface", "klein", "--at", "0,0"],
-        vec![
-            "surface-info",
-            "--surface",
-            "torus",
-            "--set",
-            "q=1",
-            "--at",
-            "0,0",
-        ],
-        vec![
-            "surface-info",
-            "--surface",
-            "torus",
-            "--set",
-            "r=5",
-            "--at",
-            "0,0",
-        ],
-        vec![
-            "surface-info",
-            "--surface",
-            "torus",
-            "--set",
-            "r",
-            "--at",
-            "0,0",
-        ],
-        vec![
-            "surface-info",
-            "--surface",
-            "torus",
-            "--set",
-            "r=nan",
-            "--at",
-            "0,0",
-        ],
-        vec!["surface-info", "--surface", "torus", "--at", "0"],
-        vec!["surface-info", "--surface", "torus", "--at", "nan,1"],
-        vec!["surface-info", "--surface", "sphere", "--at", "0,9"],
-        vec![
-            "surface-info",
-            "--surface",
-            "sphere",
-            "--at",
-            "0,1.5707963267948966",
-        ],
-        vec!["surface-info", "--surface", "torus"],
-        vec!["surface-info", "--at", "0,0"],
+    // One command line a case.
+    for line in [
+        "--surface klein --at 0,0",
+        "--surface torus --set q=1 --at 0,0",
+        "--surface torus --set r=5 --at 0,0",
+        "--surface torus --set r --at 0,0",
+        "--surface torus --set r=nan --at 0,0",
+        "--surface torus --at 0",
+        "--surface torus --at nan,1",
+        "--surface sphere --at 0,9",
+        "--surface sphere --at 0,1.5707963267948966",
+        "--surface torus",
+        "--at 0,0",
     ] {
-        let (code, out, err) = dupin(&args);
-        assert_eq!(code, 2, "{args:?}: {err}");
+        let args = command_line("surface-info", line, "");
+        let (out, _) = refused(&args);
         assert!(out.is_empty(), "{args:?}");
-        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
-        assert!(err.starts_with("error:"), "{args:?}: {err}");
     }
 }

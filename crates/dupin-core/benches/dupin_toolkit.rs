@@ -1,11 +1,12 @@
 //! Hot paths of the Dupin toolkit, called per vertex / per triangle by the P-Hex pipeline.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use dupin_core::mesh::{PolyMesh, is_simple_polygon};
+use dupin_core::mesh::is_simple_polygon;
 use dupin_core::phex::{
     DupinIndicatrix, TriangleStar, dupin_center, dupin_center_3d, ideal_triangle,
     tangent_dual_point,
 };
+use dupin_core::scenes::benchmark_meshes::torus_triangulation;
 use dupin_core::surface::{DupinCyclide, MeshSurface, Surface, Torus};
 use dupin_core::{Vec2, Vec3};
 use std::hint::black_box;
@@ -32,11 +33,9 @@ fn bench(c: &mut Criterion) {
         b.iter(|| dupin_center(&ind, black_box(&a), black_box(&p), black_box(&q)).unwrap())
     });
     let curv = torus.curvature(0.5, 0.4).unwrap();
-    let pts = [
-        torus.position(0.5, 0.4),
-        torus.position(0.55, 0.41),
-        torus.position(0.52, 0.46),
-    ];
+    // Three nearby surface points (a small triangle) and their normals.
+    let at = [(0.5, 0.4), (0.55, 0.41), (0.52, 0.46)];
+    let pts = at.map(|(u, v)| torus.position(u, v));
     c.bench_function("dupin_center/3d", |b| {
         b.iter(|| {
             dupin_center_3d(
@@ -48,11 +47,7 @@ fn bench(c: &mut Criterion) {
             .unwrap()
         })
     });
-    let nrm = [
-        torus.normal(0.5, 0.4),
-        torus.normal(0.55, 0.41),
-        torus.normal(0.52, 0.46),
-    ];
+    let nrm = at.map(|(u, v)| torus.normal(u, v));
     c.bench_function("tangent_dual_point", |b| {
         b.iter(|| {
             tangent_dual_point(
@@ -82,25 +77,7 @@ fn bench(c: &mut Criterion) {
         })
     });
     // A 100 x 50 torus mesh (10k triangles).
-    let (nu, nv) = (100, 50);
-    let mut pos = Vec::new();
-    for j in 0..nv {
-        for i in 0..nu {
-            pos.push(torus.position(
-                std::f64::consts::TAU * i as f64 / nu as f64,
-                std::f64::consts::TAU * j as f64 / nv as f64,
-            ));
-        }
-    }
-    let id = |i: usize, j: usize| ((j % nv) * nu + (i % nu)) as u32;
-    let mut faces = Vec::new();
-    for j in 0..nv {
-        for i in 0..nu {
-            faces.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-            faces.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
-    let mesh = PolyMesh::new(pos, faces).unwrap();
+    let mesh = torus_triangulation(100, 50, torus.major, torus.minor);
     c.bench_function("mesh_surface/build_10k_triangles", |b| {
         b.iter(|| MeshSurface::from_mesh(black_box(mesh.clone())))
     });

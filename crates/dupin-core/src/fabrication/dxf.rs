@@ -90,15 +90,34 @@ impl Dxf {
         self.next_handle
     }
 
-    /// An entity's common head: type, handle, owner (the model space block record), layer.
+    /// An entity's common head: type, a new handle, owner (the model space block record),
+    /// layer.
     fn entity(&mut self, kind: &str, layer: &str, subclass: &str) {
-        self.pair(0, kind);
         let h = self.handle();
-        self.pair(5, format!("{h:X}"));
-        self.pair(330, "1F");
+        self.entity_head(kind, &format!("{h:X}"), "1F", layer, subclass);
+    }
+
+    /// The head every entity shares, with its handle and owner given: the drawing's entities
+    /// ([`Dxf::entity`]) and the BLOCK / ENDBLK markers, whose owner is their block record.
+    fn entity_head(&mut self, kind: &str, handle: &str, owner: &str, layer: &str, subclass: &str) {
+        self.pair(0, kind);
+        self.pair(5, handle);
+        self.pair(330, owner);
         self.pair(100, "AcDbEntity");
         self.pair(8, layer);
         self.pair(100, subclass);
+    }
+
+    /// A symbol-table record's common head: its type, handle, owner (the handle of the table it
+    /// stands in), the two subclass markers and its name; the group codes that follow differ per
+    /// table (flags, colour, line pattern, font). The tables' counterpart of [`Dxf::entity`].
+    fn record(&mut self, kind: &str, handle: &str, owner: &str, subclass: &str, name: &str) {
+        self.pair(0, kind);
+        self.pair(5, handle);
+        self.pair(330, owner);
+        self.pair(100, "AcDbSymbolTableRecord");
+        self.pair(100, subclass);
+        self.pair(2, name);
     }
 
     fn text(&mut self, layer: &str, at: Vec2, height: f64, value: &str) {
@@ -164,12 +183,7 @@ fn head(d: &mut Dxf, extent: Vec2) {
     d.pair(2, "TABLES");
     // Line types: CONTINUOUS only.
     table(d, "LTYPE", "5", 1);
-    d.pair(0, "LTYPE");
-    d.pair(5, "14");
-    d.pair(330, "5");
-    d.pair(100, "AcDbSymbolTableRecord");
-    d.pair(100, "AcDbLinetypeTableRecord");
-    d.pair(2, "CONTINUOUS");
+    d.record("LTYPE", "14", "5", "AcDbLinetypeTableRecord", "CONTINUOUS");
     d.pair(70, 0);
     d.pair(3, "Solid line");
     d.pair(72, 65);
@@ -178,24 +192,15 @@ fn head(d: &mut Dxf, extent: Vec2) {
     d.pair(0, "ENDTAB");
     table(d, "LAYER", "2", LAYERS.len() + 1);
     for (k, (name, colour)) in [("0", 7)].into_iter().chain(LAYERS).enumerate() {
-        d.pair(0, "LAYER");
-        d.pair(5, format!("{:X}", 0x40 + k));
-        d.pair(330, "2");
-        d.pair(100, "AcDbSymbolTableRecord");
-        d.pair(100, "AcDbLayerTableRecord");
-        d.pair(2, name);
+        let handle = format!("{:X}", 0x40 + k);
+        d.record("LAYER", &handle, "2", "AcDbLayerTableRecord", name);
         d.pair(70, 0);
         d.pair(62, colour);
         d.pair(6, "CONTINUOUS");
     }
     d.pair(0, "ENDTAB");
     table(d, "STYLE", "3", 1);
-    d.pair(0, "STYLE");
-    d.pair(5, "11");
-    d.pair(330, "3");
-    d.pair(100, "AcDbSymbolTableRecord");
-    d.pair(100, "AcDbTextStyleTableRecord");
-    d.pair(2, "STANDARD");
+    d.record("STYLE", "11", "3", "AcDbTextStyleTableRecord", "STANDARD");
     d.pair(70, 0);
     d.pair(40, 0.0);
     d.pair(41, 1.0);
@@ -207,12 +212,7 @@ fn head(d: &mut Dxf, extent: Vec2) {
     d.pair(0, "ENDTAB");
     table(d, "BLOCK_RECORD", "1", 2);
     for (handle, name) in [("1F", "*Model_Space"), ("1B", "*Paper_Space")] {
-        d.pair(0, "BLOCK_RECORD");
-        d.pair(5, handle);
-        d.pair(330, "1");
-        d.pair(100, "AcDbSymbolTableRecord");
-        d.pair(100, "AcDbBlockTableRecord");
-        d.pair(2, name);
+        d.record("BLOCK_RECORD", handle, "1", "AcDbBlockTableRecord", name);
     }
     d.pair(0, "ENDTAB");
     d.pair(0, "ENDSEC");
@@ -222,12 +222,7 @@ fn head(d: &mut Dxf, extent: Vec2) {
         ("20", "21", "1F", "*Model_Space"),
         ("1C", "1D", "1B", "*Paper_Space"),
     ] {
-        d.pair(0, "BLOCK");
-        d.pair(5, block);
-        d.pair(330, owner);
-        d.pair(100, "AcDbEntity");
-        d.pair(8, "0");
-        d.pair(100, "AcDbBlockBegin");
+        d.entity_head("BLOCK", block, owner, "0", "AcDbBlockBegin");
         d.pair(2, name);
         d.pair(70, 0);
         for (c, v) in [(10, 0.0), (20, 0.0), (30, 0.0)] {
@@ -235,12 +230,7 @@ fn head(d: &mut Dxf, extent: Vec2) {
         }
         d.pair(3, name);
         d.pair(1, "");
-        d.pair(0, "ENDBLK");
-        d.pair(5, end);
-        d.pair(330, owner);
-        d.pair(100, "AcDbEntity");
-        d.pair(8, "0");
-        d.pair(100, "AcDbBlockEnd");
+        d.entity_head("ENDBLK", end, owner, "0", "AcDbBlockEnd");
     }
     d.pair(0, "ENDSEC");
 }

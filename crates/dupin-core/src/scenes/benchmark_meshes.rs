@@ -1,5 +1,5 @@
 //! Test and benchmark meshes for PQ perturbation: a skew quad grid on z = xy, a regular torus
-//! quad mesh, a noisy vase and the centroid dual of a regular torus triangulation.
+//! quad mesh, a noisy vase, a regular torus triangulation and its centroid dual.
 
 use crate::Vec3;
 use crate::conical::principal_quad_mesh;
@@ -68,6 +68,31 @@ pub fn noisy_vase(n: usize) -> PolyMesh {
         }
     }
     m
+}
+
+/// The regular triangulation of a torus (R = `major`, r = `minor`) with `nu x nv` vertices at
+/// u = 2 pi i / nu, v = 2 pi j / nv, each parameter quad split along the same diagonal (all
+/// valences 6): `2 nu nv` triangles, oriented along the outward normal. The closed test mesh of
+/// the mesh-surface queries (closest point, footpoints) and their benchmarks.
+pub fn torus_triangulation(nu: usize, nv: usize, major: f64, minor: f64) -> PolyMesh {
+    let torus = Torus { major, minor };
+    let mut pos = Vec::with_capacity(nu * nv);
+    for j in 0..nv {
+        for i in 0..nu {
+            let u = std::f64::consts::TAU * i as f64 / nu as f64;
+            let v = std::f64::consts::TAU * j as f64 / nv as f64;
+            pos.push(torus.position(u, v));
+        }
+    }
+    let id = |i: usize, j: usize| ((j % nv) * nu + (i % nu)) as u32;
+    let mut faces = Vec::with_capacity(2 * nu * nv);
+    for j in 0..nv {
+        for i in 0..nu {
+            faces.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            faces.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    PolyMesh::new(pos, faces).expect("grid indices are valid")
 }
 
 /// The centroid dual of the regular triangulation of a torus (R = `major`, r = `minor`) with

@@ -318,29 +318,10 @@ fn fit_quadric(
 mod tests {
     use super::*;
     use crate::mesh::write_obj;
+    use crate::scenes::benchmark_meshes::torus_triangulation;
     use crate::surface::{Surface, Torus};
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
-
-    fn torus_mesh(t: &Torus, nu: usize, nv: usize) -> PolyMesh {
-        let mut pos = Vec::new();
-        for j in 0..nv {
-            for i in 0..nu {
-                let u = std::f64::consts::TAU * i as f64 / nu as f64;
-                let v = std::f64::consts::TAU * j as f64 / nv as f64;
-                pos.push(t.position(u, v));
-            }
-        }
-        let id = |i: usize, j: usize| ((j % nv) * nu + (i % nu)) as u32;
-        let mut faces = Vec::new();
-        for j in 0..nv {
-            for i in 0..nu {
-                faces.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-                faces.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-            }
-        }
-        PolyMesh::new(pos, faces).unwrap()
-    }
 
     #[test]
     fn torus_curvature_within_two_percent() {
@@ -350,7 +331,9 @@ mod tests {
         };
         let (nu, nv) = (240, 96);
         // Through OBJ text, as the CLI reads it.
-        let surf = MeshSurface::from_obj(&write_obj(&torus_mesh(&t, nu, nv))).unwrap();
+        let surf =
+            MeshSurface::from_obj(&write_obj(&torus_triangulation(nu, nv, t.major, t.minor)))
+                .unwrap();
         let mut worst: f64 = 0.0;
         let mut worst_normal: f64 = 0.0;
         for j in 0..nv {
@@ -379,7 +362,7 @@ mod tests {
             major: 2.0,
             minor: 0.7,
         };
-        let mesh = torus_mesh(&t, 40, 20);
+        let mesh = torus_triangulation(40, 20, t.major, t.minor);
         let surf = MeshSurface::from_mesh(mesh.clone());
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         for _ in 0..200 {

@@ -44,6 +44,27 @@ pub struct Domain {
 }
 
 impl Domain {
+    /// u the angle about an axis, a full turn `[0, 2pi)` and periodic; v in `v`, not periodic:
+    /// the meridian interval of a surface of revolution (sphere, cylinder, vase, catenoid,
+    /// hyperboloid) or the latitude of the ellipsoid.
+    pub fn full_turn_in_u(v: (f64, f64)) -> Domain {
+        Domain {
+            u: (0.0, std::f64::consts::TAU),
+            v,
+            periodic_u: true,
+            periodic_v: false,
+        }
+    }
+
+    /// u and v both a full turn `[0, 2pi)` and both periodic: the closed ring surfaces (torus,
+    /// ring Dupin cyclide), parametrised by their two families of circles.
+    pub fn full_turns() -> Domain {
+        Domain {
+            periodic_v: true,
+            ..Domain::full_turn_in_u((0.0, std::f64::consts::TAU))
+        }
+    }
+
     /// Maps (u, v) into the domain: periodic directions wrap into `[lo, hi)`, the others are
     /// clamped to `[lo, hi]`. Non-finite input is returned unchanged.
     pub fn normalize(&self, u: f64, v: f64) -> (f64, f64) {

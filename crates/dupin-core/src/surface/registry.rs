@@ -85,14 +85,35 @@ pub struct SurfaceSpec {
     pub params: &'static [ParamSpec],
 }
 
-const fn len(key: &'static str, default: f64, doc: &'static str) -> ParamSpec {
+/// A real parameter with its own range `[min, max]`: the one place a catalogue entry is spelt
+/// out, so the catalogue below reads as a table of (key, default, range, meaning).
+const fn real(key: &'static str, default: f64, min: f64, max: f64, doc: &'static str) -> ParamSpec {
     ParamSpec {
         key,
         default,
-        min: 1e-6,
-        max: 1e6,
+        min,
+        max,
         integer: false,
         doc,
+    }
+}
+
+/// A length (radius, semi-axis, extent): positive, with the range every length shares.
+const fn len(key: &'static str, default: f64, doc: &'static str) -> ParamSpec {
+    real(key, default, 1e-6, 1e6, doc)
+}
+
+/// A count of control points: a real range whose values must also be integers.
+const fn count(
+    key: &'static str,
+    default: f64,
+    min: f64,
+    max: f64,
+    doc: &'static str,
+) -> ParamSpec {
+    ParamSpec {
+        integer: true,
+        ..real(key, default, min, max, doc)
     }
 }
 
@@ -125,14 +146,7 @@ static CATALOG: &[SurfaceSpec] = &[
         params: &[
             len("a", 1.0, "waist radius"),
             len("c", 1.0, "vertical scale"),
-            ParamSpec {
-                key: "vmax",
-                default: 1.2,
-                min: 1e-3,
-                max: 10.0,
-                integer: false,
-                doc: "half-range of v",
-            },
+            real("vmax", 1.2, 1e-3, 10.0, "half-range of v"),
         ],
     },
     SurfaceSpec {
@@ -149,14 +163,7 @@ static CATALOG: &[SurfaceSpec] = &[
         parametrisation: "ring cyclide, d = a - c cos u cos v: ((mu (c - a cos u cos v) + b^2 cos u)/d, b sin u (a - mu cos v)/d, b sin v (c cos u - mu)/d), b^2 = a^2 - c^2, u, v in [0, 2pi) periodic; needs 0 <= c < mu < a",
         params: &[
             len("a", 2.0, "semi-major axis of the focal ellipse"),
-            ParamSpec {
-                key: "c",
-                default: 0.6,
-                min: 0.0,
-                max: 1e6,
-                integer: false,
-                doc: "focal distance (0 gives a torus)",
-            },
+            real("c", 0.6, 0.0, 1e6, "focal distance (0 gives a torus)"),
             len("mu", 1.1, "sphere-radius parameter (c < mu < a)"),
         ],
     },
@@ -179,14 +186,13 @@ static CATALOG: &[SurfaceSpec] = &[
         parametrisation: "scale (u - u^3/3 + u v^2, v - v^3/3 + v u^2, u^2 - v^2), u, v in [-extent, extent]",
         params: &[
             len("scale", 1.0, "uniform scale"),
-            ParamSpec {
-                key: "extent",
-                default: 1.0,
-                min: 1e-3,
-                max: 1.2,
-                integer: false,
-                doc: "half-extent of the square domain (embedded up to 1.2)",
-            },
+            real(
+                "extent",
+                1.0,
+                1e-3,
+                1.2,
+                "half-extent of the square domain (embedded up to 1.2)",
+            ),
         ],
     },
     SurfaceSpec {
@@ -198,31 +204,10 @@ static CATALOG: &[SurfaceSpec] = &[
         name: "bspline",
         parametrisation: "uniform bicubic B-spline patch, control net (x_i, y_j, amplitude sin(1.2 x_i) cos(0.9 y_j) + 0.1 (x_i^2 + y_j^2)) on an nu x nv grid over [-size, size]^2, u in [0, nu - 3], v in [0, nv - 3]",
         params: &[
-            ParamSpec {
-                key: "nu",
-                default: 8.0,
-                min: 4.0,
-                max: 256.0,
-                integer: true,
-                doc: "control points along u",
-            },
-            ParamSpec {
-                key: "nv",
-                default: 8.0,
-                min: 4.0,
-                max: 256.0,
-                integer: true,
-                doc: "control points along v",
-            },
+            count("nu", 8.0, 4.0, 256.0, "control points along u"),
+            count("nv", 8.0, 4.0, 256.0, "control points along v"),
             len("size", 2.0, "half-extent of the control net"),
-            ParamSpec {
-                key: "amplitude",
-                default: 0.5,
-                min: -1e6,
-                max: 1e6,
-                integer: false,
-                doc: "height of the waves",
-            },
+            real("amplitude", 0.5, -1e6, 1e6, "height of the waves"),
         ],
     },
 ];

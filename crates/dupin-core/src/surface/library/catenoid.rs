@@ -3,7 +3,6 @@
 
 use crate::surface::RegistryError;
 use crate::surface::{Domain, Surface, SurfaceDerivatives, revolution_derivatives};
-use std::f64::consts::TAU;
 
 /// Catenoid (c cosh(v/c) cos u, c cosh(v/c) sin u, v), u in [0, 2 pi) periodic,
 /// v in [-height/2, height/2]. Principal curvatures +-1 / (c cosh^2(v/c)).
@@ -29,12 +28,7 @@ impl Catenoid {
 
 impl Surface for Catenoid {
     fn domain(&self) -> Domain {
-        Domain {
-            u: (0.0, TAU),
-            v: (-0.5 * self.height, 0.5 * self.height),
-            periodic_u: true,
-            periodic_v: false,
-        }
+        Domain::full_turn_in_u((-0.5 * self.height, 0.5 * self.height))
     }
 
     fn derivatives(&self, u: f64, v: f64) -> SurfaceDerivatives {

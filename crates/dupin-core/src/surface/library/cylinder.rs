@@ -3,7 +3,6 @@
 
 use crate::surface::RegistryError;
 use crate::surface::{Domain, Surface, SurfaceDerivatives, revolution_derivatives};
-use std::f64::consts::TAU;
 
 /// Cylinder (r cos u, r sin u, v), u in [0, 2 pi) periodic, v in [0, height].
 /// k1 = 0 (along the rulings), k2 = -1/r (outward normal): every point is parabolic.
@@ -29,12 +28,7 @@ impl Cylinder {
 
 impl Surface for Cylinder {
     fn domain(&self) -> Domain {
-        Domain {
-            u: (0.0, TAU),
-            v: (0.0, self.height),
-            periodic_u: true,
-            periodic_v: false,
-        }
+        Domain::full_turn_in_u((0.0, self.height))
     }
 
     fn derivatives(&self, u: f64, v: f64) -> SurfaceDerivatives {

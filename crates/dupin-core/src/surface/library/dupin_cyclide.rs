@@ -3,7 +3,6 @@
 use crate::Vec3;
 use crate::surface::RegistryError;
 use crate::surface::{Domain, Surface, SurfaceDerivatives};
-use std::f64::consts::TAU;
 
 /// Ring Dupin cyclide in the standard form with focal ellipse x^2/a^2 + y^2/b^2 = 1 and focal
 /// hyperbola x^2/c^2 - z^2/b^2 = 1, b^2 = a^2 - c^2:
@@ -53,12 +52,7 @@ impl DupinCyclide {
 
 impl Surface for DupinCyclide {
     fn domain(&self) -> Domain {
-        Domain {
-            u: (0.0, TAU),
-            v: (0.0, TAU),
-            periodic_u: true,
-            periodic_v: true,
-        }
+        Domain::full_turns()
     }
 
     fn derivatives(&self, u: f64, v: f64) -> SurfaceDerivatives {

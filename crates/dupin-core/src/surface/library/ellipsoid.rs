@@ -3,7 +3,7 @@
 use crate::Vec3;
 use crate::surface::RegistryError;
 use crate::surface::{Domain, Surface, SurfaceDerivatives};
-use std::f64::consts::{FRAC_PI_2, TAU};
+use std::f64::consts::FRAC_PI_2;
 
 /// Ellipsoid (a cos v cos u, b cos v sin u, c sin v), u in [0, 2 pi) periodic, v in
 /// [-pi/2, pi/2] (poles singular). Outward normal, so both principal curvatures are negative.
@@ -37,12 +37,7 @@ impl Ellipsoid {
 
 impl Surface for Ellipsoid {
     fn domain(&self) -> Domain {
-        Domain {
-            u: (0.0, TAU),
-            v: (-FRAC_PI_2, FRAC_PI_2),
-            periodic_u: true,
-            periodic_v: false,
-        }
+        Domain::full_turn_in_u((-FRAC_PI_2, FRAC_PI_2))
     }
 
     fn derivatives(&self, u: f64, v: f64) -> SurfaceDerivatives {

@@ -3,7 +3,6 @@
 
 use crate::surface::RegistryError;
 use crate::surface::{Domain, Surface, SurfaceDerivatives, revolution_derivatives};
-use std::f64::consts::TAU;
 
 /// Hyperboloid (a cosh v cos u, a cosh v sin u, c sinh v), u in [0, 2 pi) periodic,
 /// v in [-v_max, v_max]. `a` is the waist radius, `c` the vertical scale; K < 0 everywhere.
@@ -32,12 +31,7 @@ impl Hyperboloid {
 
 impl Surface for Hyperboloid {
     fn domain(&self) -> Domain {
-        Domain {
-            u: (0.0, TAU),
-            v: (-self.v_max, self.v_max),
-            periodic_u: true,
-            periodic_v: false,
-        }
+        Domain::full_turn_in_u((-self.v_max, self.v_max))
     }
 
     fn derivatives(&self, u: f64, v: f64) -> SurfaceDerivatives {

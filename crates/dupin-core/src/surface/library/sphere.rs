@@ -1,7 +1,7 @@
 //! Sphere, parametrised as in the outside contract (P-Hex paper, section 7, Fig. 20).
 
 use crate::surface::{Domain, Surface, SurfaceDerivatives, revolution_derivatives};
-use std::f64::consts::{FRAC_PI_2, TAU};
+use std::f64::consts::FRAC_PI_2;
 
 /// Sphere r (cos v cos u, cos v sin u, sin v), u in [0, 2 pi) periodic, v in [-pi/2, pi/2].
 ///
@@ -17,12 +17,7 @@ pub struct Sphere {
 
 impl Surface for Sphere {
     fn domain(&self) -> Domain {
-        Domain {
-            u: (0.0, TAU),
-            v: (-FRAC_PI_2, FRAC_PI_2),
-            periodic_u: true,
-            periodic_v: false,
-        }
+        Domain::full_turn_in_u((-FRAC_PI_2, FRAC_PI_2))
     }
 
     fn derivatives(&self, u: f64, v: f64) -> SurfaceDerivatives {

@@ -2,7 +2,6 @@
 
 use crate::Vec3;
 use crate::surface::{Domain, Surface, SurfaceDerivatives};
-use std::f64::consts::TAU;
 
 /// Torus ((R + r cos v) cos u, (R + r cos v) sin u, r sin v), u, v in [0, 2 pi), both periodic.
 ///
@@ -20,12 +19,7 @@ pub struct Torus {
 
 impl Surface for Torus {
     fn domain(&self) -> Domain {
-        Domain {
-            u: (0.0, TAU),
-            v: (0.0, TAU),
-            periodic_u: true,
-            periodic_v: true,
-        }
+        Domain::full_turns()
     }
 
     fn derivatives(&self, u: f64, v: f64) -> SurfaceDerivatives {

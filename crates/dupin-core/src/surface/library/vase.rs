@@ -3,7 +3,7 @@
 
 use crate::surface::RegistryError;
 use crate::surface::{Domain, Surface, SurfaceDerivatives, revolution_derivatives};
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::PI;
 
 /// Vase (rho(v) cos u, rho(v) sin u, v) with rho(v) = radius + amplitude sin(2 pi v / height),
 /// u in [0, 2 pi) periodic, v in [0, height].
@@ -57,12 +57,7 @@ impl Vase {
 
 impl Surface for Vase {
     fn domain(&self) -> Domain {
-        Domain {
-            u: (0.0, TAU),
-            v: (0.0, self.height),
-            periodic_u: true,
-            periodic_v: false,
-        }
+        Domain::full_turn_in_u((0.0, self.height))
     }
 
     fn derivatives(&self, u: f64, v: f64) -> SurfaceDerivatives {
