@@ -1,4 +1,5 @@
-//! Rust values and errors as JS values: the two conversions every page API module uses.
+//! Rust values and errors as JS values, and JS arguments checked before use: the conversions
+//! every page API module uses.
 
 use serde::Serialize;
 use wasm_bindgen::prelude::*;
@@ -12,4 +13,26 @@ pub(crate) fn to_js<T: Serialize>(v: &T) -> Result<JsValue, JsError> {
 /// A JS `Error` carrying the Rust message.
 pub(crate) fn err(e: impl std::fmt::Display) -> JsError {
     JsError::new(&e.to_string())
+}
+
+/// A string argument from JS, checked: a number or an object where a string is expected is a
+/// JS `Error` naming the argument, not a trap in wasm memory.
+pub(crate) fn string_arg(value: &JsValue, what: &str) -> Result<String, JsError> {
+    value.as_string().ok_or_else(|| {
+        let got = if value.is_undefined() || value.is_null() {
+            "nothing".to_string()
+        } else {
+            value.js_typeof().as_string().unwrap_or_default()
+        };
+        err(format!("{what} must be a string, got {got}"))
+    })
+}
+
+/// A number argument from JS, checked to be a finite number.
+pub(crate) fn number_arg(value: f64, what: &str) -> Result<f64, JsError> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(err(format!("{what} must be a finite number, got {value}")))
+    }
 }

@@ -529,7 +529,12 @@ impl DupinLesson {
     /// `params` is an object of the surface's parameters (missing keys take their defaults).
     /// Throws for unknown surfaces, bad parameters, singular or planar points.
     #[wasm_bindgen(constructor)]
-    pub fn new(surface: &str, params: JsValue, u: f64, v: f64) -> Result<DupinLesson, JsError> {
+    pub fn new(surface: JsValue, params: JsValue, u: f64, v: f64) -> Result<DupinLesson, JsError> {
+        let surface = crate::js::string_arg(&surface, "the surface name")?;
+        let (u, v) = (
+            crate::js::number_arg(u, "u")?,
+            crate::js::number_arg(v, "v")?,
+        );
         let params: BTreeMap<String, f64> = if params.is_undefined() || params.is_null() {
             BTreeMap::new()
         } else {
@@ -537,7 +542,7 @@ impl DupinLesson {
                 .map_err(|e| err(format!("surface parameters must be numbers: {e}")))?
         };
         let list: Vec<(&str, f64)> = params.iter().map(|(k, v)| (k.as_str(), *v)).collect();
-        DupinLesson::build(surface, &list, u, v).map_err(err)
+        DupinLesson::build(&surface, &list, u, v).map_err(err)
     }
 
     /// The lesson at a picked mesh vertex: `pick` is what `Session.pickVertex` returned (the

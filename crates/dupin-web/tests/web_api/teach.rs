@@ -18,7 +18,7 @@ fn pair(v: &JsValue) -> (f64, f64) {
 #[wasm_bindgen_test]
 fn lesson_validity_flips_across_de() {
     let params = js_sys::JSON::parse(r#"{"R":2,"r":0.7}"#).unwrap();
-    let mut l = DupinLesson::new("torus", params, 0.3, 0.4).unwrap();
+    let mut l = DupinLesson::new("torus".into(), params, 0.3, 0.4).unwrap();
     let s = l.state().unwrap();
     assert_eq!(get(&s, "kind").as_string().as_deref(), Some("elliptic"));
     assert_eq!(get(&s, "verdict").as_string().as_deref(), Some("valid"));
@@ -59,11 +59,14 @@ fn lesson_validity_flips_across_de() {
 
 #[wasm_bindgen_test]
 fn lesson_errors_are_js_errors() {
-    assert!(DupinLesson::new("nope", JsValue::UNDEFINED, 0.0, 0.0).is_err());
-    assert!(DupinLesson::new("sphere", JsValue::UNDEFINED, f64::NAN, 0.0).is_err());
+    assert!(DupinLesson::new("nope".into(), JsValue::UNDEFINED, 0.0, 0.0).is_err());
+    assert!(DupinLesson::new("sphere".into(), JsValue::UNDEFINED, f64::NAN, 0.0).is_err());
     let bad = js_sys::JSON::parse(r#"{"radius":"big"}"#).unwrap();
-    assert!(DupinLesson::new("sphere", bad, 0.0, 0.0).is_err());
+    assert!(DupinLesson::new("sphere".into(), bad, 0.0, 0.0).is_err());
     assert!(DupinLesson::from_curvatures_js(0.0, 0.0).is_err());
+    // A number where the surface name belongs is an Error, not a trap in wasm memory.
+    assert!(DupinLesson::new(JsValue::from(42), JsValue::UNDEFINED, 0.0, 0.0).is_err());
+    assert!(DupinLesson::new(JsValue::NULL, JsValue::UNDEFINED, 0.0, 0.0).is_err());
 }
 
 #[wasm_bindgen_test]
