@@ -10,7 +10,7 @@
 
 use dupin_core::hex_delaunay::{HexDelaunayMode, HexDelaunayStepper, triangulation_quality};
 
-use dupin_core::Vec2;
+use dupin_core::{Stepper, Vec2};
 use serde::Serialize;
 use wasm_bindgen::prelude::*;
 
@@ -52,20 +52,12 @@ pub struct HexDelaunayLab {
     stepper: Option<HexDelaunayStepper>,
 }
 
-fn mode_of(name: &str) -> Result<HexDelaunayMode, String> {
-    match name {
-        "simple" => Ok(HexDelaunayMode::Simple),
-        "extended" => Ok(HexDelaunayMode::Extended),
-        other => Err(format!(
-            "mode must be `simple` or `extended`, not `{other}`"
-        )),
-    }
-}
-
 impl HexDelaunayLab {
     pub(crate) fn with_mode(mode: &str) -> Result<Self, String> {
         Ok(HexDelaunayLab {
-            mode: mode_of(mode)?,
+            mode: mode
+                .parse()
+                .map_err(|e: dupin_core::UnknownName| e.to_string())?,
             stepper: None,
         })
     }
@@ -154,7 +146,10 @@ impl HexDelaunayLab {
     /// One subdivision step; false once refinement is finished (or there is no input).
     pub fn step(&mut self) -> Result<bool, JsError> {
         match &mut self.stepper {
-            Some(s) => s.step().map_err(|e| JsError::new(&e.to_string())),
+            Some(s) => s
+                .step()
+                .map(|m| m.changed)
+                .map_err(|e| JsError::new(&e.to_string())),
             None => Ok(false),
         }
     }
@@ -223,7 +218,7 @@ mod tests {
         // Segments are triangulated (section 7); crossing ones are refused with the reason.
         lab.set_input(&[0.0, 0.0, 1.0, 0.0, 0.0, 1.0], &[0, 1])
             .unwrap();
-        while lab.stepper.as_mut().unwrap().step().unwrap() {}
+        while lab.stepper.as_mut().unwrap().step().unwrap().changed {}
         assert!(
             !lab.stepper
                 .as_ref()
@@ -240,7 +235,7 @@ mod tests {
         assert!(HexDelaunayLab::with_mode("fancy").is_err());
         let mut ext = HexDelaunayLab::with_mode("extended").unwrap();
         ext.set_input(&[0.0, 0.0, 1.0, 0.2], &[]).unwrap();
-        while ext.stepper.as_mut().unwrap().step().unwrap() {}
+        while ext.stepper.as_mut().unwrap().step().unwrap().changed {}
         let d = ext.dual_data();
         assert!(d.min_angle >= 43.89 && d.max_angle <= 90.0001, "{d:?}");
     }

@@ -1,12 +1,11 @@
 //! `Session`: the contract's step-by-step JS API over the core's P-Hex pipeline and PQ scenes.
 
 use crate::mesh_data::MeshData;
+use dupin_core::Stepper;
 use dupin_core::conical::{PqMode, PqSceneStepInfo, PqSceneStepper, support_structure};
 use dupin_core::fabrication::{SheetOptions, panel_schedule, panel_schedule_svg};
 use dupin_core::mesh::{PolyMesh, face_planarity, max_planarity, write_obj};
-use dupin_core::phex::{
-    Initialisation, LayerRule, PhexConfig, PhexPipeline, TriangulationMethod, face_info,
-};
+use dupin_core::phex::{LayerRule, PhexConfig, PhexPipeline, TriangulationMethod, face_info};
 use dupin_core::scenes::{PHEX_SCENES, PQ_SCENES, phex_scene, pq_scene_stepper};
 use dupin_core::surface::surface_catalog;
 use serde::{Deserialize, Serialize};
@@ -326,15 +325,12 @@ impl Session {
                 Run::Phex(Box::new(PhexPipeline::new(scene.config).map_err(err)?))
             }
             (None, Some(surface)) => {
-                let method = match cfg.method.as_deref().unwrap_or("progressive") {
-                    "progressive" => TriangulationMethod::Progressive,
-                    "prescribed" => TriangulationMethod::Prescribed,
-                    other => {
-                        return Err(JsError::new(&format!(
-                            "method must be `progressive` or `prescribed`, not `{other}`"
-                        )));
-                    }
-                };
+                let method: TriangulationMethod = cfg
+                    .method
+                    .as_deref()
+                    .unwrap_or("progressive")
+                    .parse()
+                    .map_err(err)?;
                 let params: Vec<(String, f64)> =
                     cfg.params.iter().map(|(k, v)| (k.clone(), *v)).collect();
                 let mut config = PhexConfig::for_surface(surface, &params, method, cfg.size);
@@ -347,15 +343,12 @@ impl Session {
                 if let Some(m) = cfg.mu {
                     config.mu = m;
                 }
-                config.initialisation = match cfg.init.as_deref().unwrap_or("tangent-duality") {
-                    "tangent-duality" => Initialisation::TangentDuality,
-                    "dupin-duality" => Initialisation::DupinDuality,
-                    other => {
-                        return Err(JsError::new(&format!(
-                            "init must be `tangent-duality` or `dupin-duality`, not `{other}`"
-                        )));
-                    }
-                };
+                config.initialisation = cfg
+                    .init
+                    .as_deref()
+                    .unwrap_or("tangent-duality")
+                    .parse()
+                    .map_err(err)?;
                 Run::Phex(Box::new(PhexPipeline::new(config).map_err(err)?))
             }
             _ => {
@@ -386,7 +379,7 @@ impl Session {
         self.per_face.replace(None);
         match &mut self.run {
             Run::Phex(p) => {
-                if !p.done() {
+                if !p.is_done() {
                     p.step().map_err(err)?;
                 }
             }
@@ -404,7 +397,7 @@ impl Session {
     /// True once the run has finished.
     pub fn done(&self) -> bool {
         match &self.run {
-            Run::Phex(p) => p.done(),
+            Run::Phex(p) => p.is_done(),
             Run::Pq { stepper, started } => *started && stepper.is_done(),
         }
     }
@@ -760,7 +753,7 @@ impl Session {
                     max_determinant,
                     singular_points_inside,
                     ..
-                } = stepper.info();
+                } = stepper.metrics();
                 Metrics {
                     // Before the first step nothing is shown yet.
                     phase: if *started { phase.name() } else { "ready" },
@@ -871,7 +864,7 @@ mod tests {
         let mut opt =
             PlanarityOptimiser::new(&d.mesh, Some(&d.vertex_uv), cfg.planarity_options()).unwrap();
         println!("faces {}", d.mesh.num_faces());
-        while !opt.done() {
+        while !opt.is_done() {
             let (t, cg, f) = (cpu(), opt.cg_iterations(), opt.factorizations());
             let st = opt.step(&mut d.mesh, p.surface()).unwrap();
             println!(
@@ -910,7 +903,7 @@ mod tests {
     fn cached_face_planarity_follows_every_step() {
         let mut cfg =
             PhexConfig::for_surface("torus", &[], TriangulationMethod::Prescribed, Some(0.6));
-        cfg.initialisation = Initialisation::DupinDuality;
+        cfg.initialisation = dupin_core::phex::Initialisation::DupinDuality;
         let mut session = Session {
             run: Run::Phex(Box::new(PhexPipeline::new(cfg).unwrap())),
             config: serde_json::from_str(r#"{"surface": "torus"}"#).unwrap(),

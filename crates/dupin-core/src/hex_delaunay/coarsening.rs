@@ -140,6 +140,7 @@ mod tests {
     use super::super::tests::{check_with, paper_data_sets};
     use super::super::{HexDelaunayMode, HexDelaunayStepper};
     use super::*;
+    use crate::Stepper;
 
     /// The stepper shows the coarsening as its own step; each blossom saves 36 triangles
     /// (96 → 60) against the same run without coarsening, and every guarantee holds after it.
@@ -161,7 +162,7 @@ mod tests {
                 .unwrap();
                 s.set_coarsening(coarsen);
                 let mut merged = Vec::new();
-                while s.step().unwrap() {
+                while s.step().unwrap().changed {
                     if !s.last_merges().is_empty() {
                         assert!(merged.is_empty(), "{name}: one coarsening step");
                         assert!(s.last_splits().is_empty(), "{name}");

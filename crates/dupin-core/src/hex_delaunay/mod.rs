@@ -47,8 +47,9 @@ mod stepper;
 pub use error::HexDelaunayError;
 pub use min_enclosing_circle::{Circle, min_enclosing_circle};
 pub use quality::{TriangulationQuality, triangulation_quality};
-pub use stepper::{HexCell, HexDelaunayStepper};
+pub use stepper::{HexCell, HexDelaunayMetrics, HexDelaunayStepper};
 
+use crate::Stepper;
 use crate::mesh::PolyMesh;
 use crate::{Vec2, Vec3};
 
@@ -61,6 +62,11 @@ pub enum HexDelaunayMode {
     /// Section 5: angles in [43.9°, 90°] (Ω with inradius 3ρ instead of 1.5ρ).
     Extended,
 }
+
+crate::names::named_choices!(HexDelaunayMode, "mode", {
+    Simple => "simple",
+    Extended => "extended",
+});
 
 /// The result of [`hex_delaunay`].
 #[derive(Debug, Clone, PartialEq)]
@@ -127,8 +133,8 @@ pub const MIN_EXTENT: f64 = 1e-100;
 pub const MAX_LEVEL: u32 = 48;
 
 /// Triangulates `points` and the segments `segments` (each a pair of point indices; they may
-/// share endpoints but not cross or overlap) by hexagonal subdivision. One-shot form of
-/// [`HexDelaunayStepper`].
+/// share endpoints but not cross or overlap) by hexagonal subdivision: [`HexDelaunayStepper`]
+/// run to its end.
 ///
 /// Errors: empty input, NaN/infinite or out-of-range coordinates, points too close for the
 /// hierarchy depth cap, bad segments, or a numerical breakdown of the segment insertion.
@@ -137,9 +143,7 @@ pub fn hex_delaunay(
     segments: &[[usize; 2]],
     mode: HexDelaunayMode,
 ) -> Result<HexTriangulation, HexDelaunayError> {
-    let mut s = HexDelaunayStepper::new(points, segments, mode)?;
-    s.run()?;
-    s.try_triangulation()
+    HexDelaunayStepper::new(points, segments, mode)?.finish()
 }
 
 #[cfg(test)]
