@@ -3,20 +3,12 @@
 //! [--report r.json]`).
 
 use crate::common::{CliError, read_text, write_report, write_text};
-use clap::{Args, ValueEnum};
-use dupin_core::hex_delaunay::{HexDelaunayMode, hex_delaunay, triangulation_quality};
+use clap::Args;
+use dupin_core::Stepper;
+use dupin_core::hex_delaunay::{HexDelaunayMode, HexDelaunayStepper, triangulation_quality};
 use dupin_core::mesh::{parse_points, parse_segments, write_obj};
 use std::path::PathBuf;
 use std::time::Instant;
-
-/// Refinement mode.
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum Mode {
-    /// Section 4: angles in [30, 120] degrees.
-    Simple,
-    /// Section 5: angles in [43.9, 90] degrees.
-    Extended,
-}
 
 /// Arguments of `dupin hexdelaunay`.
 #[derive(Args, Debug)]
@@ -27,9 +19,10 @@ pub struct HexDelaunayArgs {
     /// Segments file: one `i j` per line, 0-based indices into the points file.
     #[arg(long)]
     segments: Option<PathBuf>,
-    /// Refinement mode.
-    #[arg(long, value_enum, default_value = "simple")]
-    mode: Mode,
+    /// Refinement mode: simple (section 4: angles in [30, 120] degrees) or extended (section
+    /// 5: angles in [43.9, 90] degrees).
+    #[arg(long, default_value = "simple")]
+    mode: HexDelaunayMode,
     /// Output OBJ (triangles, z = 0).
     #[arg(long)]
     out: PathBuf,
@@ -51,12 +44,11 @@ pub fn run(args: HexDelaunayArgs) -> Result<(), CliError> {
             .map_err(|e| CliError::input(&p.display().to_string(), e))?,
         None => Vec::new(),
     };
-    let mode = match args.mode {
-        Mode::Simple => HexDelaunayMode::Simple,
-        Mode::Extended => HexDelaunayMode::Extended,
-    };
+    let mode = args.mode;
     let start = Instant::now();
-    let tri = hex_delaunay(&points, &segments, mode).map_err(|e| CliError::input("", e))?;
+    let tri = HexDelaunayStepper::new(&points, &segments, mode)
+        .and_then(Stepper::finish)
+        .map_err(|e| CliError::input("", e))?;
     let seconds = start.elapsed().as_secs_f64();
     let q = triangulation_quality(&tri.vertices, &tri.triangles);
     // With segments (section 7) the bounds hold only for triangles that do not meet one.

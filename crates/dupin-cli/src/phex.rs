@@ -2,8 +2,9 @@
 
 use crate::common::{CliError, write_report, write_text};
 use clap::Args;
+use dupin_core::Stepper;
 use dupin_core::mesh::write_obj;
-use dupin_core::phex::{PhexConfig, TriangulationMethod, phex_run};
+use dupin_core::phex::{PhexConfig, PhexPipeline, TriangulationMethod};
 use dupin_core::scenes::{PHEX_SCENES, phex_scene};
 use dupin_core::surface::parse_assignment;
 use serde_json::json;
@@ -23,7 +24,7 @@ pub struct PhexArgs {
     pub set: Vec<String>,
     /// Triangulation method: progressive (method 1) or prescribed (method 2).
     #[arg(long)]
-    pub method: Option<String>,
+    pub method: Option<TriangulationMethod>,
     /// Target edge length of the base curve.
     #[arg(long)]
     pub size: Option<f64>,
@@ -63,16 +64,7 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
         .out
         .clone()
         .ok_or_else(|| CliError::Input("--out is required".into()))?;
-    let method = match args.method.as_deref() {
-        None => None,
-        Some("progressive") => Some(TriangulationMethod::Progressive),
-        Some("prescribed") => Some(TriangulationMethod::Prescribed),
-        Some(m) => {
-            return Err(CliError::Input(format!(
-                "unknown --method '{m}'; use progressive or prescribed"
-            )));
-        }
-    };
+    let method = args.method;
     let mut config = match (&args.scene, &args.surface) {
         (Some(name), None) => {
             if !args.set.is_empty() {
@@ -130,7 +122,9 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
         .or(args.surface.clone())
         .unwrap_or_default();
     let start = std::time::Instant::now();
-    let r = phex_run(config).map_err(|e| CliError::input("", e))?;
+    let r = PhexPipeline::new(config)
+        .and_then(Stepper::finish)
+        .map_err(|e| CliError::input("", e))?;
     let seconds = start.elapsed().as_secs_f64();
     write_text(&out, &write_obj(&r.mesh))?;
     let rep = &r.report;

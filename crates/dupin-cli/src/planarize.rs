@@ -3,21 +3,11 @@
 
 use crate::common::{CliError, read_mesh_file, write_report, write_text};
 use clap::{Args, ValueEnum};
-use dupin_core::conical::{PqMode, PqOptions, Refinement, pq_perturb};
+use dupin_core::Stepper;
+use dupin_core::conical::{PqMode, PqOptions, PqPerturbation, Refinement};
 use dupin_core::mesh::write_obj;
 use serde_json::json;
 use std::path::PathBuf;
-
-/// Which property to enforce besides planar faces.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum ModeArg {
-    /// Planar faces only.
-    Planar,
-    /// Planar faces and conical vertices (angle balance at interior valence-4 vertices).
-    Conical,
-    /// Planar faces and circular quads (opposite angles sum to pi).
-    Circular,
-}
 
 /// Solver of the exact phase after the penalty iterations.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -34,9 +24,10 @@ pub struct PlanarizeArgs {
     /// Input mesh: OBJ (any polygons), STL or glTF/GLB (triangles).
     #[arg(long)]
     pub input: PathBuf,
-    /// Property to enforce.
-    #[arg(long, value_enum, default_value = "planar")]
-    pub mode: ModeArg,
+    /// Property to enforce besides planar faces: planar, conical (angle balance at interior
+    /// valence-4 vertices) or circular (opposite angles of every quad sum to pi).
+    #[arg(long, default_value = "planar")]
+    pub mode: PqMode,
     /// Keep the boundary vertices fixed.
     #[arg(long)]
     pub fix_boundary: bool,
@@ -66,11 +57,7 @@ pub struct PlanarizeArgs {
 /// Runs `dupin planarize`.
 pub fn run(args: PlanarizeArgs) -> Result<(), CliError> {
     let mesh = read_mesh_file(&args.input)?;
-    let mode = match args.mode {
-        ModeArg::Planar => PqMode::Planar,
-        ModeArg::Conical => PqMode::Conical,
-        ModeArg::Circular => PqMode::Circular,
-    };
+    let mode = args.mode;
     let mut fixed_vertices = Vec::with_capacity(args.fix_vertices.len());
     for &i in &args.fix_vertices {
         if i == 0 || i > mesh.num_vertices() {
@@ -95,7 +82,9 @@ pub fn run(args: PlanarizeArgs) -> Result<(), CliError> {
         ..PqOptions::default()
     };
     let start = std::time::Instant::now();
-    let result = pq_perturb(&mesh, options).map_err(|e| CliError::input("", e))?;
+    let Ok(result) = PqPerturbation::new(&mesh, options)
+        .map_err(|e| CliError::input("", e))?
+        .finish();
     let seconds = start.elapsed().as_secs_f64();
     write_text(&args.out, &write_obj(&result.mesh))?;
     let mut report = json!({

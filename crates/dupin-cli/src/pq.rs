@@ -3,8 +3,9 @@
 
 use crate::common::{CliError, write_report, write_text};
 use clap::Args;
+use dupin_core::Stepper;
 use dupin_core::mesh::write_obj;
-use dupin_core::scenes::{PQ_SCENES, pq_scene};
+use dupin_core::scenes::{PQ_SCENES, pq_scene_stepper};
 use serde_json::json;
 use std::path::PathBuf;
 
@@ -38,7 +39,9 @@ pub fn run(args: PqArgs) -> Result<(), CliError> {
         .out
         .ok_or_else(|| CliError::Input("--out is required".into()))?;
     let start = std::time::Instant::now();
-    let r = pq_scene(&name).map_err(|e| CliError::input("", e))?;
+    let r = pq_scene_stepper(&name)
+        .and_then(Stepper::finish)
+        .map_err(|e| CliError::input("", e))?;
     let seconds = start.elapsed().as_secs_f64();
     write_text(&out, &write_obj(&r.mesh))?;
     let mut report = json!({

@@ -5,8 +5,8 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use dupin_core::mesh::PolyMesh;
 use dupin_core::phex::{
-    DualMesh, Initialisation, PhexConfig, PhexPipeline, PlanarityOptimiser, PlanarityOptions,
-    TriangulationMethod, TriangulationSpec, dual_mesh, phex_run, triangulate,
+    DualMesh, DualMeshOptions, Initialisation, PhexConfig, PhexPipeline, PlanarityOptimiser,
+    PlanarityOptions, TriangulationMethod, TriangulationSpec, dual_mesh, phex_run, triangulate,
 };
 use dupin_core::scenes::phex_scene;
 use dupin_core::surface::{Surface, surface_by_name};
@@ -47,7 +47,7 @@ fn optimise(
     options: PlanarityOptions,
 ) -> PlanarityOptimiser {
     let mut o = PlanarityOptimiser::new(m, Some(&d.vertex_uv), options).unwrap();
-    while !o.done() {
+    while !o.is_done() {
         o.step(m, surface).unwrap();
     }
     o
@@ -94,11 +94,11 @@ fn bench(c: &mut Criterion) {
         });
         let tri = triangulate(torus.as_ref(), &sp).unwrap();
         g.bench_function("initialisation", |b| {
-            b.iter(|| black_box(dual_mesh(&tri).unwrap()))
+            b.iter(|| black_box(dual_mesh(&tri, None, &DualMeshOptions::default()).unwrap()))
         });
         // Optimisation from a perturbed start (the pipeline's start is already planar): run
         // to max_planarity <= 1e-10.
-        let d = dual_mesh(&tri).unwrap();
+        let d = dual_mesh(&tri, None, &DualMeshOptions::default()).unwrap();
         let mut noisy = d.mesh.clone();
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         let e = noisy.face_mean_edge(0);

@@ -11,7 +11,7 @@
 
 use dupin_core::hex_delaunay::{HexDelaunayMode, hex_delaunay};
 
-use dupin_core::Vec2;
+use dupin_core::{Stepper, Vec2};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -207,7 +207,7 @@ fn main() {
             let t0 = thread_cpu().unwrap_or(0.0);
             let mut s = dupin_core::hex_delaunay::HexDelaunayStepper::new(&pts, &[], mode).unwrap();
             let t1 = thread_cpu().unwrap_or(0.0);
-            s.run().unwrap();
+            s.run_to_end().unwrap();
             let t2 = thread_cpu().unwrap_or(0.0);
             let tri = s.triangulation();
             let t3 = thread_cpu().unwrap_or(0.0);

@@ -9,6 +9,7 @@
 //! the first pays the allocations' first touch); `PENALTY=n` sets the penalty iterations,
 //! `REFINEMENT=sqp` the exact phase.
 
+use dupin_core::Stepper;
 use dupin_core::mesh::{MeshTopology, PolyMesh, parse_obj};
 
 use dupin_core::conical::{PqMode, PqOptions, PqPerturbation, Refinement};
@@ -82,7 +83,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         while !solver.is_done() {
             let before = solver.mesh().positions.clone();
             let (start, wall) = (cpu(), std::time::Instant::now());
-            let info = solver.step();
+            let Ok(info) = solver.step();
             let ms = wall.elapsed().as_secs_f64() * 1e3;
             cpu_s += cpu() - start;
             let moved = before
@@ -102,7 +103,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             );
         }
         let cpu_ms = cpu_s * 1e3;
-        let r = solver.finish();
+        let Ok(r) = solver.finish();
         eprintln!(
             "  total {cpu_ms:.1} ms CPU: {} iterations, {} factorisations, converged {}, max_planarity {:.3e}, max_move {:.4}, fairness {:.6e}",
             r.iterations,

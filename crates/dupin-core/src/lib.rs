@@ -19,6 +19,7 @@
 //! | [`scenes`] | the named scenes of both papers' figures, benchmark meshes |
 //! | [`fabrication`] | panel schedules: flattened, numbered panels on sheets |
 //! | [`Stepper`] | the one shape of every stepped computation |
+//! | [`UnknownName`] | a method, initialisation or mode name that none of its choices has |
 
 // `!(x > t)` is used on purpose throughout: unlike `x <= t` it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -28,9 +29,13 @@ pub mod fabrication;
 pub mod hex_delaunay;
 mod math;
 pub mod mesh;
+mod names;
 pub mod phex;
 pub mod scenes;
 pub mod solver;
+mod stepper;
 pub mod surface;
 
 pub use math::{Vec2, Vec3};
+pub use names::UnknownName;
+pub use stepper::Stepper;

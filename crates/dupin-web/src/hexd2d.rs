@@ -13,7 +13,7 @@ use dupin_core::hex_delaunay::{
     HexDelaunayMode, HexDelaunayStepper, angle_histogram, triangulation_quality,
 };
 
-use dupin_core::Vec2;
+use dupin_core::{Stepper, Vec2};
 use serde::Serialize;
 use wasm_bindgen::prelude::*;
 
@@ -55,17 +55,12 @@ pub struct HexDelaunayLab {
     stepper: Option<HexDelaunayStepper>,
 }
 
-fn mode_of(name: &str) -> Result<HexDelaunayMode, String> {
-    HexDelaunayMode::ALL
-        .into_iter()
-        .find(|m| m.name() == name)
-        .ok_or_else(|| format!("mode must be `simple` or `extended`, not `{name}`"))
-}
-
 impl HexDelaunayLab {
     pub(crate) fn with_mode(mode: &str) -> Result<Self, String> {
         Ok(HexDelaunayLab {
-            mode: mode_of(mode)?,
+            mode: mode
+                .parse()
+                .map_err(|e: dupin_core::UnknownName| e.to_string())?,
             stepper: None,
         })
     }
@@ -144,7 +139,7 @@ impl HexDelaunayLab {
     /// One subdivision step; false once refinement is finished (or there is no input).
     pub fn step(&mut self) -> Result<bool, JsError> {
         match &mut self.stepper {
-            Some(s) => s.step().map_err(err),
+            Some(s) => s.step().map(|m| m.changed).map_err(err),
             None => Ok(false),
         }
     }
@@ -213,7 +208,7 @@ mod tests {
         // Segments are triangulated (section 7); crossing ones are refused with the reason.
         lab.set_input(&[0.0, 0.0, 1.0, 0.0, 0.0, 1.0], &[0, 1])
             .unwrap();
-        while lab.stepper.as_mut().unwrap().step().unwrap() {}
+        while lab.stepper.as_mut().unwrap().step().unwrap().changed {}
         assert!(
             !lab.stepper
                 .as_ref()
@@ -230,7 +225,7 @@ mod tests {
         assert!(HexDelaunayLab::with_mode("fancy").is_err());
         let mut ext = HexDelaunayLab::with_mode("extended").unwrap();
         ext.set_input(&[0.0, 0.0, 1.0, 0.2], &[]).unwrap();
-        while ext.stepper.as_mut().unwrap().step().unwrap() {}
+        while ext.stepper.as_mut().unwrap().step().unwrap().changed {}
         let d = ext.dual_data();
         assert!(d.min_angle >= 43.89 && d.max_angle <= 90.0001, "{d:?}");
     }

@@ -4,6 +4,7 @@
 
 use dupin_core::surface::Curvature;
 
+use dupin_core::Stepper;
 use dupin_core::phex::{PhexPhase, PhexPipeline};
 
 use dupin_core::Vec3;
@@ -189,7 +190,7 @@ mod tests {
     fn a_click_on_a_projected_vertex_picks_it_and_its_star() {
         let cfg = PhexConfig::for_surface("torus", &[], TriangulationMethod::Prescribed, Some(0.5));
         let mut p = PhexPipeline::new(cfg).unwrap();
-        while !p.done() {
+        while !p.is_done() {
             p.step().unwrap();
         }
         let tri = p.triangulation().clone();

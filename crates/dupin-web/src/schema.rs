@@ -113,6 +113,9 @@ mod tests {
         let names = |c: &[Choice]| c.iter().map(|c| c.name).collect::<Vec<_>>();
         assert_eq!(names(&s.methods), ["progressive", "prescribed"]);
         assert_eq!(METHODS[0].2, TriangulationMethod::Progressive);
+        // The page's names are the core's, which parse them.
+        assert!(METHODS.iter().all(|&(name, _, m)| name == m.name()));
+        assert!(INITIALISATIONS.iter().all(|&(name, _, i)| name == i.name()));
         assert_eq!(
             names(&s.initialisations),
             ["tangent-duality", "dupin-duality"]

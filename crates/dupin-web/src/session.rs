@@ -2,6 +2,7 @@
 
 use crate::js::{err, to_js};
 use crate::mesh_data::MeshData;
+use dupin_core::Stepper;
 use dupin_core::conical::{PqMode, PqSceneStepInfo, PqSceneStepper, support_structure};
 use dupin_core::fabrication::{SheetOptions, panel_schedule, panel_schedule_svg};
 use dupin_core::mesh::{
@@ -66,12 +67,6 @@ pub(crate) const INITIALISATIONS: [(&str, &str, Initialisation); 2] = [
         Initialisation::DupinDuality,
     ),
 ];
-
-/// The value named `name` in `table`; the first entry when no name is given.
-fn by_name<T: Copy>(table: &[(&str, &str, T)], name: Option<&str>) -> Option<T> {
-    let name = name.unwrap_or(table[0].0);
-    table.iter().find(|(n, ..)| *n == name).map(|&(.., v)| v)
-}
 
 /// The fields of [`SessionConfig`], for [`refuse_unknown_keys`].
 const SESSION_CONFIG_KEYS: &[&str] = &[
@@ -329,12 +324,12 @@ impl Session {
                 Run::Phex(Box::new(PhexPipeline::new(scene.config).map_err(err)?))
             }
             (None, Some(surface)) => {
-                let method = by_name(&METHODS, cfg.method.as_deref()).ok_or_else(|| {
-                    JsError::new(&format!(
-                        "method must be `progressive` or `prescribed`, not `{}`",
-                        cfg.method.as_deref().unwrap_or_default()
-                    ))
-                })?;
+                let method: TriangulationMethod = cfg
+                    .method
+                    .as_deref()
+                    .unwrap_or("progressive")
+                    .parse()
+                    .map_err(err)?;
                 let params: Vec<(String, f64)> =
                     cfg.params.iter().map(|(k, v)| (k.clone(), *v)).collect();
                 let mut config = PhexConfig::for_surface(surface, &params, method, cfg.size);
@@ -347,13 +342,12 @@ impl Session {
                 if let Some(m) = cfg.mu {
                     config.mu = m;
                 }
-                config.initialisation =
-                    by_name(&INITIALISATIONS, cfg.init.as_deref()).ok_or_else(|| {
-                        JsError::new(&format!(
-                            "init must be `tangent-duality` or `dupin-duality`, not `{}`",
-                            cfg.init.as_deref().unwrap_or_default()
-                        ))
-                    })?;
+                config.initialisation = cfg
+                    .init
+                    .as_deref()
+                    .unwrap_or("tangent-duality")
+                    .parse()
+                    .map_err(err)?;
                 Run::Phex(Box::new(PhexPipeline::new(config).map_err(err)?))
             }
             _ => {
@@ -384,7 +378,7 @@ impl Session {
         self.per_face = None;
         match &mut self.run {
             Run::Phex(p) => {
-                if !p.done() {
+                if !p.is_done() {
                     p.step().map_err(err)?;
                 }
             }
@@ -402,7 +396,7 @@ impl Session {
     /// True once the run has finished.
     pub fn done(&self) -> bool {
         match &self.run {
-            Run::Phex(p) => p.done(),
+            Run::Phex(p) => p.is_done(),
             Run::Pq { stepper, started } => *started && stepper.is_done(),
         }
     }
@@ -745,7 +739,7 @@ impl Session {
                     max_determinant,
                     singular_points_inside,
                     ..
-                } = stepper.info();
+                } = stepper.metrics();
                 Metrics {
                     // Before the first step nothing is shown yet.
                     phase: if *started { phase.name() } else { "ready" },
@@ -802,7 +796,7 @@ mod tests {
         let mut opt =
             PlanarityOptimiser::new(&d.mesh, Some(&d.vertex_uv), cfg.planarity_options()).unwrap();
         println!("faces {}", d.mesh.num_faces());
-        while !opt.done() {
+        while !opt.is_done() {
             let (t, cg, f) = (cpu(), opt.cg_iterations(), opt.factorizations());
             let st = opt.step(&mut d.mesh, p.surface()).unwrap();
             println!(
@@ -841,7 +835,7 @@ mod tests {
     fn cached_face_planarity_follows_every_step() {
         let mut cfg =
             PhexConfig::for_surface("torus", &[], TriangulationMethod::Prescribed, Some(0.6));
-        cfg.initialisation = Initialisation::DupinDuality;
+        cfg.initialisation = dupin_core::phex::Initialisation::DupinDuality;
         let mut session = Session {
             run: Run::Phex(Box::new(PhexPipeline::new(cfg).unwrap())),
             config: serde_json::from_str(r#"{"surface": "torus"}"#).unwrap(),

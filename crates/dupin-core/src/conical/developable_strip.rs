@@ -7,11 +7,11 @@
 //! Möbius band), a [`StripRule`] and a number of rounds. Output: the refined PQ strip, its
 //! determinant terms and its singular curve (the intersection points of consecutive rulings).
 
-use crate::Vec3;
 use crate::conical::discrete_terms::quad_det_grad;
 use crate::conical::{PqError, PqOptions, PqPerturbation, PqResult};
 use crate::mesh::PolyMesh;
 use crate::mesh::{chaikin, lane_riesenfeld_cubic};
+use crate::{Stepper, Vec3};
 
 /// A strip of quads (a_i, a_{i+1}, b_{i+1}, b_i) between two polylines.
 #[derive(Debug, Clone, PartialEq)]
@@ -197,7 +197,7 @@ impl PqStrip {
     /// PQ perturbation of the strip with the determinant terms on (µ = 1), glued across the
     /// end joint for closed and Möbius strips.
     pub fn perturb(&self, options: PqOptions) -> Result<(PqStrip, PqResult), PqError> {
-        let r = self.perturbation(&options)?.finish();
+        let Ok(r) = self.perturbation(&options)?.finish();
         Ok((self.rebuild_from_cut(&r.mesh.positions), r))
     }
 

@@ -4,7 +4,9 @@
 //!
 //! | section | concept | file |
 //! |---|---|---|
-//! | 2 | PQ perturbation: penalty phase, then SQP (planar, conical, circular) | `perturbation.rs` |
+//! | 2 | PQ perturbation: modes, options and errors | `perturbation/options.rs` |
+//! | 2 | PQ perturbation: unknowns, penalty rows (eq. (5)), exact constraints (eqs. (3), (6), (7)) | `perturbation/problem.rs` |
+//! | 2 | PQ perturbation: the stepper (penalty phase, then SQP) and its one-shot run | `perturbation/stepper.rs` |
 //! | 2 | discrete angle and determinant terms with their gradients | `discrete_terms.rs` |
 //! | 3 | subdivision and perturbation alternating, level by level | `refinement.rs` |
 //! | 3.2 | conical vertices: angle balance, cone axes, spherical image | `cones.rs` |

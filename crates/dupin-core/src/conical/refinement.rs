@@ -3,16 +3,17 @@
 //! grow: control mesh -> perturbed -> subdivided -> perturbed -> ...
 //!
 //! Input: a [`PqSceneSpec`] (a control mesh or strip with its rule, level count and
-//! [`PqOptions`]; the named scenes are in [`crate::scenes`]). One [`PqSceneStepper::step`] is one perturbation iteration
-//! ([`PqPerturbation::step`]) or one subdivision (Catmull-Clark or Doo-Sabin for meshes, one
+//! [`PqOptions`]; the named scenes are in [`crate::scenes`]). One [`Stepper::step`] is one perturbation iteration
+//! ([`Stepper::step`] of [`PqPerturbation`]) or one subdivision (Catmull-Clark or Doo-Sabin for meshes, one
 //! curve-rule round for strips). Output after every step: the current mesh, level, phase,
-//! iteration count and the scene's measures; [`PqSceneStepper::finish`] gives the same
+//! iteration count and the scene's measures; [`Stepper::finish`] gives the same
 //! [`PqSceneResult`].
 
 use super::circular::circular_residual;
 use super::cones::conical_residual;
 use super::developable_strip::{PqStrip, StripRule};
 use super::perturbation::{PqError, PqMode, PqOptions, PqPerturbation, PqPhase};
+use crate::Stepper;
 use crate::mesh::{MeshTopology, PolyMesh, TopologyError, catmull_clark, doo_sabin, max_planarity};
 use thiserror::Error;
 
@@ -274,26 +275,60 @@ impl PqSceneStepper {
         self.phase
     }
 
-    /// Whether the run has finished.
-    pub fn is_done(&self) -> bool {
-        self.phase == PqScenePhase::Done
-    }
-
     /// Perturbation iterations over all levels so far.
     pub fn iteration(&self) -> usize {
         self.done_iterations + self.running_iterations
     }
 
+    /// Ends a finished perturbation: its result becomes the current mesh, and after the last
+    /// level the run is done.
+    fn settle(&mut self) {
+        if !self.perturbation.as_ref().is_some_and(|p| p.is_done()) {
+            return;
+        }
+        let Ok(r) = self
+            .perturbation
+            .take()
+            .expect("a finished perturbation")
+            .finish();
+        self.done_iterations += r.iterations;
+        self.running_iterations = 0;
+        self.converged &= r.converged;
+        self.show(r.mesh);
+        if self.level == self.levels {
+            self.phase = PqScenePhase::Done;
+        }
+    }
+
+    /// Takes the positions of the perturbation's mesh (for strips, of the cut-open mesh).
+    fn show(&mut self, perturbed: PolyMesh) {
+        match &mut self.target {
+            Target::Mesh(_) => self.mesh = perturbed,
+            Target::Strip { strip, .. } => {
+                *strip = strip.rebuild_from_cut(&perturbed.positions);
+                self.mesh = strip.to_mesh();
+            }
+        }
+    }
+}
+
+/// One step is one perturbation iteration or one subdivision.
+impl Stepper for PqSceneStepper {
+    type Metrics = PqSceneStepInfo;
+    type Output = PqSceneResult;
+    type Error = PqSceneError;
+
     /// One perturbation iteration or one subdivision (no-op once done); returns the state
     /// after it. A level whose mesh needs no perturbation (already within the tolerance)
     /// takes no step of its own.
-    pub fn step(&mut self) -> Result<PqSceneStepInfo, PqSceneError> {
+    fn step(&mut self) -> Result<PqSceneStepInfo, PqSceneError> {
         self.settle();
         if self.phase == PqScenePhase::Done {
-            return Ok(self.info());
+            return Ok(self.metrics());
         }
         if let Some(p) = self.perturbation.as_mut() {
-            self.running_iterations = p.step().iteration;
+            let Ok(i) = p.step();
+            self.running_iterations = i.iteration;
             self.phase = PqScenePhase::Perturb;
             if !p.is_done() {
                 let m = p.mesh().clone();
@@ -319,42 +354,16 @@ impl PqSceneStepper {
                 }
             }
         }
-        Ok(self.info())
+        Ok(self.metrics())
     }
 
-    /// Ends a finished perturbation: its result becomes the current mesh, and after the last
-    /// level the run is done.
-    fn settle(&mut self) {
-        if !self.perturbation.as_ref().is_some_and(|p| p.is_done()) {
-            return;
-        }
-        let r = self
-            .perturbation
-            .take()
-            .expect("a finished perturbation")
-            .finish();
-        self.done_iterations += r.iterations;
-        self.running_iterations = 0;
-        self.converged &= r.converged;
-        self.show(r.mesh);
-        if self.level == self.levels {
-            self.phase = PqScenePhase::Done;
-        }
-    }
-
-    /// Takes the positions of the perturbation's mesh (for strips, of the cut-open mesh).
-    fn show(&mut self, perturbed: PolyMesh) {
-        match &mut self.target {
-            Target::Mesh(_) => self.mesh = perturbed,
-            Target::Strip { strip, .. } => {
-                *strip = strip.rebuild_from_cut(&perturbed.positions);
-                self.mesh = strip.to_mesh();
-            }
-        }
+    /// Whether the run has finished.
+    fn is_done(&self) -> bool {
+        self.phase == PqScenePhase::Done
     }
 
     /// The current state and its measures (computed on the current mesh).
-    pub fn info(&self) -> PqSceneStepInfo {
+    fn metrics(&self) -> PqSceneStepInfo {
         let conical = (self.options.mode == PqMode::Conical).then(|| {
             MeshTopology::new(&self.mesh)
                 .map_or(f64::INFINITY, |t| conical_residual(&self.mesh, &t))
@@ -377,11 +386,9 @@ impl PqSceneStepper {
     }
 
     /// Runs to the end and returns the scene's result.
-    pub fn finish(mut self) -> Result<PqSceneResult, PqSceneError> {
-        while !self.is_done() {
-            self.step()?;
-        }
-        let i = self.info();
+    fn finish(mut self) -> Result<PqSceneResult, PqSceneError> {
+        self.run_to_end()?;
+        let i = self.metrics();
         Ok(PqSceneResult {
             mesh: self.mesh,
             levels: self.levels,
@@ -483,7 +490,7 @@ mod tests {
             let mut s = PqSceneStepper::from_spec(pq_scene_spec(name).unwrap()).unwrap();
             assert_eq!(s.phase(), PqScenePhase::Control);
             assert_eq!((s.level(), s.iteration()), (0, 0));
-            let mut prev = s.info();
+            let mut prev = s.metrics();
             let mut subdivisions = 0;
             let mut steps = 0;
             while !s.is_done() {
@@ -524,7 +531,7 @@ mod tests {
         let mut s = PqSceneStepper::from_spec(pq_scene_spec("conical-station").unwrap()).unwrap();
         // The control mesh follows principal lines of a surface of revolution: already PQ
         // and conical, so the first step subdivides.
-        let control = s.info();
+        let control = s.metrics();
         assert_eq!(control.faces, 24);
         assert!(control.max_planarity <= 1e-10);
         let mut after_subdivision = Vec::new();
@@ -540,7 +547,7 @@ mod tests {
             after_subdivision.iter().all(|&p| p > 1e-6),
             "{after_subdivision:?}"
         );
-        let last = s.info();
+        let last = s.metrics();
         assert_eq!(last.faces, 24 * 16);
         assert!(last.max_planarity <= 1e-10);
         assert!(last.conical_residual.unwrap() <= 1e-10);

@@ -63,8 +63,9 @@ pub use min_enclosing_circle::{Circle, min_enclosing_circle};
 pub use quality::{
     TriangulationQuality, angle_histogram, triangle_angles_deg, triangulation_quality,
 };
-pub use stepper::{HexCell, HexDelaunayStepper};
+pub use stepper::{HexCell, HexDelaunayMetrics, HexDelaunayStepper};
 
+use crate::Stepper;
 use crate::mesh::PolyMesh;
 use crate::{Vec2, Vec3};
 
@@ -78,17 +79,14 @@ pub enum HexDelaunayMode {
     Extended,
 }
 
+crate::names::named_choices!(HexDelaunayMode, "mode", {
+    Simple => "simple",
+    Extended => "extended",
+});
+
 impl HexDelaunayMode {
     /// Both modes, the default ([`HexDelaunayMode::Simple`]) first.
     pub const ALL: [HexDelaunayMode; 2] = [HexDelaunayMode::Simple, HexDelaunayMode::Extended];
-
-    /// The mode's name: `simple` or `extended`.
-    pub fn name(self) -> &'static str {
-        match self {
-            HexDelaunayMode::Simple => "simple",
-            HexDelaunayMode::Extended => "extended",
-        }
-    }
 
     /// The interior angle bounds (degrees, min and max) the mode guarantees away from input
     /// segments: [30, 120] for the simple refinement (section 4), [43.9, 90] for the extended
@@ -166,8 +164,8 @@ pub const MIN_EXTENT: f64 = 1e-100;
 pub const MAX_LEVEL: u32 = 48;
 
 /// Triangulates `points` and the segments `segments` (each a pair of point indices; they may
-/// share endpoints but not cross or overlap) by hexagonal subdivision. One-shot form of
-/// [`HexDelaunayStepper`].
+/// share endpoints but not cross or overlap) by hexagonal subdivision: [`HexDelaunayStepper`]
+/// run to its end.
 ///
 /// Errors: empty input, NaN/infinite or out-of-range coordinates, points too close for the
 /// hierarchy depth cap, bad segments, or a numerical breakdown of the segment insertion.
@@ -176,9 +174,7 @@ pub fn hex_delaunay(
     segments: &[[usize; 2]],
     mode: HexDelaunayMode,
 ) -> Result<HexTriangulation, HexDelaunayError> {
-    let mut s = HexDelaunayStepper::new(points, segments, mode)?;
-    s.run()?;
-    s.take_triangulation()
+    HexDelaunayStepper::new(points, segments, mode)?.finish()
 }
 
 #[cfg(test)]

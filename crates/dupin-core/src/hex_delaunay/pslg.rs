@@ -535,6 +535,7 @@ pub fn undo_inverting_snaps(
 pub(crate) mod tests {
     use super::super::{HexDelaunayMode, HexTriangulation, hex_delaunay, triangulation_quality};
     use super::*;
+    use crate::Stepper;
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
@@ -823,7 +824,7 @@ pub(crate) mod tests {
                 s.triangulation().segment_edges.is_empty(),
                 "no segments before the end"
             );
-            while s.step().unwrap() {}
+            while s.step().unwrap().changed {}
             assert!(s.is_done());
             assert_eq!(s.triangulation(), hex_delaunay(&pts, &segs, mode).unwrap());
             // A point inserted on a segment (a fraction no family puts a point at): the
@@ -831,7 +832,7 @@ pub(crate) mod tests {
             let [i, j] = segs[0];
             let mid = pts[i] + (pts[j] - pts[i]) * 0.0137;
             s.insert(&[mid]).unwrap();
-            s.run().unwrap();
+            s.run_to_end().unwrap();
             let t = s.try_triangulation().unwrap();
             let mut all = pts.clone();
             all.push(mid);

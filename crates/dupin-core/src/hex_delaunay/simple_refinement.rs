@@ -376,6 +376,7 @@ mod tests {
     use super::super::lattice::{in_domain, on_boundary};
     use super::super::tests::{FAMILIES, sample};
     use super::*;
+    use crate::Stepper;
     use crate::hex_delaunay::HexDelaunayStepper;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
@@ -389,7 +390,7 @@ mod tests {
             let mut s =
                 HexDelaunayStepper::new(&pts, &[], crate::hex_delaunay::HexDelaunayMode::Simple)
                     .unwrap();
-            s.run().unwrap();
+            s.run_to_end().unwrap();
             let r = s.refinement();
             let h = &r.hierarchy;
             // Balancing: every split hexagon has its six neighbours (inside Ω) present, i.e.

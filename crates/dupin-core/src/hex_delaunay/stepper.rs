@@ -15,7 +15,7 @@ use super::pslg::{
 };
 use super::simple_refinement::Refinement;
 use super::{HexDelaunayMode, HexTriangulation, MAX_COORDINATE, MAX_LEVEL, MIN_EXTENT};
-use crate::Vec2;
+use crate::{Stepper, Vec2};
 use robust::{Coord, orient2d};
 use rustc_hash::{FxHashMap, FxHashSet};
 
@@ -30,7 +30,7 @@ pub struct HexCell {
     pub occupied: bool,
 }
 
-/// Hexagonal Delaunay triangulation run step by step: each [`step`](Self::step) performs one
+/// Hexagonal Delaunay triangulation run step by step: each [`Stepper::step`] performs one
 /// refinement-rule subdivision (with the balancing splits it forces).
 #[derive(Debug, Clone)]
 pub struct HexDelaunayStepper {
@@ -164,7 +164,8 @@ impl HexDelaunayStepper {
         })
     }
 
-    /// One subdivision step. Returns `Ok(false)` once refinement is finished. With segments,
+    /// One subdivision step (see [`Stepper::step`]); whether it changed anything (`false` once
+    /// refinement is finished). With segments,
     /// once the point rules (and extended passes) find nothing, one pass of the segment rules
     /// (section 7.2, see `pslg.rs`) is one step.
     ///
@@ -172,7 +173,7 @@ impl HexDelaunayStepper {
     /// into blossoms (section 5.3, see `extended/coarsening.rs`; [`last_merges`](Self::last_merges)
     /// lists what it merged, [`last_splits`](Self::last_splits) is empty), after which the
     /// rules are checked again (a full extended pass, then the segment pass).
-    pub fn step(&mut self) -> Result<bool, HexDelaunayError> {
+    fn subdivide(&mut self) -> Result<bool, HexDelaunayError> {
         self.last_merged.clear();
         self.last = self.refinement.step()?;
         if self.mode == HexDelaunayMode::Extended {
@@ -232,7 +233,7 @@ impl HexDelaunayStepper {
 
     /// Incremental insertion (the paper's abstract and section 9): adds further points to the
     /// current subdivision, which is refined further by the following steps or
-    /// [`run`](Self::run) (in the extended mode the coarsening into blossoms runs again once
+    /// [`Stepper::run_to_end`] (in the extended mode the coarsening into blossoms runs again once
     /// the rules are at their fixed point; earlier blossoms are split where the new points'
     /// rules ask). The points must lie strictly inside [`domain`](Self::domain), which
     /// the first batch fixed. They are numbered after all earlier points in
@@ -283,7 +284,7 @@ impl HexDelaunayStepper {
         self.extended.reset();
         self.extended_clean = false;
         let mut changed = false;
-        while self.step()? {
+        while self.subdivide()? {
             changed = true;
         }
         Ok(changed)
@@ -292,20 +293,6 @@ impl HexDelaunayStepper {
     #[cfg(test)]
     pub(crate) fn refinement(&self) -> &Refinement {
         &self.refinement
-    }
-
-    /// Runs all remaining steps.
-    pub fn run(&mut self) -> Result<(), HexDelaunayError> {
-        if self.mode == HexDelaunayMode::Simple && self.segments.is_empty() {
-            return self.refinement.run();
-        }
-        while self.step()? {}
-        Ok(())
-    }
-
-    /// Whether refinement is finished.
-    pub fn is_done(&self) -> bool {
-        self.everything_clean() && !(self.wants_coarsening())
     }
 
     /// Whether no rule fires (simple, extended and segment rules at their fixed point).
@@ -342,7 +329,7 @@ impl HexDelaunayStepper {
             .collect()
     }
 
-    /// Number of steps taken through [`step`](Self::step).
+    /// Number of steps taken through [`Stepper::step`].
     pub fn steps(&self) -> usize {
         self.steps
     }
@@ -549,6 +536,68 @@ impl HexDelaunayStepper {
             segment_edges: Vec::new(),
         };
         (t, segs, orig)
+    }
+}
+
+/// The refinement's state after a step ([`HexDelaunayStepper`]'s [`Stepper::Metrics`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct HexDelaunayMetrics {
+    /// Whether the last step changed the subdivision (split hexagons, or merged them into
+    /// blossoms); `false` once refinement is finished.
+    pub changed: bool,
+    /// Steps taken that changed the subdivision.
+    pub steps: usize,
+    /// Split hexagons so far (root included).
+    pub split_count: usize,
+}
+
+impl Stepper for HexDelaunayStepper {
+    type Metrics = HexDelaunayMetrics;
+    type Output = HexTriangulation;
+    type Error = HexDelaunayError;
+
+    /// One subdivision step (with the balancing splits it forces); a no-op with
+    /// [`HexDelaunayMetrics::changed`] `false` once refinement is finished. With segments,
+    /// once the point rules (and extended passes) find nothing, one pass of the segment rules
+    /// (section 7.2, see `pslg.rs`) is one step.
+    ///
+    /// Extended mode: once every rule is at its fixed point, one step is the local coarsening
+    /// into blossoms (section 5.3, see `coarsening.rs`; [`last_merges`](HexDelaunayStepper::last_merges)
+    /// lists what it merged, [`last_splits`](HexDelaunayStepper::last_splits) is empty), after which the
+    /// rules are checked again (a full extended pass, then the segment pass).
+    fn step(&mut self) -> Result<HexDelaunayMetrics, HexDelaunayError> {
+        self.subdivide()?;
+        Ok(self.metrics())
+    }
+
+    /// Whether refinement is finished.
+    fn is_done(&self) -> bool {
+        self.everything_clean() && !(self.wants_coarsening())
+    }
+
+    fn metrics(&self) -> HexDelaunayMetrics {
+        HexDelaunayMetrics {
+            changed: !self.last.is_empty() || !self.last_merged.is_empty(),
+            steps: self.steps,
+            split_count: self.split_count(),
+        }
+    }
+
+    /// Runs all remaining steps (the simple mode without segments by the refinement's own
+    /// loop, which ends in the same subdivision).
+    fn run_to_end(&mut self) -> Result<(), HexDelaunayError> {
+        if self.mode == HexDelaunayMode::Simple && self.segments.is_empty() {
+            return self.refinement.run();
+        }
+        while self.subdivide()? {}
+        Ok(())
+    }
+
+    /// Runs to the end and returns the triangulation, taking the extended state's cached
+    /// relocations instead of copying them.
+    fn finish(mut self) -> Result<HexTriangulation, HexDelaunayError> {
+        self.run_to_end()?;
+        self.take_triangulation()
     }
 }
 

@@ -320,7 +320,7 @@ fn extended_cached_relocation_matches_a_new_full_pass() {
     for family in FAMILIES {
         let pts = sample(family, &mut rng);
         let mut s = HexDelaunayStepper::new(&pts, &[], HexDelaunayMode::Extended).unwrap();
-        s.run().unwrap();
+        s.run_to_end().unwrap();
         let cached = s.triangulation();
         assert_eq!(cached, s.triangulation(), "{family:?}");
     }
@@ -339,7 +339,7 @@ fn stepper_matches_one_shot_and_cells_tile() {
         let one = hex_delaunay(&pts, &[], mode).unwrap();
         let mut s = HexDelaunayStepper::new(&pts, &[], mode).unwrap();
         let mut steps = 0;
-        while s.step().unwrap() {
+        while s.step().unwrap().changed {
             steps += 1;
             // A step splits, or is the coarsening into blossoms (extended mode).
             assert!(!s.last_splits().is_empty() || !s.last_merges().is_empty());
@@ -477,10 +477,10 @@ fn incremental_insertion_keeps_the_guarantees() {
             }
         }
         let mut s = HexDelaunayStepper::new(&first, &[], mode).unwrap();
-        s.run().unwrap();
+        s.run_to_end().unwrap();
         let before = s.triangulation();
         s.insert(&more).unwrap();
-        s.run().unwrap();
+        s.run_to_end().unwrap();
         let after = s.triangulation();
         assert_eq!(after.domain, before.domain);
         assert!(after.triangles.len() >= before.triangles.len());
@@ -490,7 +490,7 @@ fn incremental_insertion_keeps_the_guarantees() {
     // Outside Ω: refused, nothing inserted.
     let pts = [Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0)];
     let mut s = HexDelaunayStepper::new(&pts, &[], HexDelaunayMode::Simple).unwrap();
-    s.run().unwrap();
+    s.run_to_end().unwrap();
     let n = s.triangulation().input_vertex.len();
     assert_eq!(
         s.insert(&[Vec2::new(0.5, 0.1), Vec2::new(0.5, 10.0)]),
@@ -542,7 +542,7 @@ pub(crate) fn paper_count(name: &str, pts: &[Vec2], mode: HexDelaunayMode) -> us
         let mut s =
             HexDelaunayStepper::new_in_domain(pts, mode, Vec2::new(0.01, 0.0), 3f64.sqrt() / 2.0)
                 .unwrap();
-        s.run().unwrap();
+        s.run_to_end().unwrap();
         s.triangulation()
     } else {
         hex_delaunay(pts, &[], mode).unwrap()

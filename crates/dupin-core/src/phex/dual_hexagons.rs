@@ -14,7 +14,7 @@
 //! conditioning of those planes; the Gauss-Newton pass of `planarity_optimisation` removes the
 //! rest.
 //!
-//! With the surface at hand ([`dual_mesh_options`], used by the pipeline), a triangle in a
+//! With the surface at hand (passed to [`dual_mesh`], as the pipeline does), a triangle in a
 //! parabolic region (section 6, step (1): K of mixed sign at the vertices, or |K| < 1e-8) whose
 //! tangent-plane point lies more than its longest edge from its centroid gets the centroid
 //! instead, as in the Dupin duality: there the tangent duality is unstable (section 6). On the
@@ -95,6 +95,11 @@ pub enum Initialisation {
     DupinDuality,
 }
 
+crate::names::named_choices!(Initialisation, "init", {
+    TangentDuality => "tangent-duality",
+    DupinDuality => "dupin-duality",
+});
+
 /// In a parabolic region, a tangent-plane point farther than this many longest triangle edges
 /// from the centroid counts as unstable and is replaced by the centroid (0.5 and 1 both keep
 /// every scene's Gauss-Newton iteration count; without a limit the torus and cyclide scenes,
@@ -112,37 +117,69 @@ fn in_parabolic_region(k: [f64; 3]) -> bool {
     !same_sign || k.iter().any(|x| x.abs() < PARABOLIC_THRESHOLD)
 }
 
-/// Builds the dual polygon mesh of `t` by tangent duality (section 6 initialisation), without
-/// the parabolic-region rule (no curvature at hand; see [`dual_mesh_options`]).
-///
-/// Errors: [`PhexError::NoValidTriangulation`] when no interior vertex exists.
-pub fn dual_mesh(t: &Triangulation) -> Result<DualMesh, PhexError> {
-    dual_from_points_impl(t, tangent_points(t), false)
+/// How [`dual_mesh`] builds the dual (section 6), lyon-style:
+/// `DualMeshOptions::default().with_initialisation(..).with_boundary_faces(..)`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct DualMeshOptions {
+    /// How the dual vertices are placed (section 6 initialisation).
+    pub initialisation: Initialisation,
+    /// Also make faces at boundary triangulation vertices (section 6: the optimisation is
+    /// "generalised to boundary faces"): a boundary vertex `v` whose incident triangles form
+    /// one fan `t_1 .. t_k` with `k >= 2` gives the face `[m(v, w_in), t_1, .., t_k,
+    /// m(v, w_out)]`, where `w_in`, `w_out` are its two boundary neighbours and `m(v, w)` is a
+    /// new dual vertex per boundary edge: the point of the tangent planes of `v` and `w`
+    /// nearest the edge midpoint (shared by the faces of `v` and `w`; always placed by tangent
+    /// duality). Every boundary face therefore also starts in the tangent plane of its vertex.
+    /// Fans with one triangle (corners) give no face. Interior vertices give the same faces
+    /// either way.
+    pub boundary_faces: bool,
 }
 
-/// Builds the dual polygon mesh of `t` with the chosen [`Initialisation`]; `surface` gives the
-/// curvature at the triangulation vertices for the Dupin duality.
-///
-/// Errors: [`PhexError::NoValidTriangulation`] when no interior vertex exists.
-pub fn dual_mesh_with(
-    t: &Triangulation,
-    surface: &dyn crate::surface::Surface,
-    init: Initialisation,
-) -> Result<DualMesh, PhexError> {
-    dual_mesh_options(t, surface, init, false)
+impl DualMeshOptions {
+    /// Tangent duality, interior faces only.
+    pub const DEFAULT: Self = DualMeshOptions {
+        initialisation: Initialisation::TangentDuality,
+        boundary_faces: false,
+    };
+
+    /// These options with `initialisation`.
+    pub fn with_initialisation(mut self, initialisation: Initialisation) -> Self {
+        self.initialisation = initialisation;
+        self
+    }
+
+    /// These options with boundary faces on or off.
+    pub fn with_boundary_faces(mut self, on: bool) -> Self {
+        self.boundary_faces = on;
+        self
+    }
 }
 
-/// [`dual_mesh_with`], plus the boundary faces of [`DualMesh::with_boundary_faces`] when
-/// `boundary_faces` is set (their edge vertices are always placed by tangent duality).
+/// Builds the dual polygon mesh of `t` (section 6 initialisation) with `options`.
 ///
-/// Errors: [`PhexError::NoValidTriangulation`] when no face can be formed.
-pub fn dual_mesh_options(
+/// `surface` gives the curvature at the triangulation vertices: the Dupin duality needs it, and
+/// with it the tangent duality applies the parabolic-region rule (see the module docs).
+/// Without it (`None`, no curvature at hand) the tangent duality places every vertex at its
+/// tangent-plane point.
+///
+/// Errors: [`PhexError::NoValidTriangulation`] when no face can be formed;
+/// [`PhexError::BadParameter`] for the Dupin duality without a surface.
+pub fn dual_mesh(
     t: &Triangulation,
-    surface: &dyn crate::surface::Surface,
-    init: Initialisation,
-    boundary_faces: bool,
+    surface: Option<&dyn crate::surface::Surface>,
+    options: &DualMeshOptions,
 ) -> Result<DualMesh, PhexError> {
-    let positions = match init {
+    let Some(surface) = surface else {
+        return match options.initialisation {
+            Initialisation::TangentDuality => {
+                dual_from_points_impl(t, tangent_points(t), options.boundary_faces)
+            }
+            Initialisation::DupinDuality => Err(PhexError::BadParameter(
+                "the Dupin duality needs the surface's curvature; pass the surface".into(),
+            )),
+        };
+    };
+    let positions = match options.initialisation {
         Initialisation::TangentDuality => {
             let k: Vec<Option<f64>> =
                 t.uv.iter()
@@ -194,7 +231,7 @@ pub fn dual_mesh_options(
                 .collect()
         }
     };
-    dual_from_points_impl(t, positions, boundary_faces)
+    dual_from_points_impl(t, positions, options.boundary_faces)
 }
 
 fn tangent_points(t: &Triangulation) -> Vec<Vec3> {
@@ -206,24 +243,6 @@ fn tangent_points(t: &Triangulation) -> Vec<Vec3> {
             tangent_plane_point(p, n)
         })
         .collect()
-}
-
-impl DualMesh {
-    /// The dual polygon mesh of `t` by tangent duality, with boundary faces (section 6: the
-    /// optimisation is "generalised to boundary faces").
-    ///
-    /// Interior triangulation vertices give the same faces as [`dual_mesh`]. A boundary vertex `v`
-    /// whose incident triangles form one fan `t_1 .. t_k` with `k >= 2` gives the face
-    /// `[m(v, w_in), t_1, .., t_k, m(v, w_out)]`, where `w_in`, `w_out` are its two boundary
-    /// neighbours and `m(v, w)` is a new dual vertex per boundary edge: the point of the tangent
-    /// planes of `v` and `w` nearest the edge midpoint (shared by the faces of `v` and `w`). Every
-    /// boundary face therefore also starts in the tangent plane of its vertex. Fans with one
-    /// triangle (corners) give no face.
-    ///
-    /// Errors: [`PhexError::NoValidTriangulation`] when no face can be formed.
-    pub fn with_boundary_faces(t: &Triangulation) -> Result<DualMesh, PhexError> {
-        dual_from_points_impl(t, tangent_points(t), true)
-    }
 }
 
 /// The point of the tangent planes at `a` (normal `na`) and `b` (normal `nb`) nearest their
@@ -429,8 +448,8 @@ mod tests {
         assert_eq!(r.report.invalid_faces, 0);
         let t = &r.triangulation;
         let s = crate::surface::surface_by_name("vase", &params).unwrap();
-        let d = dual_mesh_options(t, s.as_ref(), Initialisation::TangentDuality, false).unwrap();
-        let plain = dual_mesh(t).unwrap();
+        let d = dual_mesh(t, Some(s.as_ref()), &DualMeshOptions::default()).unwrap();
+        let plain = dual_mesh(t, None, &DualMeshOptions::default()).unwrap();
         let mut replaced = 0;
         for (i, tr) in t.triangles.iter().enumerate() {
             let k = tr.map(|v| {
@@ -473,8 +492,13 @@ mod tests {
             })
             .count();
         assert!(parabolic > 100, "{parabolic} parabolic triangles");
-        let d = dual_mesh_options(t, s.as_ref(), Initialisation::TangentDuality, false).unwrap();
-        assert_eq!(d.mesh, dual_mesh(t).unwrap().mesh);
+        let d = dual_mesh(t, Some(s.as_ref()), &DualMeshOptions::default()).unwrap();
+        assert_eq!(
+            d.mesh,
+            dual_mesh(t, None, &DualMeshOptions::default())
+                .unwrap()
+                .mesh
+        );
         assert!(
             r.report.max_planarity < 1e-12,
             "{:e}",
@@ -505,7 +529,7 @@ mod tests {
         let r = crate::phex::phex_run(crate::scenes::phex_scene("torus-bound").unwrap().config)
             .unwrap();
         let t = &r.triangulation;
-        let d = dual_mesh(t).unwrap();
+        let d = dual_mesh(t, None, &DualMeshOptions::default()).unwrap();
         for (f, &v) in d.face_vertex.iter().enumerate() {
             let (p, n) = (t.positions[v as usize], t.normals[v as usize]);
             let e = d.mesh.face_mean_edge(f);
@@ -526,8 +550,13 @@ mod tests {
             cfg.optimize = false;
             let r = crate::phex::phex_run(cfg).unwrap();
             let t = &r.triangulation;
-            let inner = dual_mesh(t).unwrap();
-            let d = DualMesh::with_boundary_faces(t).unwrap();
+            let inner = dual_mesh(t, None, &DualMeshOptions::default()).unwrap();
+            let d = dual_mesh(
+                t,
+                None,
+                &DualMeshOptions::default().with_boundary_faces(true),
+            )
+            .unwrap();
             let interior: HashSet<u32> = inner.face_vertex.iter().copied().collect();
             let boundary: Vec<usize> = (0..d.mesh.num_faces())
                 .filter(|&f| !interior.contains(&d.face_vertex[f]))
@@ -572,7 +601,7 @@ mod tests {
             let mut opt =
                 PlanarityOptimiser::new(&mesh, Some(&d.vertex_uv), PlanarityOptions::default())
                     .unwrap();
-            while !opt.done() {
+            while !opt.is_done() {
                 opt.step(&mut mesh, surface.as_ref()).unwrap();
             }
             assert!(

@@ -20,8 +20,7 @@ mod report;
 mod triangulation;
 
 pub use dual_hexagons::{
-    DualMesh, Initialisation, PARABOLIC_THRESHOLD, dual_mesh, dual_mesh_options, dual_mesh_with,
-    tangent_plane_point,
+    DualMesh, DualMeshOptions, Initialisation, PARABOLIC_THRESHOLD, dual_mesh, tangent_plane_point,
 };
 pub use duality::{
     DupinCenterError, DupinCenterMethod, DupinConic, DupinHexagon, DupinIndicatrix, IdealTriangle,

@@ -4,13 +4,14 @@
 //! web page); [`phex_run`] the one-shot function (for the CLI).
 
 use super::PhexError;
-use super::dual_hexagons::{DualMesh, dual_mesh_options};
+use super::dual_hexagons::{DualMesh, DualMeshOptions, dual_mesh};
 use super::planarity_optimisation::{PlanarityOptimiser, PlanarityOptions};
 use super::report::{PhexReport, phex_report};
 use super::triangulation::{
     LayerRule, Triangulation, TriangulationMethod, TriangulationSpec, triangulate,
     triangulate_along_fields,
 };
+use crate::Stepper;
 use crate::mesh::{PolyMesh, max_planarity};
 use crate::surface::{FREEFORM, FreeformSurface, Surface, TwistedSurface, surface_by_name};
 
@@ -46,7 +47,7 @@ pub struct PhexConfig {
     /// How the hexagon vertices are initialised (section 6).
     pub initialisation: super::Initialisation,
     /// Also make faces at boundary triangulation vertices (section 6: the optimisation
-    /// "generalised to boundary faces"; see [`super::DualMesh::with_boundary_faces`]).
+    /// "generalised to boundary faces"; see [`super::DualMeshOptions::boundary_faces`]).
     pub boundary_faces: bool,
     /// Method 2 with a user-chosen first direction field: the angle (radians) of the first
     /// field against the first principal direction (the u direction at umbilics); the second
@@ -59,12 +60,19 @@ pub struct PhexConfig {
 }
 
 impl PhexConfig {
+    /// The dual-mesh options this configuration asks for (initialisation, boundary faces).
+    pub fn dual_mesh_options(&self) -> DualMeshOptions {
+        DualMeshOptions::default()
+            .with_initialisation(self.initialisation)
+            .with_boundary_faces(self.boundary_faces)
+    }
+
     /// The optimiser's options this configuration asks for (iteration cap, lambda, mu).
     pub fn planarity_options(&self) -> PlanarityOptions {
         PlanarityOptions {
             max_iterations: self.iterations,
-            fairness: self.lambda,
-            distance: self.mu,
+            lambda: self.lambda,
+            mu: self.mu,
             ..PlanarityOptions::default()
         }
     }
@@ -96,8 +104,8 @@ impl PhexConfig {
             initialisation: super::Initialisation::TangentDuality,
             boundary_faces: true,
             field_angle: None,
-            lambda: PlanarityOptions::default().fairness,
-            mu: PlanarityOptions::default().distance,
+            lambda: PlanarityOptions::default().lambda,
+            mu: PlanarityOptions::default().mu,
         }
     }
 }
@@ -149,7 +157,7 @@ pub struct PhexMetrics {
 /// The stateful P-Hex pipeline.
 ///
 /// The triangulation is computed when the pipeline is created (it is cheap and its errors must
-/// surface at once); [`PhexPipeline::step`] then reveals it one layer per step, builds the dual
+/// surface at once); [`Stepper::step`] then reveals it one layer per step, builds the dual
 /// mesh, and runs one Gauss-Newton iteration per step.
 pub struct PhexPipeline {
     surface: Box<dyn Surface>,
@@ -222,11 +230,10 @@ impl PhexPipeline {
     /// The hexagonal mesh dual to the current triangulation, by the configured initialisation
     /// (section 6), before any optimisation.
     pub fn initial_dual_mesh(&self) -> Result<DualMesh, PhexError> {
-        dual_mesh_options(
+        dual_mesh(
             &self.tri,
-            self.surface.as_ref(),
-            self.config.initialisation,
-            self.config.boundary_faces,
+            Some(self.surface.as_ref()),
+            &self.config.dual_mesh_options(),
         )
     }
 
@@ -424,16 +431,6 @@ impl PhexPipeline {
         &self.tri
     }
 
-    /// Whether the run has finished.
-    pub fn done(&self) -> bool {
-        self.phase == PhexPhase::Done
-    }
-
-    /// Metrics after the last step.
-    pub fn metrics(&self) -> PhexMetrics {
-        self.metrics
-    }
-
     /// The current mesh: the triangles of the layers shown so far, then the hexagonal mesh.
     pub fn mesh(&self) -> PolyMesh {
         match &self.dual {
@@ -474,12 +471,26 @@ impl PhexPipeline {
             self.optimiser.as_ref().map_or(0, |o| o.iteration()),
         ))
     }
+}
+
+fn count_invalid(mesh: &PolyMesh) -> usize {
+    (0..mesh.num_faces())
+        .filter(|&i| !super::report::face_info(mesh, i, 0.0).simple)
+        .count()
+}
+
+/// One step reveals a triangulation layer, builds the dual mesh, or runs one Gauss-Newton
+/// iteration.
+impl Stepper for PhexPipeline {
+    type Metrics = PhexMetrics;
+    type Output = PhexResult;
+    type Error = PhexError;
 
     /// Advances one observable step and returns the metrics.
     ///
     /// Errors: [`PhexError::NoValidTriangulation`] when the dual mesh cannot be formed,
     /// [`PhexError::Solver`] when an optimisation step fails.
-    pub fn step(&mut self) -> Result<PhexMetrics, PhexError> {
+    fn step(&mut self) -> Result<PhexMetrics, PhexError> {
         match self.phase {
             PhexPhase::Triangulation => {
                 self.shown += 1;
@@ -503,7 +514,7 @@ impl PhexPipeline {
                     Some(&d.vertex_uv),
                     self.config.planarity_options(),
                 )?;
-                self.phase = if self.config.optimize && !opt.done() {
+                self.phase = if self.config.optimize && !opt.is_done() {
                     PhexPhase::Optimisation
                 } else {
                     PhexPhase::Done
@@ -520,7 +531,7 @@ impl PhexPipeline {
                 self.metrics.iteration = s.iteration;
                 self.metrics.max_planarity = s.max_planarity;
                 self.metrics.invalid_faces = count_invalid(&d.mesh);
-                if opt.done() {
+                if opt.is_done() {
                     self.phase = PhexPhase::Done;
                 }
             }
@@ -529,35 +540,45 @@ impl PhexPipeline {
         self.metrics.phase = self.phase;
         Ok(self.metrics)
     }
-}
 
-fn count_invalid(mesh: &PolyMesh) -> usize {
-    (0..mesh.num_faces())
-        .filter(|&i| !super::report::face_info(mesh, i, 0.0).simple)
-        .count()
-}
-
-/// One-shot P-Hex run: triangulation, dual mesh, planarity optimisation, report.
-///
-/// Errors: see [`PhexPipeline::new`] and [`PhexPipeline::step`].
-pub fn phex_run(config: PhexConfig) -> Result<PhexResult, PhexError> {
-    let mut p = PhexPipeline::new(config)?;
-    // Skip the layer-by-layer reveal.
-    p.shown = p.tri.layers.len();
-    p.phase = PhexPhase::Hexagons;
-    while !p.done() {
-        p.step()?;
+    fn is_done(&self) -> bool {
+        self.phase == PhexPhase::Done
     }
-    let report = p
-        .report()
-        .ok_or_else(|| PhexError::NoValidTriangulation("no hexagonal mesh was produced".into()))?;
-    let dual = p
-        .dual
-        .take()
-        .ok_or_else(|| PhexError::NoValidTriangulation("no hexagonal mesh was produced".into()))?;
-    Ok(PhexResult {
-        mesh: dual.mesh,
-        triangulation: p.tri,
-        report,
-    })
+
+    /// Metrics after the last step.
+    fn metrics(&self) -> PhexMetrics {
+        self.metrics
+    }
+
+    /// Runs to the end (skipping the rest of the layer-by-layer reveal) and returns the mesh,
+    /// its triangulation and report.
+    ///
+    /// Errors: see [`Stepper::step`]; [`PhexError::NoValidTriangulation`] when no hexagonal
+    /// mesh was produced.
+    fn finish(mut self) -> Result<PhexResult, PhexError> {
+        if self.phase == PhexPhase::Triangulation {
+            self.shown = self.tri.layers.len();
+            self.phase = PhexPhase::Hexagons;
+        }
+        self.run_to_end()?;
+        let report = self.report().ok_or_else(|| {
+            PhexError::NoValidTriangulation("no hexagonal mesh was produced".into())
+        })?;
+        let dual = self.dual.take().ok_or_else(|| {
+            PhexError::NoValidTriangulation("no hexagonal mesh was produced".into())
+        })?;
+        Ok(PhexResult {
+            mesh: dual.mesh,
+            triangulation: self.tri,
+            report,
+        })
+    }
+}
+
+/// One-shot P-Hex run: triangulation, dual mesh, planarity optimisation, report;
+/// [`PhexPipeline`] run to its end.
+///
+/// Errors: see [`PhexPipeline::new`] and [`Stepper::step`].
+pub fn phex_run(config: PhexConfig) -> Result<PhexResult, PhexError> {
+    PhexPipeline::new(config)?.finish()
 }

@@ -64,10 +64,10 @@ use nalgebra::Matrix3;
 /// Settings of the planarity optimisation.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlanarityOptions {
-    /// Initial fairness weight λ (relative; shrinks by 10 each iteration).
-    pub fairness: f64,
-    /// Initial surface-distance weight μ (relative; shrinks by 10 each iteration).
-    pub distance: f64,
+    /// Initial fairness weight λ (section 7; relative; shrinks by 10 each iteration).
+    pub lambda: f64,
+    /// Initial surface-distance weight μ (section 7; relative; shrinks by 10 each iteration).
+    pub mu: f64,
     /// Stop once `max_planarity` is at most this.
     pub tolerance: f64,
     /// Largest number of Gauss-Newton iterations.
@@ -77,8 +77,8 @@ pub struct PlanarityOptions {
 impl Default for PlanarityOptions {
     fn default() -> Self {
         PlanarityOptions {
-            fairness: 1e-8,
-            distance: 1e-6,
+            lambda: 1e-8,
+            mu: 1e-6,
             tolerance: 1e-10,
             max_iterations: 10,
         }
@@ -335,7 +335,7 @@ impl PlanarityOptimiser {
         start_uv: Option<&[Vec2]>,
         options: PlanarityOptions,
     ) -> Result<Self, PhexError> {
-        if !(options.tolerance > 0.0) || !(options.fairness >= 0.0) || !(options.distance >= 0.0) {
+        if !(options.tolerance > 0.0) || !(options.lambda >= 0.0) || !(options.mu >= 0.0) {
             return Err(PhexError::BadParameter(
                 "planarity tolerance must be > 0 and weights >= 0".into(),
             ));
@@ -384,8 +384,8 @@ impl PlanarityOptimiser {
                 Some(s) if s.len() == nv => s.iter().map(|&p| Some(p)).collect(),
                 _ => vec![None; nv],
             },
-            lambda: options.fairness,
-            mu: options.distance,
+            lambda: options.lambda,
+            mu: options.mu,
             iteration: 0,
             max_planarity: max_planarity(mesh),
             num_faces: mesh.num_faces(),
@@ -440,7 +440,7 @@ impl PlanarityOptimiser {
     }
 
     /// Whether the tolerance is reached or the iteration budget is spent.
-    pub fn done(&self) -> bool {
+    pub fn is_done(&self) -> bool {
         self.max_planarity <= self.options.tolerance
             || self.iteration >= self.options.max_iterations
     }
@@ -856,7 +856,7 @@ mod tests {
                 PlanarityOptimiser::new(&mesh, None, PlanarityOptions::default()).unwrap();
             // Closed meshes start with CG, open ones (boundary faces) with exact steps.
             assert_eq!(opt.direct, direct, "{name}");
-            while !opt.done() {
+            while !opt.is_done() {
                 opt.step(&mut mesh, surface.as_ref()).unwrap();
             }
             assert!(
@@ -1028,7 +1028,7 @@ mod tests {
         let mut opt =
             PlanarityOptimiser::new(&d.mesh, Some(&d.vertex_uv), cfg.planarity_options()).unwrap();
         assert!(!opt.direct && opt.max_planarity() > 1e-3);
-        while !opt.done() {
+        while !opt.is_done() {
             opt.step(&mut d.mesh, p.surface()).unwrap();
         }
         assert!(opt.max_planarity() <= 1e-10, "{:e}", opt.max_planarity());

@@ -95,8 +95,8 @@ impl SceneSpec {
             initialisation: Initialisation::TangentDuality,
             boundary_faces: true,
             field_angle: self.field_angle,
-            lambda: PlanarityOptions::default().fairness,
-            mu: PlanarityOptions::default().distance,
+            lambda: PlanarityOptions::default().lambda,
+            mu: PlanarityOptions::default().mu,
         }
     }
 }
@@ -251,6 +251,7 @@ pub(crate) use tests::acceptance as acceptance_for_tests;
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Stepper;
     use crate::phex::{PhexPipeline, PhexReport, phex_run};
 
     /// Faces counted as "away from parabolic curves": |K| at least this share of the largest |K|.
@@ -338,9 +339,13 @@ mod tests {
                         bad.push(format!("shape deviation {shape:.2}"));
                     }
                     // Boundary faces are part of the mesh checked above, on every open scene.
-                    let interior = crate::phex::dual_mesh(&r.triangulation)
-                        .map(|d| d.mesh.num_faces())
-                        .unwrap_or(0);
+                    let interior = crate::phex::dual_mesh(
+                        &r.triangulation,
+                        None,
+                        &crate::phex::DualMeshOptions::default(),
+                    )
+                    .map(|d| d.mesh.num_faces())
+                    .unwrap_or(0);
                     let closed = ["torus-bound", "cyclide-prescribed", "convex-loop"];
                     if closed.contains(name) != (r.report.faces == interior) {
                         bad.push(format!(
@@ -399,7 +404,7 @@ mod tests {
         let m = p.step().unwrap();
         assert_ne!(m.phase, crate::phex::PhexPhase::Triangulation);
         let mut guard = 0;
-        while !p.done() {
+        while !p.is_done() {
             p.step().unwrap();
             guard += 1;
             assert!(guard <= 10);

@@ -1,13 +1,13 @@
 //! The PQ scenes of the outside contract, after the conical paper's figures (Figs. 1, 7, 8, 9,
 //! 14, 16, 17): each a control mesh or strip with its subdivision rule and perturbation options.
 
-use crate::Vec3;
 use crate::conical::{
     PqMode, PqOptions, PqSceneError, PqSceneResult, PqSceneSpec, PqSceneStepper, PqStrip,
     StripClosure, StripRule, principal_quad_mesh, trefoil_moebius,
 };
 use crate::mesh::PolyMesh;
 use crate::surface::SurfaceOfRevolution;
+use crate::{Stepper, Vec3};
 
 /// Names of the PQ scenes of the outside contract, after the conical paper's figures.
 pub const PQ_SCENES: &[&str] = &[

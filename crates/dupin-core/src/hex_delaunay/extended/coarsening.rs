@@ -127,6 +127,7 @@ pub fn coarsen(r: &mut Refinement, segments: &[[u32; 2]]) -> Coarsening {
 
 #[cfg(test)]
 mod tests {
+    use crate::Stepper;
     use crate::Vec2;
     use crate::hex_delaunay::tests::{check_with, paper_data_sets};
     use crate::hex_delaunay::{HexDelaunayMode, HexDelaunayStepper};
@@ -151,7 +152,7 @@ mod tests {
                 .unwrap();
                 s.set_coarsening(coarsen);
                 let mut merged = Vec::new();
-                while s.step().unwrap() {
+                while s.step().unwrap().changed {
                     if !s.last_merges().is_empty() {
                         assert!(merged.is_empty(), "{name}: one coarsening step");
                         assert!(s.last_splits().is_empty(), "{name}");

@@ -40,6 +40,11 @@ pub enum TriangulationMethod {
     Prescribed,
 }
 
+crate::names::named_choices!(TriangulationMethod, "method", {
+    Progressive => "progressive",
+    Prescribed => "prescribed",
+});
+
 /// The section 5.3 lower bound b of the scenes and of a configuration for a library surface.
 pub const DEFAULT_BOUND: f64 = 0.3;
 
