@@ -3,7 +3,8 @@
 use std::path::Path;
 use thiserror::Error;
 
-/// Any failure of a command; printed as one `error:` line with exit code 2.
+/// Any failure of a command; printed as one `error:` line, exit code 2 (bad input) or 3 (the
+/// computation ran, its output and report are written, but the result misses what was asked).
 #[derive(Debug, Error)]
 pub enum CliError {
     /// Reading or writing a file failed.
@@ -17,9 +18,21 @@ pub enum CliError {
     /// Input was malformed or out of range; the message says what to change.
     #[error("{0}")]
     Input(String),
+    /// The result misses what was asked (not converged, invalid faces, beyond tolerance): the
+    /// output and the report (with `converged: false` and the `reason`) are already written.
+    #[error("{0}")]
+    Unmet(String),
 }
 
 impl CliError {
+    /// The exit code of this error: 3 for a result that misses what was asked, 2 otherwise.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            CliError::Unmet(_) => 3,
+            _ => 2,
+        }
+    }
+
     /// Wraps any displayable error as bad input, prefixed with context.
     pub fn input(context: &str, e: impl std::fmt::Display) -> Self {
         if context.is_empty() {

@@ -1,6 +1,7 @@
 //! The `dupin` command line (see `../shared/contract.md` and the README).
 //!
-//! Exit code 0 on success; 2 on bad input with one line on stderr starting `error:`.
+//! Exit code 0 on success; 2 on bad input and 3 on a result that misses what was asked (not
+//! converged, invalid faces), each with one line on stderr starting `error:`.
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::process::ExitCode;
@@ -129,7 +130,7 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {}", e.to_string().replace('\n', " "));
-            ExitCode::from(2)
+            ExitCode::from(e.exit_code())
         }
     }
 }

@@ -65,6 +65,8 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
         .clone()
         .ok_or_else(|| CliError::Input("--out is required".into()))?;
     let method = args.method;
+    // A scene made to show invalid faces (Fig. 11's hyperboloid) has them by design.
+    let mut expect_valid = true;
     let mut config = match (&args.scene, &args.surface) {
         (Some(name), None) => {
             if !args.set.is_empty() {
@@ -72,7 +74,9 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
                     "--set applies to --surface, not to --scene".into(),
                 ));
             }
-            phex_scene(name).map_err(|e| CliError::input("", e))?.config
+            let scene = phex_scene(name).map_err(|e| CliError::input("", e))?;
+            expect_valid = scene.expect_valid;
+            scene.config
         }
         (None, Some(name)) => {
             let mut params = vec![];
@@ -121,6 +125,8 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
         .clone()
         .or(args.surface.clone())
         .unwrap_or_default();
+    let optimize = config.optimize;
+    let tolerance = config.planarity_options().tolerance;
     let start = std::time::Instant::now();
     let r = PhexPipeline::new(config)
         .and_then(Stepper::finish)
@@ -133,7 +139,26 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
         .iter()
         .map(|(k, v)| (k.to_string(), json!(v)))
         .collect();
-    let report = json!({
+    // What was asked and missed: planar faces (unless the optimisation was switched off) and
+    // simple faces (unless the scene shows invalid ones).
+    let mut missed = Vec::new();
+    // NaN counts as a miss.
+    let planar = rep.max_planarity <= tolerance;
+    if optimize && !planar {
+        missed.push(format!(
+            "max_planarity {:.3e} is above the tolerance {tolerance:.0e} after {} iterations",
+            rep.max_planarity, rep.iterations
+        ));
+    }
+    if expect_valid && rep.invalid_faces > 0 {
+        missed.push(format!(
+            "{} of {} faces are self-intersecting (invalid); try a larger --size or another \
+             --method",
+            rep.invalid_faces, rep.faces
+        ));
+    }
+    let reason = (!missed.is_empty()).then(|| missed.join("; "));
+    let mut report = json!({
         "vertices": rep.vertices,
         "faces": rep.faces,
         "face_sizes": sizes,
@@ -143,11 +168,25 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
         "max_surface_distance": rep.max_surface_distance,
         "bbox_diagonal": rep.bbox_diagonal,
         "seconds": seconds,
+        "converged": reason.is_none(),
     });
+    if let Some(r) = &reason {
+        report["reason"] = json!(r);
+    }
     write_report(args.report.as_deref(), &report)?;
     println!(
-        "phex {label}: {} faces, max_planarity {:.3e}, {} invalid faces, {} iterations, {:.3} s",
-        rep.faces, rep.max_planarity, rep.invalid_faces, rep.iterations, seconds
+        "phex {label}: {} faces, max_planarity {:.3e}, {} invalid faces, {} iterations, {:.3} s{}",
+        rep.faces,
+        rep.max_planarity,
+        rep.invalid_faces,
+        rep.iterations,
+        seconds,
+        reason
+            .as_ref()
+            .map_or(String::new(), |r| format!(", NOT done: {r}"))
     );
-    Ok(())
+    match reason {
+        Some(r) => Err(CliError::Unmet(r)),
+        None => Ok(()),
+    }
 }

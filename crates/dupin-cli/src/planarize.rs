@@ -127,5 +127,12 @@ pub fn run(args: PlanarizeArgs) -> Result<(), CliError> {
         );
     }
     println!("{line}");
-    Ok(())
+    if result.converged {
+        Ok(())
+    } else {
+        Err(CliError::Unmet(format!(
+            "not converged: {}",
+            result.reason.as_deref().unwrap_or("unknown")
+        )))
+    }
 }

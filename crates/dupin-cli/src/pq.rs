@@ -54,6 +54,12 @@ pub fn run(args: PqArgs) -> Result<(), CliError> {
         "converged": r.converged,
         "seconds": seconds,
     });
+    if !r.converged {
+        report["reason"] = json!(format!(
+            "a perturbation level did not reach the tolerance (max_planarity {:.3e})",
+            r.max_planarity
+        ));
+    }
     if let Some(c) = r.conical_residual {
         report["conical_residual"] = json!(c);
     }
@@ -76,5 +82,12 @@ pub fn run(args: PqArgs) -> Result<(), CliError> {
         seconds,
         if r.converged { "" } else { ", NOT converged" }
     );
-    Ok(())
+    if r.converged {
+        Ok(())
+    } else {
+        Err(CliError::Unmet(format!(
+            "scene {name} did not converge: max_planarity {:.3e} after {} iterations",
+            r.max_planarity, r.iterations
+        )))
+    }
 }

@@ -117,3 +117,49 @@ fn field_angle_extension_and_boundary_faces() {
     let without = run("sphere", &["--no-boundary-faces"]);
     assert!(with > without, "{with} vs {without}");
 }
+
+/// A result that misses what was asked exits 3 with the output and the report written: faces
+/// not yet planar when the iterations run out, and self-intersecting faces where the paper's
+/// validity was asked for. A scene made to show invalid faces (Fig. 11) is not a miss.
+#[test]
+fn missed_results_exit_3_with_output_and_reason() {
+    let r = run_reported(
+        "phex-cap",
+        &["phex", "--scene", "vase-bottom-up", "--iterations", "1"],
+    );
+    let rep = r.unmet();
+    assert!(
+        rep["reason"]
+            .as_str()
+            .unwrap()
+            .contains("above the tolerance"),
+        "{rep}"
+    );
+    assert!(r.stderr().contains("max_planarity"));
+    let r = run_reported(
+        "phex-invalid",
+        &[
+            "phex",
+            "--surface",
+            "torus",
+            "--method",
+            "progressive",
+            "--size",
+            "0.2",
+            "--no-optimize",
+        ],
+    );
+    let rep = r.unmet();
+    assert!(rep["invalid_faces"].as_u64().unwrap() > 0);
+    assert!(
+        rep["reason"]
+            .as_str()
+            .unwrap()
+            .contains("self-intersecting"),
+        "{rep}"
+    );
+    let shown = run_reported("phex-shown", &["phex", "--scene", "hyperboloid-invalid"]);
+    let rep = shown.ok();
+    assert!(rep["invalid_faces"].as_u64().unwrap() > 0);
+    assert_eq!(rep["converged"], true);
+}

@@ -89,6 +89,21 @@ impl Run {
         self.report.as_ref().expect("a report")
     }
 
+    /// Asserts exit code 3 (the result misses what was asked): one `error:` line on stderr,
+    /// the output and the report written, the report's `converged` false with a `reason`.
+    /// Returns the report.
+    pub fn unmet(&self) -> &serde_json::Value {
+        let err = self.stderr();
+        assert_eq!(self.o.status.code(), Some(3), "{err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.starts_with("error: "), "{err}");
+        assert!(self.out.is_some(), "the output is written");
+        let r = self.report.as_ref().expect("a report");
+        assert_eq!(r["converged"], false, "{r}");
+        assert!(r["reason"].as_str().is_some_and(|s| !s.is_empty()), "{r}");
+        r
+    }
+
     /// Asserts exit code 2 and returns the error text.
     pub fn fails(&self) -> String {
         assert_eq!(self.o.status.code(), Some(2), "{}", self.stderr());

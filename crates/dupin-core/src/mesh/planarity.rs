@@ -23,7 +23,7 @@ pub fn face_planarity(mesh: &PolyMesh, i: usize) -> f64 {
 
 /// The least-squares plane of `points` (at least one): its point, the centroid, and its unit
 /// normal (sign arbitrary), the eigenvector of the smallest eigenvalue of the points'
-/// covariance matrix ([`least_squares_normal`]). The one plane fit of the crate: the contract's
+/// covariance matrix (`least_squares_normal`). The one plane fit of the crate: the contract's
 /// `max_planarity`, panel flattening and the PQ solver's start all use it.
 pub fn least_squares_plane(points: impl Iterator<Item = Vec3> + Clone) -> (Vec3, Vec3) {
     let (sum, n) = points

@@ -22,7 +22,7 @@ crate::names::named_choices!(PqMode, "mode", {
     Circular => "circular",
 });
 
-/// Settings of [`pq_perturb`] and [`PqPerturbation`].
+/// Settings of [`super::pq_perturb`] and [`super::PqPerturbation`].
 ///
 /// Weights are dimensionless: fairness and closeness residuals are divided by the mean edge
 /// length, so the defaults suit meshes of any scale.

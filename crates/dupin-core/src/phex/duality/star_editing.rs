@@ -16,7 +16,7 @@ pub enum StarEditError {
     /// A ring vertex of the 3D star is NaN or infinite.
     #[error("star vertices must be finite")]
     NonFiniteStar,
-    /// The projection of triangle `index` (centre, ring[index], ring[index + 1]) is degenerate.
+    /// The projection of triangle `index` (centre, `ring[index]`, `ring[index + 1]`) is degenerate.
     #[error("{error}: triangle {index} of the star is flat in the tangent plane")]
     FlatProjection {
         /// What the triangle test found.
