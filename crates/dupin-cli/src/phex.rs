@@ -41,6 +41,10 @@ pub struct PhexArgs {
     /// Extension: no faces at boundary vertices of the triangulation (closed stars only).
     #[arg(long)]
     pub no_boundary_faces: bool,
+    /// Largest number of P-Hex faces (default 100000): a run that would make more is refused
+    /// while its triangulation is built.
+    #[arg(long)]
+    pub max_faces: Option<usize>,
     /// Print the scene names, one a line.
     #[arg(long)]
     pub list_scenes: bool,
@@ -119,6 +123,9 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
     }
     if args.no_boundary_faces {
         config.boundary_faces = false;
+    }
+    if let Some(n) = args.max_faces {
+        config.max_faces = n;
     }
     let label = args
         .scene

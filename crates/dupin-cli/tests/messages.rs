@@ -133,3 +133,56 @@ fn huge_offset_distances_are_refused_with_the_limit() {
     }
     let _ = std::fs::remove_file(&mesh);
 }
+
+/// Runs that would make far more P-Hex faces than the limit are refused while the
+/// triangulation is built, in well under a second, naming the limit and the option: a field
+/// angle whose layers come out thin (it made 563,566 faces where the scene has 2,444), the
+/// progressive method on a hyperboloid, a tiny size.
+#[test]
+fn phex_runs_beyond_the_face_limit_are_refused_early() {
+    let out = tmp("budget.obj");
+    let out = out.to_str().unwrap();
+    for args in [
+        &[
+            "phex",
+            "--scene",
+            "cyclide-prescribed",
+            "--field-angle",
+            "45",
+            "--out",
+            out,
+        ][..],
+        &[
+            "phex",
+            "--surface",
+            "hyperboloid",
+            "--method",
+            "progressive",
+            "--out",
+            out,
+        ],
+        &[
+            "phex",
+            "--surface",
+            "sphere",
+            "--method",
+            "progressive",
+            "--size",
+            "1e-3",
+            "--out",
+            out,
+        ],
+    ] {
+        let start = std::time::Instant::now();
+        let e = refused(args);
+        assert!(
+            e.contains("limit of 100000") && e.contains("--max-faces"),
+            "{e}"
+        );
+        assert!(
+            start.elapsed().as_secs_f64() < 20.0,
+            "{args:?} took {:?}",
+            start.elapsed()
+        );
+    }
+}

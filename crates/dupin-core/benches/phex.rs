@@ -67,6 +67,7 @@ fn spec(size: f64) -> TriangulationSpec {
     let len = 2.0 * std::f64::consts::PI * (2.0 + 0.7);
     let _ = s;
     TriangulationSpec {
+        max_vertices: dupin_core::phex::MAX_PHEX_FACES,
         method: TriangulationMethod::Prescribed,
         rule: dupin_core::phex::LayerRule::Ideal { bound: 0.3 },
         samples: (len / size).round() as usize,

@@ -33,9 +33,9 @@ pub use pipeline::{PhexConfig, PhexMetrics, PhexPhase, PhexPipeline, PhexResult,
 pub use planarity_optimisation::{PlanarityOptimiser, PlanarityOptions, PlanarityStep};
 pub use report::{FaceInfo, PhexReport, count_invalid_faces, face_info, phex_report};
 pub use triangulation::{
-    ConjugateFields, DEFAULT_BOUND, LayerRule, MAX_RATIO, MAX_RATIO_ELLIPTIC, Triangulation,
-    TriangulationMethod, TriangulationSpec, bounded_ratio, convex_loop_triangulation,
-    loop_subdivide, triangulate, triangulate_along_fields,
+    ConjugateFields, DEFAULT_BOUND, LayerRule, MAX_PHEX_FACES, MAX_RATIO, MAX_RATIO_ELLIPTIC,
+    Triangulation, TriangulationMethod, TriangulationSpec, bounded_ratio,
+    convex_loop_triangulation, loop_subdivide, triangulate, triangulate_along_fields,
 };
 
 use thiserror::Error;

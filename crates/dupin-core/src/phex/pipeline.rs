@@ -57,6 +57,10 @@ pub struct PhexConfig {
     pub lambda: f64,
     /// Initial surface-distance weight mu of the planarity optimisation (section 7; >= 0).
     pub mu: f64,
+    /// Largest number of P-Hex faces (triangulation vertices) the run may make
+    /// ([`super::MAX_PHEX_FACES`] by default): a larger triangulation is refused while it is
+    /// built.
+    pub max_faces: usize,
 }
 
 impl PhexConfig {
@@ -106,6 +110,7 @@ impl PhexConfig {
             field_angle: None,
             lambda: PlanarityOptions::default().lambda,
             mu: PlanarityOptions::default().mu,
+            max_faces: crate::phex::MAX_PHEX_FACES,
         }
     }
 }
@@ -321,6 +326,7 @@ impl PhexPipeline {
             end: across.1,
             along,
             max_layers: 4000,
+            max_vertices: config.max_faces,
         };
         let tri = match config.field_angle {
             None => triangulate(surface.as_ref(), &spec)?,

@@ -97,6 +97,7 @@ impl SceneSpec {
             field_angle: self.field_angle,
             lambda: PlanarityOptions::default().lambda,
             mu: PlanarityOptions::default().mu,
+            max_faces: crate::phex::MAX_PHEX_FACES,
         }
     }
 }

@@ -407,6 +407,9 @@ impl<'a> Region<'a> {
 
     /// Adds the vertex at the parameters `uv` (position and unit normal).
     fn push(&self, t: &mut Triangulation, uv: Vec2) -> Result<u32, PhexError> {
+        if t.positions.len() >= self.spec.max_vertices {
+            return Err(super::layers::over_budget(self.spec, t.layers.len()));
+        }
         let (u, v) = self.f.dom.normalize(uv.x, uv.y);
         let d = self.s.derivatives(u, v);
         let nrm = d.pu.cross(&d.pv).try_normalize(1e-300).ok_or_else(|| {

@@ -14,7 +14,7 @@ mod loop_subdivision;
 
 pub use conjugate_fields::{ConjugateFields, triangulate_along_fields};
 pub use layers::{
-    DEFAULT_BOUND, LayerRule, MAX_RATIO, MAX_RATIO_ELLIPTIC, Triangulation, TriangulationMethod,
-    TriangulationSpec, bounded_ratio, triangulate,
+    DEFAULT_BOUND, LayerRule, MAX_PHEX_FACES, MAX_RATIO, MAX_RATIO_ELLIPTIC, Triangulation,
+    TriangulationMethod, TriangulationSpec, bounded_ratio, triangulate,
 };
 pub use loop_subdivision::{convex_loop_triangulation, loop_subdivide};
