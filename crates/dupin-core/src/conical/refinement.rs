@@ -313,24 +313,19 @@ impl PqSceneStepper {
 }
 
 /// One step is one perturbation iteration or one subdivision.
-impl Stepper for PqSceneStepper {
-    type Metrics = PqSceneStepInfo;
-    type Output = PqSceneResult;
-    type Error = PqSceneError;
-
-    /// One perturbation iteration or one subdivision (no-op once done); returns the state
-    /// after it. A level whose mesh needs no perturbation (already within the tolerance)
-    /// takes no step of its own.
-    fn step(&mut self) -> Result<PqSceneStepInfo, PqSceneError> {
+impl PqSceneStepper {
+    /// One perturbation iteration or one subdivision, unmeasured; `show` copies a running
+    /// perturbation's mesh out for display.
+    fn advance(&mut self, show: bool) -> Result<(), PqSceneError> {
         self.settle();
         if self.phase == PqScenePhase::Done {
-            return Ok(self.metrics());
+            return Ok(());
         }
         if let Some(p) = self.perturbation.as_mut() {
             let Ok(i) = p.step();
             self.running_iterations = i.iteration;
             self.phase = PqScenePhase::Perturb;
-            if !p.is_done() {
+            if show && !p.is_done() {
                 let m = p.mesh().clone();
                 self.show(m);
             }
@@ -354,7 +349,30 @@ impl Stepper for PqSceneStepper {
                 }
             }
         }
+        Ok(())
+    }
+}
+
+impl Stepper for PqSceneStepper {
+    type Metrics = PqSceneStepInfo;
+    type Output = PqSceneResult;
+    type Error = PqSceneError;
+
+    /// One perturbation iteration or one subdivision (no-op once done); returns the state
+    /// after it. A level whose mesh needs no perturbation (already within the tolerance)
+    /// takes no step of its own.
+    fn step(&mut self) -> Result<PqSceneStepInfo, PqSceneError> {
+        self.advance(true)?;
         Ok(self.metrics())
+    }
+
+    /// The steps without their measures and without copying each iteration's mesh out of the
+    /// perturbation: the same final state, at the cost of the one-shot parts.
+    fn run_to_end(&mut self) -> Result<(), PqSceneError> {
+        while !self.is_done() {
+            self.advance(false)?;
+        }
+        Ok(())
     }
 
     /// Whether the run has finished.

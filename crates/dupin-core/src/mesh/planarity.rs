@@ -30,21 +30,27 @@ pub fn least_squares_plane(points: impl Iterator<Item = Vec3> + Clone) -> (Vec3,
         .clone()
         .fold((Vec3::zeros(), 0usize), |(s, n), p| (s + p, n + 1));
     let c = sum / n as f64;
-    // The covariance of a face of size 1e-160 underflows, of size 1e160 overflows: scale the
-    // offsets to about 1 first, by a power of two so that the scaling is exact and ordinary
-    // faces get the same bits as unscaled sums.
-    let size = points.clone().map(|p| (p - c).amax()).fold(0.0, f64::max);
-    let scale = if size > 0.0 && size.is_finite() {
-        2f64.powi((-size.log2().floor() as i32).clamp(-1000, 1000))
-    } else {
-        1.0
+    let covariance = |scale: f64| {
+        let mut cov = Matrix3::zeros();
+        for p in points.clone() {
+            let d = (p - c) * scale;
+            cov += d * d.transpose();
+        }
+        cov
     };
-    let mut cov = Matrix3::zeros();
-    for p in points {
-        let d = (p - c) * scale;
-        cov += d * d.transpose();
+    let cov = covariance(1.0);
+    // The covariance of a face of size 1e-160 underflows, of size 1e160 overflows: there,
+    // scale the offsets to about 1 first, by a power of two so that the scaling is exact.
+    let m = cov.amax();
+    if m == 0.0 || (1e-280..1e280).contains(&m) {
+        return (c, least_squares_normal(&cov));
     }
-    (c, least_squares_normal(&cov))
+    let size = points.clone().map(|p| (p - c).amax()).fold(0.0, f64::max);
+    if !(size > 0.0 && size.is_finite()) {
+        return (c, least_squares_normal(&cov));
+    }
+    let scale = 2f64.powi((-size.log2().floor() as i32).clamp(-1000, 1000));
+    (c, least_squares_normal(&covariance(scale)))
 }
 
 /// Unit eigenvector of the smallest eigenvalue of a symmetric positive semi-definite 3 x 3

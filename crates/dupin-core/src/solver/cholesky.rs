@@ -161,11 +161,8 @@ impl SparseCholesky {
         if needed > limit {
             return Err(SolverError::TooLarge { needed, limit });
         }
-        let mut factor = Vec::new();
-        factor
-            .try_reserve_exact(symbolic.len_val())
-            .map_err(|_| SolverError::TooLarge { needed, limit })?;
-        factor.resize(symbolic.len_val(), 0.0);
+        // Zeroed by the allocator (calloc: pages zeroed on first touch), not by a memset.
+        let factor = vec![0.0; symbolic.len_val()];
         let req = symbolic
             .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
             .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
