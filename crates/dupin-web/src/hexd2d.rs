@@ -125,8 +125,9 @@ impl HexDelaunayLab {
 impl HexDelaunayLab {
     /// `new HexDelaunayLab(mode)`, mode `simple` or `extended`.
     #[wasm_bindgen(constructor)]
-    pub fn new(mode: &str) -> Result<HexDelaunayLab, JsError> {
-        HexDelaunayLab::with_mode(mode).map_err(err)
+    pub fn new(mode: JsValue) -> Result<HexDelaunayLab, JsError> {
+        let mode = crate::js::string_arg(&mode, "the mode")?;
+        HexDelaunayLab::with_mode(&mode).map_err(err)
     }
 
     /// Replaces the input and restarts at the bounding hexagon: `xy` holds x y pairs, `segments`

@@ -260,13 +260,14 @@ pub fn free_defaults() -> Result<JsValue, JsError> {
 /// Colour stops of a colour mode for the page's legend: `[{ label, color: [r, g, b] }]` (linear
 /// RGB in 0..1, the same colours the panels get).
 #[wasm_bindgen(js_name = colorLegend)]
-pub fn color_legend(mode: &str) -> Result<JsValue, JsError> {
+pub fn color_legend(mode: JsValue) -> Result<JsValue, JsError> {
+    let mode = crate::js::string_arg(&mode, "the colour mode")?;
     #[derive(Serialize)]
     struct Stop {
         label: String,
         color: [f32; 3],
     }
-    let stops: Vec<Stop> = match ColorMode::parse(mode).map_err(err)? {
+    let stops: Vec<Stop> = match ColorMode::parse(&mode).map_err(err)? {
         ColorMode::Planarity => PLANARITY_LEGEND_LOG10
             .iter()
             .map(|&e| Stop {
@@ -525,50 +526,14 @@ impl Session {
     /// planar, through white, to red at 1e-2 and above, log scale; `convexity`; `regularity`:
     /// the P-Hex paper's section 4.2 deviation from the affine (quasi-)regular hexagon) and
     /// their edges.
-    pub fn mesh(&mut self, mode: Option<String>) -> Result<MeshData, JsError> {
-        let mode = ColorMode::parse(mode.as_deref().unwrap_or("")).map_err(err)?;
-        let m = self.current_mesh().unwrap_or_default();
-        let colors: Vec<[f32; 3]> = match mode {
-            ColorMode::Planarity => self
-                .face_planarities(&m)
-                .iter()
-                .map(|&p| planarity_color(p))
-                .collect(),
-            ColorMode::Convexity => (0..m.num_faces())
-                .map(|i| {
-                    let f = face_info(&m, i, 0.0);
-                    convexity_color(f.simple, f.convex)
-                })
-                .collect(),
-            ColorMode::Regularity => {
-                // The regularity measure depends on the sign of K at the face: the P-Hex report
-                // has it per face; other meshes are compared with the affine-regular hexagon.
-                let report = match &self.run {
-                    Run::Phex(p) => p.report(),
-                    Run::Pq { .. } => None,
-                };
-                (0..m.num_faces())
-                    .map(|i| {
-                        let d = match &report {
-                            Some(r) => r.per_face.get(i).and_then(|f| f.shape_deviation),
-                            None => face_info(&m, i, 1.0).shape_deviation,
-                        };
-                        d.map_or(NOT_HEX, regularity_color)
-                    })
-                    .collect()
-            }
+    pub fn mesh(&mut self, mode: JsValue) -> Result<MeshData, JsError> {
+        // No mode (undefined or null): planarity colours.
+        let mode = if mode.is_undefined() || mode.is_null() {
+            None
+        } else {
+            Some(crate::js::string_arg(&mode, "the colour mode")?)
         };
-        let mut data = MeshData::panels(m.clone(), &colors);
-        if let Some((offset, beams, segments)) = self.layer_meshes(&m)? {
-            if let Some(offset) = offset {
-                data.add_layer(&offset, OFFSET_COLOR, true);
-            }
-            if let Some(beams) = beams {
-                data.add_layer(&beams, BEAM_COLOR, false);
-                data.add_lines(&segments);
-            }
-        }
-        Ok(data)
+        self.mesh_in(mode.as_deref())
     }
 
     /// Sets the extra layers `mesh()` draws: `{ offset, support, distance }` (see
@@ -641,6 +606,53 @@ const BEAM_COLOR: [f32; 3] = [0.55, 0.56, 0.60];
 type Layers = (Option<PolyMesh>, Option<PolyMesh>, Vec<f32>);
 
 impl Session {
+    /// [`Session::mesh`] for Rust callers: `None` is planarity colours.
+    pub fn mesh_in(&mut self, mode: Option<&str>) -> Result<MeshData, JsError> {
+        let mode = ColorMode::parse(mode.unwrap_or("")).map_err(err)?;
+        let m = self.current_mesh().unwrap_or_default();
+        let colors: Vec<[f32; 3]> = match mode {
+            ColorMode::Planarity => self
+                .face_planarities(&m)
+                .iter()
+                .map(|&p| planarity_color(p))
+                .collect(),
+            ColorMode::Convexity => (0..m.num_faces())
+                .map(|i| {
+                    let f = face_info(&m, i, 0.0);
+                    convexity_color(f.simple, f.convex)
+                })
+                .collect(),
+            ColorMode::Regularity => {
+                // The regularity measure depends on the sign of K at the face: the P-Hex report
+                // has it per face; other meshes are compared with the affine-regular hexagon.
+                let report = match &self.run {
+                    Run::Phex(p) => p.report(),
+                    Run::Pq { .. } => None,
+                };
+                (0..m.num_faces())
+                    .map(|i| {
+                        let d = match &report {
+                            Some(r) => r.per_face.get(i).and_then(|f| f.shape_deviation),
+                            None => face_info(&m, i, 1.0).shape_deviation,
+                        };
+                        d.map_or(NOT_HEX, regularity_color)
+                    })
+                    .collect()
+            }
+        };
+        let mut data = MeshData::panels(m.clone(), &colors);
+        if let Some((offset, beams, segments)) = self.layer_meshes(&m)? {
+            if let Some(offset) = offset {
+                data.add_layer(&offset, OFFSET_COLOR, true);
+            }
+            if let Some(beams) = beams {
+                data.add_layer(&beams, BEAM_COLOR, false);
+                data.add_lines(&segments);
+            }
+        }
+        Ok(data)
+    }
+
     /// Per-face planarity of `mesh` (the current mesh), cached until the next step.
     fn face_planarities(&mut self, mesh: &PolyMesh) -> Vec<f64> {
         match &self.per_face {
@@ -921,7 +933,7 @@ mod tests {
         while !s.done() {
             s.advance().unwrap();
         }
-        let plain = s.mesh(None).unwrap();
+        let plain = s.mesh_in(None).unwrap();
         let mesh = s.current_mesh().unwrap();
         assert!(s.offset_reason().is_none());
         assert!(pq_session("developable-strips").offset_reason().is_some());
@@ -941,7 +953,7 @@ mod tests {
         assert!(max_planarity(&offset) <= 1e-9, "{}", max_planarity(&offset));
         assert!(max_planarity(&beams) <= 1e-9, "{}", max_planarity(&beams));
         assert_eq!(segments.len(), 6 * mesh.num_vertices());
-        let layered = s.mesh(None).unwrap();
+        let layered = s.mesh_in(None).unwrap();
         let tris = |m: &MeshData| m.buffers.triangle_count();
         let offset_tris = dupin_core::mesh::polymesh_buffers(&offset, None)
             .0
@@ -954,6 +966,6 @@ mod tests {
         assert!(layered.edges.len() > plain.edges.len() + segments.len());
         // Only the support layer: no offset panels.
         s.layers.offset = false;
-        assert_eq!(tris(&s.mesh(None).unwrap()), tris(&plain) + beam_tris);
+        assert_eq!(tris(&s.mesh_in(None).unwrap()), tris(&plain) + beam_tris);
     }
 }

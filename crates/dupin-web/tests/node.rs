@@ -2,6 +2,7 @@
 #![cfg(target_arch = "wasm32")]
 
 use dupin_web::torus_mesh;
+use wasm_bindgen::JsValue;
 use wasm_bindgen_test::*;
 
 #[wasm_bindgen_test]
@@ -56,13 +57,16 @@ fn session_steps_a_phex_scene_to_planar_hexagons() {
     let faces = get("faces").as_f64().unwrap() as usize;
     let obj = s.export_obj();
     assert_eq!(obj.lines().filter(|l| l.starts_with("f ")).count(), faces);
-    assert!(s.mesh(None).unwrap().edges().length() > 0);
+    assert!(s.mesh(JsValue::UNDEFINED).unwrap().edges().length() > 0);
     // Colour modes colour every vertex; an unknown mode is an error.
     for mode in ["planarity", "convexity", "regularity"] {
-        let md = s.mesh(Some(mode.into())).unwrap();
+        let md = s.mesh(JsValue::from(mode)).unwrap();
         assert_eq!(md.colors().length(), md.positions().length(), "{mode}");
     }
-    assert!(s.mesh(Some("rainbow".into())).is_err());
+    assert!(s.mesh(JsValue::from("rainbow")).is_err());
+    // A number where a string belongs is an Error, not a trap in wasm memory.
+    assert!(s.mesh(JsValue::from(42)).is_err());
+    assert!(dupin_web::color_legend(JsValue::from(42)).is_err());
     // JSON: the report's face count and one face list per face.
     let json: serde_json::Value = serde_json::from_str(&s.export_json().unwrap()).unwrap();
     assert_eq!(json["report"]["faces"].as_u64(), Some(faces as u64));
@@ -174,10 +178,10 @@ fn pq_session_steps_levels_and_draws_conical_layers() {
         let msg = message(s.set_layers(parse(json)).unwrap_err());
         assert!(msg.contains(needle), "{json}: {msg}");
     }
-    let plain = s.mesh(None).unwrap().triangle_count();
+    let plain = s.mesh(JsValue::UNDEFINED).unwrap().triangle_count();
     s.set_layers(parse(r#"{"offset":true,"support":true,"distance":0.2}"#))
         .unwrap();
-    assert!(s.mesh(None).unwrap().triangle_count() > 2 * plain);
+    assert!(s.mesh(JsValue::UNDEFINED).unwrap().triangle_count() > 2 * plain);
     let mut levels = std::collections::BTreeSet::from([0]);
     while !s.done() {
         let m = s.step().unwrap();

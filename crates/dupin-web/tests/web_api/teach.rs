@@ -71,7 +71,7 @@ fn lesson_errors_are_js_errors() {
 
 #[wasm_bindgen_test]
 fn hex_lab_steps_to_the_simple_bounds() {
-    let mut lab = HexDelaunayLab::new("simple").unwrap();
+    let mut lab = HexDelaunayLab::new("simple".into()).unwrap();
     let xy = vec![0.0, 0.0, 0.3, 0.1, -0.2, 0.25, 0.05, -0.3, 0.31, 0.12];
     lab.set_input_js(xy, vec![]).unwrap();
     let mut n = 0;
@@ -95,5 +95,6 @@ fn hex_lab_steps_to_the_simple_bounds() {
         lab.set_input_js(vec![0.0, 0.0, 1.0, 1.0], vec![0, 5])
             .is_err()
     );
-    assert!(HexDelaunayLab::new("other").is_err());
+    assert!(HexDelaunayLab::new("other".into()).is_err());
+    assert!(HexDelaunayLab::new(JsValue::from(42)).is_err());
 }
