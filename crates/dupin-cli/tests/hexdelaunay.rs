@@ -129,6 +129,12 @@ fn bad_input_exits_2_with_one_error_line() {
     assert!(bad(line, Some("0 2\n1 3\n"), &[]).contains("cross"));
     assert!(bad(line, Some("0 3\n1 2\n"), &["--mode", "extended"]).contains("cross"));
     assert!(bad("0 0\n1 0\n0 0\n", Some("0 2\n"), &[]).contains("zero length"));
+    // The same segment twice, in either order, is named as a repeat, not as a crossing.
+    let e = bad(square, Some("0 1\n1 0\n"), &[]);
+    assert!(
+        e.contains("join the same two points") && !e.contains("cross"),
+        "{e}"
+    );
     assert!(bad(square, None, &["--mode", "fancy"]).contains("error"));
     let missing = temp("missing.txt", None);
     let out = temp("out.obj", None);

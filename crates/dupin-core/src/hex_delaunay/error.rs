@@ -65,6 +65,19 @@ pub enum HexDelaunayError {
         /// Index of the segment (0-based).
         segment: usize,
     },
+    /// Two segments join the same two points (in either order).
+    #[error(
+        "segments {first} and {second} join the same two points (segment lines {} and {}); give \
+         each segment once",
+        .first + 1,
+        .second + 1
+    )]
+    DuplicateSegment {
+        /// Index of the first segment (0-based).
+        first: usize,
+        /// Index of the repeat (0-based).
+        second: usize,
+    },
     /// Two segments cross or overlap away from a shared endpoint.
     #[error("segments {first} and {second} cross")]
     SegmentsCross {

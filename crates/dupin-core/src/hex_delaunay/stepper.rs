@@ -700,6 +700,13 @@ pub(super) fn check_segments(
         for j in i + 1..segments.len() {
             let [a, b] = segments[i];
             let [p, q] = segments[j];
+            let same = |u: usize, v: usize| points[u] == points[v];
+            if (same(a, p) && same(b, q)) || (same(a, q) && same(b, p)) {
+                return Err(HexDelaunayError::DuplicateSegment {
+                    first: i,
+                    second: j,
+                });
+            }
             let shared = [a, b]
                 .iter()
                 .any(|&u| [p, q].iter().any(|&v| points[u] == points[v]));
