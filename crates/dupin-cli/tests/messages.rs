@@ -186,3 +186,33 @@ fn phex_runs_beyond_the_face_limit_are_refused_early() {
         );
     }
 }
+
+/// Huge numbers print in exponent form, not in 300 digits.
+#[test]
+fn huge_numbers_stay_short_in_messages() {
+    let out = tmp("huge.obj");
+    let out = out.to_str().unwrap();
+    for args in [
+        &[
+            "phex",
+            "--surface",
+            "sphere",
+            "--size",
+            "1e300",
+            "--out",
+            out,
+        ][..],
+        &[
+            "phex",
+            "--surface",
+            "torus",
+            "--set",
+            "R=1e300",
+            "--out",
+            out,
+        ],
+    ] {
+        let e = refused(args);
+        assert!(e.contains("1e300") && e.len() < 200, "{e}");
+    }
+}

@@ -305,14 +305,16 @@ impl PhexPipeline {
         let size = config.size.unwrap_or(base_len / 48.0);
         if !(size.is_finite() && size > 0.0) {
             return Err(PhexError::BadSize(format!(
-                "size {size} must be a positive length"
+                "size {} must be a positive length",
+                crate::math::Num(size)
             )));
         }
         let samples_f = (base_len / size).round();
         if !(6.0..=4000.0).contains(&samples_f) {
             return Err(PhexError::BadSize(format!(
-                "size {size} gives {samples_f} samples on a base curve of length {base_len:.3}; \
+                "size {} gives {samples_f} samples on a base curve of length {base_len:.3}; \
                  use a size between {:.3e} and {:.3e}",
+                crate::math::Num(size),
                 base_len / 4000.0,
                 base_len / 6.0
             )));
@@ -418,7 +420,8 @@ impl PhexPipeline {
         let size = config.size.unwrap_or(mean_axis / 12.0);
         if !(size.is_finite() && size > 0.0) {
             return Err(PhexError::BadSize(format!(
-                "size {size} must be a positive length"
+                "size {} must be a positive length",
+                crate::math::Num(size)
             )));
         }
         let levels = (1.05 * mean_axis / size).log2().ceil().max(1.0) as usize;

@@ -35,7 +35,13 @@ pub enum RegistryError {
     Malformed(String),
     /// A value lies outside its documented range (or is not finite, or not an integer where one
     /// is required).
-    #[error("parameter `{key}` = {value} is out of range [{min}, {max}]{integer}", integer = if *.integer { " (integer)" } else { "" })]
+    #[error(
+        "parameter `{key}` = {} is out of range [{}, {}]{integer}",
+        crate::math::Num(*.value),
+        crate::math::Num(*.min),
+        crate::math::Num(*.max),
+        integer = if *.integer { " (integer)" } else { "" }
+    )]
     OutOfRange {
         /// The key.
         key: String,
