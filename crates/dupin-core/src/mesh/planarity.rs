@@ -53,6 +53,19 @@ pub fn least_squares_plane(points: impl Iterator<Item = Vec3> + Clone) -> (Vec3,
     (c, least_squares_normal(&covariance(scale)))
 }
 
+/// An orthonormal basis (e1, e2) of the plane with unit normal `n`, with (e1, e2, n)
+/// right-handed: e1 is x (or y, when n is near x) projected onto the plane. Where faces are
+/// flattened for exact 2D predicates.
+pub fn plane_basis(n: Vec3) -> (Vec3, Vec3) {
+    let e1 = if n.x.abs() < 0.9 {
+        Vec3::x()
+    } else {
+        Vec3::y()
+    };
+    let e1 = (e1 - n * n.dot(&e1)).normalize();
+    (e1, n.cross(&e1))
+}
+
 /// Unit eigenvector of the smallest eigenvalue of a symmetric positive semi-definite 3 x 3
 /// matrix (a covariance): the normal of the least-squares plane.
 ///

@@ -271,13 +271,7 @@ fn edge_point(a: Vec3, na: Vec3, b: Vec3, nb: Vec3) -> Vec3 {
 /// Whether `pts`, projected onto the plane through `origin` with unit normal `n`, form a simple
 /// polygon.
 fn starts_simple(pts: &[Vec3], origin: Vec3, n: Vec3) -> bool {
-    let e1 = if n.x.abs() < 0.9 {
-        Vec3::x()
-    } else {
-        Vec3::y()
-    };
-    let e1 = (e1 - n * n.dot(&e1)).normalize();
-    let e2 = n.cross(&e1);
+    let (e1, e2) = crate::mesh::plane_basis(n);
     let q: Vec<crate::Vec2> = pts
         .iter()
         .map(|p| crate::Vec2::new((p - origin).dot(&e1), (p - origin).dot(&e2)))

@@ -60,13 +60,7 @@ fn project(pts: &[Vec3]) -> (Vec<Vec2>, Vec3) {
         n += (pts[i] - c).cross(&(pts[(i + 1) % pts.len()] - c));
     }
     let n = n.try_normalize(0.0).unwrap_or(Vec3::z());
-    let e1 = if n.x.abs() < 0.9 {
-        Vec3::x()
-    } else {
-        Vec3::y()
-    };
-    let e1 = (e1 - n * n.dot(&e1)).normalize();
-    let e2 = n.cross(&e1);
+    let (e1, e2) = crate::mesh::plane_basis(n);
     (
         pts.iter()
             .map(|p| Vec2::new((p - c).dot(&e1), (p - c).dot(&e2)))
