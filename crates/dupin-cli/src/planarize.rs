@@ -5,7 +5,7 @@ use crate::common::{CliError, read_mesh_file, write_report, write_text};
 use clap::{Args, ValueEnum};
 use dupin_core::Stepper;
 use dupin_core::conical::{PqMode, PqOptions, PqPerturbation, Refinement};
-use dupin_core::mesh::write_obj;
+use dupin_core::mesh::{flipped_faces, write_obj};
 use serde_json::json;
 use std::path::PathBuf;
 
@@ -102,7 +102,29 @@ pub fn run(args: PlanarizeArgs) -> Result<(), CliError> {
     if let Some(c) = result.circular_residual {
         report["circular_residual"] = json!(c);
     }
-    if let Some(r) = &result.reason {
+    // Planar faces that turned over are a folded design, not a planarised one.
+    let flipped = flipped_faces(&mesh, &result.mesh);
+    report["flipped_faces"] = json!(flipped.len());
+    let mut reason = result.reason.clone();
+    if !flipped.is_empty() {
+        report["converged"] = json!(false);
+        let shown: Vec<String> = flipped
+            .iter()
+            .take(5)
+            .map(|f| (f + 1).to_string())
+            .collect();
+        let folded = format!(
+            "{} faces turned over (folded), e.g. faces {}; anchor the boundary or raise \
+             --closeness",
+            flipped.len(),
+            shown.join(", ")
+        );
+        reason = Some(match reason {
+            Some(r) => format!("{r}; {folded}"),
+            None => folded,
+        });
+    }
+    if let Some(r) = &reason {
         report["reason"] = json!(r);
     }
     write_report(args.report.as_deref(), &report)?;
@@ -120,19 +142,17 @@ pub fn run(args: PlanarizeArgs) -> Result<(), CliError> {
     if let Some(c) = result.circular_residual {
         line += &format!(", circular_residual {c:.3e}");
     }
-    if !result.converged {
-        line += &format!(
-            ", NOT converged: {}",
-            result.reason.as_deref().unwrap_or("unknown")
-        );
+    let done = result.converged && flipped.is_empty();
+    if !done {
+        line += &format!(", NOT done: {}", reason.as_deref().unwrap_or("unknown"));
     }
     println!("{line}");
-    if result.converged {
+    if done {
         Ok(())
     } else {
         Err(CliError::Unmet(format!(
-            "not converged: {}",
-            result.reason.as_deref().unwrap_or("unknown")
+            "not done: {}",
+            reason.as_deref().unwrap_or("unknown")
         )))
     }
 }

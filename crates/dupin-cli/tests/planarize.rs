@@ -5,8 +5,12 @@ use common::{Run, run_reported, tmp};
 
 /// A 6 x 6 quad grid on the saddle z = xy, rotated 30 degrees: far from planar.
 fn skew_grid_obj() -> String {
-    let n = 6;
-    let (s, c) = 30f64.to_radians().sin_cos();
+    skew_grid(6, 30.0)
+}
+
+/// An `n x n` quad grid on the saddle z = xy over [-1, 1]², rotated by `degrees`.
+fn skew_grid(n: usize, degrees: f64) -> String {
+    let (s, c) = degrees.to_radians().sin_cos();
     let mut out = String::new();
     for j in 0..=n {
         for i in 0..=n {
@@ -182,4 +186,17 @@ fn sqp_refinement_reaches_the_same_accuracy() {
     let r = run.ok();
     assert_eq!(r["converged"], true, "{r}");
     assert!(r["max_planarity"].as_f64().unwrap() <= 1e-10);
+}
+
+/// Planar faces that turned over are a folded design: exit 3 with the count, though every face
+/// is planar (the 20 x 20 grid at 15 degrees folds 68 faces).
+#[test]
+fn folded_faces_are_not_a_planarised_design() {
+    let run = planarize("fold", &skew_grid(20, 15.0), &[]);
+    let r = run.unmet();
+    assert!(r["max_planarity"].as_f64().unwrap() <= 1e-10, "{r}");
+    assert!(r["flipped_faces"].as_u64().unwrap() > 0, "{r}");
+    assert!(r["reason"].as_str().unwrap().contains("turned over"), "{r}");
+    let fine = planarize("nofold", &skew_grid_obj(), &[]);
+    assert_eq!(fine.ok()["flipped_faces"], 0);
 }

@@ -53,6 +53,23 @@ pub fn least_squares_plane(points: impl Iterator<Item = Vec3> + Clone) -> (Vec3,
     (c, least_squares_normal(&covariance(scale)))
 }
 
+/// The faces of `after` (the same faces as `before`, moved vertices) whose orientation turned
+/// over: Newell normals (through the centroid, robust for non-planar and non-convex faces) at
+/// an angle of 90 degrees or more. A planarisation that folds faces over has not kept the
+/// design, whatever its planarity.
+pub fn flipped_faces(before: &PolyMesh, after: &PolyMesh) -> Vec<usize> {
+    let newell = |m: &PolyMesh, f: usize| -> Vec3 {
+        let p: Vec<Vec3> = m.face(f).iter().map(|&v| m.positions[v as usize]).collect();
+        let c = p.iter().sum::<Vec3>() / p.len() as f64;
+        (0..p.len())
+            .map(|k| (p[k] - c).cross(&(p[(k + 1) % p.len()] - c)))
+            .sum()
+    };
+    (0..before.num_faces().min(after.num_faces()))
+        .filter(|&f| !(newell(before, f).dot(&newell(after, f)) > 0.0))
+        .collect()
+}
+
 /// An orthonormal basis (e1, e2) of the plane with unit normal `n`, with (e1, e2, n)
 /// right-handed: e1 is x (or y, when n is near x) projected onto the plane. Where faces are
 /// flattened for exact 2D predicates.
@@ -270,5 +287,25 @@ mod tests {
         // A 1 m panel 1e7 m from the origin keeps the figure to the rounding of its coordinates.
         let got = at(1.0, Vec3::new(1e7, -3e6, 2e5));
         assert!((got / want - 1.0).abs() < 1e-7, "offset: {got} vs {want}");
+    }
+
+    #[test]
+    fn a_face_turned_over_is_flipped() {
+        let p = vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(2.0, 1.0, 0.0),
+        ];
+        let a = PolyMesh::new(p.clone(), [[0u32, 1, 2, 3], [1, 4, 5, 2]]).unwrap();
+        let mut q = p;
+        // The second quad folded over its shared edge: its far corners now lie at x = 0.
+        q[4].x = 0.5;
+        q[5].x = 0.5;
+        let b = PolyMesh::new(q, [[0u32, 1, 2, 3], [1, 4, 5, 2]]).unwrap();
+        assert_eq!(flipped_faces(&a, &b), vec![1]);
+        assert!(flipped_faces(&a, &a).is_empty());
     }
 }
