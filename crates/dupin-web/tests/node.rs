@@ -101,6 +101,10 @@ fn bad_session_configs_throw_readable_errors() {
             r#"{"scene":"sphere-radial","iterations":3}"#,
             "unknown field `iterations`",
         ),
+        // Sizes the page suggested made the worker run out of memory ("capacity overflow")
+        // or return 180k self-intersecting faces: refused at once by the face budget.
+        (r#"{"surface":"torus","size":0.0043}"#, "limit of 100000"),
+        (r#"{"surface":"sphere","size":0.001}"#, "limit of 100000"),
     ] {
         let err = match Session::new(js_sys::JSON::parse(json).unwrap()) {
             Err(e) => wasm_bindgen::JsValue::from(e),
