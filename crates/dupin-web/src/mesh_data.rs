@@ -159,8 +159,15 @@ impl MeshData {
     /// The mesh as OBJ text (the outside contract's format; panels keep their true size).
     #[wasm_bindgen(js_name = toObj)]
     pub fn to_obj(&self) -> Result<String, JsError> {
+        Ok(write_obj(&self.to_polymesh()?))
+    }
+}
+
+impl MeshData {
+    /// The mesh as polygons: the panels where the data carries them, else its triangles.
+    pub(crate) fn to_polymesh(&self) -> Result<PolyMesh, JsError> {
         if let Some(mesh) = &self.panels {
-            return Ok(write_obj(mesh));
+            return Ok(mesh.clone());
         }
         let positions = self
             .buffers
@@ -168,9 +175,7 @@ impl MeshData {
             .chunks_exact(3)
             .map(|p| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
             .collect();
-        let mesh = PolyMesh::new(positions, self.buffers.indices.chunks_exact(3))
-            .map_err(crate::js::err)?;
-        Ok(write_obj(&mesh))
+        PolyMesh::new(positions, self.buffers.indices.chunks_exact(3)).map_err(crate::js::err)
     }
 }
 

@@ -154,19 +154,7 @@ mod canvas {
         /// `{ panels, beams, offsetError }` and frames the camera on it.
         #[wasm_bindgen(js_name = setMesh)]
         pub fn set_mesh(&mut self, mesh: &MeshData, offset: bool) -> Result<JsValue, JsError> {
-            let poly = match &mesh.panels {
-                Some(p) => p.clone(),
-                None => {
-                    let pos = mesh
-                        .buffers
-                        .positions
-                        .chunks_exact(3)
-                        .map(|p| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
-                        .collect();
-                    PolyMesh::new(pos, mesh.buffers.indices.chunks_exact(3))
-                        .map_err(crate::js::err)?
-                }
-            };
+            let poly = mesh.to_polymesh()?;
             let scene = build_scene(&poly, offset);
             self.renderer
                 .set_scene(&self.device, &self.queue, &scene.glass, None, &scene.frames)
@@ -235,21 +223,15 @@ mod canvas {
 
         /// Draws one frame.
         pub fn render(&mut self) -> Result<(), JsError> {
-            let Some(frame) = crate::viewer::next_frame(&self.surface, &self.device, &self.config)?
-            else {
-                return Ok(());
-            };
-            let view = frame.texture.create_view(&Default::default());
-            self.renderer.render(
+            let (renderer, camera) = (&mut self.renderer, &self.camera);
+            let (w, h) = (self.config.width, self.config.height);
+            crate::viewer::draw_frame(
+                &self.surface,
                 &self.device,
                 &self.queue,
-                &view,
-                self.config.width,
-                self.config.height,
-                &self.camera,
-            );
-            self.queue.present(frame);
-            Ok(())
+                &self.config,
+                |d, q, view| renderer.render(d, q, view, w, h, camera),
+            )
         }
 
         /// Renders at `scale` x the canvas size (2 for the 2x PNG); resolves to an `ImageData`.

@@ -148,26 +148,39 @@ impl Viewer {
 
     /// Draws one frame.
     pub fn render(&mut self) -> Result<(), JsError> {
-        let Some(frame) = next_frame(&self.surface, &self.device, &self.config)? else {
-            return Ok(());
-        };
-        let view = frame.texture.create_view(&Default::default());
-        self.renderer.render(
+        let (renderer, camera) = (&mut self.renderer, &self.camera);
+        let (w, h) = (self.config.width, self.config.height);
+        draw_frame(
+            &self.surface,
             &self.device,
             &self.queue,
-            &view,
-            self.config.width,
-            self.config.height,
-            &self.camera,
-        );
-        self.queue.present(frame);
-        Ok(())
+            &self.config,
+            |d, q, view| renderer.render(d, q, view, w, h, camera),
+        )
     }
 }
 
 /// The canvas's next frame, or `None` when there is nothing to draw into this time (an outdated
 /// or lost surface is reconfigured; a timeout or an occluded canvas skips the frame).
-pub(crate) fn next_frame(
+/// Draws one frame into the canvas with `draw` and presents it (nothing when the surface has no
+/// frame to give, e.g. while it is being reconfigured).
+pub(crate) fn draw_frame(
+    surface: &wgpu::Surface<'static>,
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    config: &wgpu::SurfaceConfiguration,
+    draw: impl FnOnce(&wgpu::Device, &wgpu::Queue, &wgpu::TextureView),
+) -> Result<(), JsError> {
+    let Some(frame) = next_frame(surface, device, config)? else {
+        return Ok(());
+    };
+    let view = frame.texture.create_view(&Default::default());
+    draw(device, queue, &view);
+    queue.present(frame);
+    Ok(())
+}
+
+fn next_frame(
     surface: &wgpu::Surface<'static>,
     device: &wgpu::Device,
     config: &wgpu::SurfaceConfiguration,
