@@ -6,6 +6,7 @@
 //! for tests. The core never knows about this crate.
 
 mod camera;
+mod draw;
 mod error;
 mod gpu_mesh;
 mod mesh_renderer;
@@ -15,6 +16,7 @@ mod presentation;
 mod readback;
 
 pub use camera::OrbitCamera;
+pub use draw::Draw;
 pub use error::RenderError;
 pub use mesh_renderer::{BACKGROUND, MeshRenderer};
 #[cfg(not(target_arch = "wasm32"))]

@@ -3,7 +3,6 @@
 use crate::camera::OrbitCamera;
 use crate::error::RenderError;
 use crate::gpu_mesh::{self, DepthBuffer, GpuMesh, PipelineSpec, Vertex};
-use crate::readback::PendingSnapshot;
 use dupin_core::mesh::TriangleBuffers;
 
 /// Background colour of every view (linear RGB), also used by tests to count covered pixels.
@@ -142,23 +141,6 @@ impl MeshRenderer {
         self.lines = None;
     }
 
-    /// Renders the current view into an offscreen texture of this renderer's format and starts
-    /// copying it back. The same pipelines draw it, so it is exactly what the canvas shows, at
-    /// any resolution (a 2x screenshot, or a test's pixel check where the browser composites no
-    /// WebGPU canvas into its own screenshots).
-    pub fn begin_snapshot(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        width: u32,
-        height: u32,
-        camera: &OrbitCamera,
-    ) -> PendingSnapshot {
-        gpu_mesh::snapshot(device, queue, self.format, (width, height), |view, w, h| {
-            self.render(device, queue, view, w, h, camera)
-        })
-    }
-
     /// Draws the current mesh and lines seen by `camera` into `target` (of this renderer's
     /// format, `width` x `height` pixels), clearing it to [`BACKGROUND`] first.
     pub fn render(
@@ -223,5 +205,23 @@ pub(crate) fn background_for(format: wgpu::TextureFormat) -> wgpu::Color {
             b: g(BACKGROUND.b),
             a: 1.0,
         }
+    }
+}
+
+impl crate::Draw for MeshRenderer {
+    fn format(&self) -> wgpu::TextureFormat {
+        self.format
+    }
+
+    fn draw(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        target: &wgpu::TextureView,
+        width: u32,
+        height: u32,
+        camera: &OrbitCamera,
+    ) {
+        self.render(device, queue, target, width, height, camera);
     }
 }

@@ -1,6 +1,7 @@
 //! Native offscreen rendering to RGBA pixels (lavapipe/llvmpipe in CI, any GPU elsewhere).
 
 use crate::camera::OrbitCamera;
+use crate::draw::Draw;
 use crate::error::RenderError;
 use crate::mesh_renderer::MeshRenderer;
 use crate::presentation::{FrameInstances, PresentationRenderer};

@@ -13,7 +13,6 @@ use crate::camera::OrbitCamera;
 use crate::error::RenderError;
 use crate::gpu_mesh::{self, DEPTH_FORMAT, DepthBuffer, GpuMesh, PipelineSpec, Vertex};
 use crate::mesh_renderer::background_for;
-use crate::readback::PendingSnapshot;
 use dupin_core::mesh::TriangleBuffers;
 use glam::{Mat4, Vec3, camera::rh};
 
@@ -533,20 +532,23 @@ impl PresentationRenderer {
         }
         queue.submit([encoder.finish()]);
     }
+}
 
-    /// Renders the current view offscreen at `width` x `height` and starts reading it back
-    /// (the page's 2x PNG and the native tests), as [`crate::MeshRenderer::begin_snapshot`].
-    pub fn begin_snapshot(
+impl crate::Draw for PresentationRenderer {
+    fn format(&self) -> wgpu::TextureFormat {
+        self.format
+    }
+
+    fn draw(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
+        target: &wgpu::TextureView,
         width: u32,
         height: u32,
         camera: &OrbitCamera,
-    ) -> PendingSnapshot {
-        gpu_mesh::snapshot(device, queue, self.format, (width, height), |view, w, h| {
-            self.render(device, queue, view, w, h, camera)
-        })
+    ) {
+        self.render(device, queue, target, width, height, camera);
     }
 }
 

@@ -69,7 +69,7 @@ pub(crate) fn read_back(
 /// few hundred kilobytes, so a frame comes back in bands of rows.
 const READBACK_CHUNK: u32 = 64 * 1024;
 
-/// A rendered frame on its way back from the GPU (see [`crate::MeshRenderer::begin_snapshot`]).
+/// A rendered frame on its way back from the GPU (see [`crate::Draw::begin_snapshot`]).
 pub struct PendingSnapshot {
     /// Readback buffers with the first row each holds, top to bottom.
     bands: Vec<(wgpu::Buffer, u32)>,

@@ -98,7 +98,7 @@ pub use canvas::Presenter;
 #[cfg(target_arch = "wasm32")]
 mod canvas {
     use super::*;
-    use dupin_render::{OrbitCamera, PresentationRenderer, wgpu};
+    use dupin_render::{Draw, OrbitCamera, PresentationRenderer, wgpu};
 
     /// Presentation view on its own canvas (WebGPU, or WebGL2), with a damped orbit.
     #[wasm_bindgen]
@@ -208,12 +208,13 @@ mod canvas {
 
         /// Adapts to a new canvas size in device pixels.
         pub fn resize(&mut self, width: u32, height: u32) {
-            let (width, height) = (width.clamp(1, 8192), height.clamp(1, 8192));
-            if (width, height) != (self.config.width, self.config.height) {
-                self.config.width = width;
-                self.config.height = height;
-                self.surface.configure(&self.device, &self.config);
-            }
+            crate::viewer::resize_surface(
+                &self.surface,
+                &self.device,
+                &mut self.config,
+                width,
+                height,
+            );
         }
 
         /// Lets wgpu deliver finished work (snapshots on WebGL2); call every frame.

@@ -1,7 +1,7 @@
 //! A canvas viewer: wgpu surface + `dupin_render::MeshRenderer` + orbit camera.
 
 use crate::mesh_data::MeshData;
-use dupin_render::{MeshRenderer, OrbitCamera, wgpu};
+use dupin_render::{Draw, MeshRenderer, OrbitCamera, wgpu};
 use wasm_bindgen::prelude::*;
 
 /// Draws meshes into an HTML canvas with WebGPU, or WebGL2 where WebGPU is unavailable.
@@ -119,12 +119,7 @@ impl Viewer {
 
     /// Adapts to a new canvas size in device pixels.
     pub fn resize(&mut self, width: u32, height: u32) {
-        let (width, height) = (width.clamp(1, 8192), height.clamp(1, 8192));
-        if (width, height) != (self.config.width, self.config.height) {
-            self.config.width = width;
-            self.config.height = height;
-            self.surface.configure(&self.device, &self.config);
-        }
+        resize_surface(&self.surface, &self.device, &mut self.config, width, height);
     }
 
     /// Renders the current view at `scale` times the canvas size (e.g. 2 for a 2x PNG) and
@@ -162,6 +157,23 @@ impl Viewer {
 
 /// The canvas's next frame, or `None` when there is nothing to draw into this time (an outdated
 /// or lost surface is reconfigured; a timeout or an occluded canvas skips the frame).
+/// Reconfigures the canvas surface for a new size in device pixels (clamped to 1..=8192),
+/// when it changed.
+pub(crate) fn resize_surface(
+    surface: &wgpu::Surface<'static>,
+    device: &wgpu::Device,
+    config: &mut wgpu::SurfaceConfiguration,
+    width: u32,
+    height: u32,
+) {
+    let (width, height) = (width.clamp(1, 8192), height.clamp(1, 8192));
+    if (width, height) != (config.width, config.height) {
+        config.width = width;
+        config.height = height;
+        surface.configure(device, config);
+    }
+}
+
 /// Draws one frame into the canvas with `draw` and presents it (nothing when the surface has no
 /// frame to give, e.g. while it is being reconfigured).
 pub(crate) fn draw_frame(
