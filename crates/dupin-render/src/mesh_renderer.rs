@@ -140,10 +140,32 @@ impl MeshRenderer {
     pub fn clear_lines(&mut self) {
         self.lines = None;
     }
+}
+
+/// The clear colour in the target's encoding, so the background looks the same on sRGB and
+/// linear targets.
+pub(crate) fn background_for(format: wgpu::TextureFormat) -> wgpu::Color {
+    if format.is_srgb() {
+        BACKGROUND
+    } else {
+        let g = |c: f64| c.powf(1.0 / 2.2);
+        wgpu::Color {
+            r: g(BACKGROUND.r),
+            g: g(BACKGROUND.g),
+            b: g(BACKGROUND.b),
+            a: 1.0,
+        }
+    }
+}
+
+impl crate::Draw for MeshRenderer {
+    fn format(&self) -> wgpu::TextureFormat {
+        self.format
+    }
 
     /// Draws the current mesh and lines seen by `camera` into `target` (of this renderer's
     /// format, `width` x `height` pixels), clearing it to [`BACKGROUND`] first.
-    pub fn render(
+    fn draw(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -189,39 +211,5 @@ impl MeshRenderer {
             }
         }
         queue.submit([encoder.finish()]);
-    }
-}
-
-/// The clear colour in the target's encoding, so the background looks the same on sRGB and
-/// linear targets.
-pub(crate) fn background_for(format: wgpu::TextureFormat) -> wgpu::Color {
-    if format.is_srgb() {
-        BACKGROUND
-    } else {
-        let g = |c: f64| c.powf(1.0 / 2.2);
-        wgpu::Color {
-            r: g(BACKGROUND.r),
-            g: g(BACKGROUND.g),
-            b: g(BACKGROUND.b),
-            a: 1.0,
-        }
-    }
-}
-
-impl crate::Draw for MeshRenderer {
-    fn format(&self) -> wgpu::TextureFormat {
-        self.format
-    }
-
-    fn draw(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        target: &wgpu::TextureView,
-        width: u32,
-        height: u32,
-        camera: &OrbitCamera,
-    ) {
-        self.render(device, queue, target, width, height, camera);
     }
 }

@@ -207,7 +207,7 @@ impl PresentationOffscreen {
         }
         let view = &self.target.as_ref().expect("created above").0;
         self.renderer
-            .render(&self.device, &self.queue, view, width, height, camera);
+            .draw(&self.device, &self.queue, view, width, height, camera);
     }
 
     /// Blocks until the GPU has finished everything submitted.

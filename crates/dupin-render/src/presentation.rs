@@ -458,12 +458,18 @@ impl PresentationRenderer {
     pub fn bounds(&self) -> (Vec3, f32) {
         self.bounds
     }
+}
+
+impl crate::Draw for PresentationRenderer {
+    fn format(&self) -> wgpu::TextureFormat {
+        self.format
+    }
 
     /// Draws the scene seen by `camera` into `target` (`width` x `height`, this renderer's
     /// format): the sun's shadow pass when the scene or the shadow setting changed since the
     /// last frame, then frames, ground, and glass blended on top: 3 draw calls (with a shadow
     /// pass: 4).
-    pub fn render(
+    fn draw(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -531,24 +537,6 @@ impl PresentationRenderer {
             }
         }
         queue.submit([encoder.finish()]);
-    }
-}
-
-impl crate::Draw for PresentationRenderer {
-    fn format(&self) -> wgpu::TextureFormat {
-        self.format
-    }
-
-    fn draw(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        target: &wgpu::TextureView,
-        width: u32,
-        height: u32,
-        camera: &OrbitCamera,
-    ) {
-        self.render(device, queue, target, width, height, camera);
     }
 }
 

@@ -231,7 +231,7 @@ mod canvas {
                 &self.device,
                 &self.queue,
                 &self.config,
-                |d, q, view| renderer.render(d, q, view, w, h, camera),
+                |d, q, view| renderer.draw(d, q, view, w, h, camera),
             )
         }
 

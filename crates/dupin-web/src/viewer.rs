@@ -150,7 +150,7 @@ impl Viewer {
             &self.device,
             &self.queue,
             &self.config,
-            |d, q, view| renderer.render(d, q, view, w, h, camera),
+            |d, q, view| renderer.draw(d, q, view, w, h, camera),
         )
     }
 }
