@@ -810,6 +810,17 @@ impl PlanarityOptimiser {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The surface's closest point and unit normal for every point of `x` (the distance
+    /// term's foot points).
+    fn foot_points(surface: &dyn Surface, x: &[Vec3]) -> Vec<(Vec3, Vec3)> {
+        x.iter()
+            .map(|p| {
+                let cp = surface.closest_point(p, None).unwrap();
+                (cp.point, surface.normal(cp.uv.x, cp.uv.y))
+            })
+            .collect()
+    }
     use crate::phex::phex_run;
     use crate::scenes::phex_scene;
     use rand::{RngExt, SeedableRng};
@@ -908,13 +919,7 @@ mod tests {
         let surface = crate::surface::surface_by_name(&scene.config.surface, &[]).unwrap();
         let mut opt = PlanarityOptimiser::new(&mesh, None, PlanarityOptions::default()).unwrap();
         let x = mesh.positions.clone();
-        let feet: Vec<(Vec3, Vec3)> = x
-            .iter()
-            .map(|p| {
-                let cp = surface.closest_point(p, None).unwrap();
-                (cp.point, surface.normal(cp.uv.x, cp.uv.y))
-            })
-            .collect();
+        let feet = foot_points(surface.as_ref(), &x);
         let (g, cost) = opt.assemble(&mesh, &x, &feet);
         assert!((cost - opt.cost(&mesh, &x, &feet)).abs() <= 1e-12 * cost.max(1e-300));
         let hv = |d: &[f64]| symmetric_product(&opt, d);
@@ -988,13 +993,7 @@ mod tests {
         let surface = crate::surface::surface_by_name(&scene.config.surface, &[]).unwrap();
         let mut opt = PlanarityOptimiser::new(&mesh, None, PlanarityOptions::default()).unwrap();
         let x = mesh.positions.clone();
-        let feet: Vec<(Vec3, Vec3)> = x
-            .iter()
-            .map(|p| {
-                let cp = surface.closest_point(p, None).unwrap();
-                (cp.point, surface.normal(cp.uv.x, cp.uv.y))
-            })
-            .collect();
+        let feet = foot_points(surface.as_ref(), &x);
         let (g, _) = opt.assemble(&mesh, &x, &feet);
         let delta = 1e-8
             * (0..g.len())
