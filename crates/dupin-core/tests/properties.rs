@@ -22,13 +22,7 @@ fn quad_grid(nx: usize, ny: usize, jitter: &[(f64, f64, f64)]) -> PolyMesh {
             p.push(Vec3::new(i as f64 + dx, j as f64 + dy, z));
         }
     }
-    let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
-    let faces: Vec<[u32; 4]> = (0..ny)
-        .flat_map(|j| {
-            (0..nx).map(move |i| [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)])
-        })
-        .collect();
-    PolyMesh::new(p, faces).expect("grid indices are valid")
+    PolyMesh::quad_grid(p, nx, ny).expect("grid indices are valid")
 }
 
 /// Grid size and one jitter triple per vertex.

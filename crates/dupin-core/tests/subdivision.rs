@@ -20,11 +20,7 @@ fn grid(n: usize, lift: impl Fn(f64, f64) -> f64) -> PolyMesh {
             p.push(Vec3::new(x, y, lift(x, y)));
         }
     }
-    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-    let f: Vec<[u32; 4]> = (0..n)
-        .flat_map(|j| (0..n).map(move |i| [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]))
-        .collect();
-    PolyMesh::new(p, f).unwrap()
+    PolyMesh::quad_grid(p, n, n).unwrap()
 }
 
 #[test]

@@ -27,13 +27,7 @@ pub fn principal_quad_mesh(
             p.push(surface.position(u, v));
         }
     }
-    let id = |i: usize, j: usize| (j * (nu + 1) + i) as u32;
-    let faces: Vec<[u32; 4]> = (0..nv)
-        .flat_map(|j| {
-            (0..nu).map(move |i| [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)])
-        })
-        .collect();
-    PolyMesh::new(p, faces).expect("grid indices are valid")
+    PolyMesh::quad_grid(p, nu, nv).expect("grid indices are valid")
 }
 
 #[cfg(test)]

@@ -101,6 +101,19 @@ impl PolyMesh {
         Ok(mesh)
     }
 
+    /// The `nu` x `nv` quad grid over `positions` in row order (vertex (i, j) at
+    /// `j * (nu + 1) + i`, so `(nu + 1) * (nv + 1)` of them), quads (i, j), (i + 1, j),
+    /// (i + 1, j + 1), (i, j + 1): counter-clockwise where (i, j) is right-handed.
+    pub fn quad_grid(positions: Vec<Vec3>, nu: usize, nv: usize) -> Result<Self, MeshError> {
+        let id = |i: usize, j: usize| (j * (nu + 1) + i) as u32;
+        let faces: Vec<[u32; 4]> = (0..nv)
+            .flat_map(|j| {
+                (0..nu).map(move |i| [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)])
+            })
+            .collect();
+        PolyMesh::new(positions, faces)
+    }
+
     /// Number of vertices.
     pub fn num_vertices(&self) -> usize {
         self.positions.len()

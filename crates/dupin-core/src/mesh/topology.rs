@@ -311,14 +311,7 @@ mod tests {
                 p.push(Vec3::new(i as f64, j as f64, 0.0));
             }
         }
-        let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-        let mut f = Vec::new();
-        for j in 0..n {
-            for i in 0..n {
-                f.push([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
-            }
-        }
-        PolyMesh::new(p, f).unwrap()
+        PolyMesh::quad_grid(p, n, n).unwrap()
     }
 
     #[test]

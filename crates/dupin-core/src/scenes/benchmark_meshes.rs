@@ -23,11 +23,7 @@ pub fn skew_quad_grid(n: usize, rotation_deg: f64) -> PolyMesh {
             p.push(Vec3::new(x, y, x * y));
         }
     }
-    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-    let faces: Vec<[u32; 4]> = (0..n)
-        .flat_map(|j| (0..n).map(move |i| [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]))
-        .collect();
-    PolyMesh::new(p, faces).expect("grid indices are valid")
+    PolyMesh::quad_grid(p, n, n).expect("grid indices are valid")
 }
 
 /// The `nu x nv` quad mesh of a torus's parameter lines (R = `major`, r = `minor`; its

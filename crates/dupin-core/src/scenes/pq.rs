@@ -54,13 +54,7 @@ pub fn pq_scene_spec(name: &str) -> Result<PqSceneSpec, PqSceneError> {
                     ));
                 }
             }
-            let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-            let faces: Vec<[u32; 4]> = (0..n)
-                .flat_map(|j| {
-                    (0..n).map(move |i| [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)])
-                })
-                .collect();
-            let control = PolyMesh::new(p, faces).expect("valid grid");
+            let control = PolyMesh::quad_grid(p, n, n).expect("valid grid");
             Ok(PqSceneSpec::Mesh {
                 control,
                 levels: 2,
