@@ -6,7 +6,11 @@ use thiserror::Error;
 
 /// A name that is none of a choice's names.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
-#[error("{what} must be {}, not `{given}`", one_of(expected))]
+#[error(
+    "{what} must be {}, not {}",
+    one_of(expected),
+    crate::mesh::io::quoted(given)
+)]
 pub struct UnknownName {
     /// What was being named (`method`, `init`, `mode`).
     pub what: &'static str,
