@@ -48,7 +48,7 @@ pub fn run(args: PqArgs) -> Result<(), CliError> {
         "scene": name,
         "vertices": r.mesh.num_vertices(),
         "faces": r.mesh.num_faces(),
-        "max_planarity": r.max_planarity,
+        "max_planarity": r.measures.max_planarity,
         "levels": r.levels,
         "iterations": r.iterations,
         "converged": r.converged,
@@ -57,26 +57,26 @@ pub fn run(args: PqArgs) -> Result<(), CliError> {
     if !r.converged {
         report["reason"] = json!(format!(
             "a perturbation level did not reach the tolerance (max_planarity {:.3e})",
-            r.max_planarity
+            r.measures.max_planarity
         ));
     }
-    if let Some(c) = r.conical_residual {
+    if let Some(c) = r.measures.conical_residual {
         report["conical_residual"] = json!(c);
     }
-    if let Some(c) = r.circular_residual {
+    if let Some(c) = r.measures.circular_residual {
         report["circular_residual"] = json!(c);
     }
-    if let Some(d) = r.max_determinant {
+    if let Some(d) = r.measures.max_determinant {
         report["max_determinant"] = json!(d);
     }
-    if let Some(k) = r.singular_points_inside {
+    if let Some(k) = r.measures.singular_points_inside {
         report["singular_points_inside"] = json!(k);
     }
     write_report(args.report.as_deref(), &report)?;
     println!(
         "pq {name}: {} faces, max_planarity {:.3e}, {} levels, {} iterations, {:.3} s{}",
         r.mesh.num_faces(),
-        r.max_planarity,
+        r.measures.max_planarity,
         r.levels,
         r.iterations,
         seconds,
@@ -87,7 +87,7 @@ pub fn run(args: PqArgs) -> Result<(), CliError> {
     } else {
         Err(CliError::Unmet(format!(
             "scene {name} did not converge: max_planarity {:.3e} after {} iterations",
-            r.max_planarity, r.iterations
+            r.measures.max_planarity, r.iterations
         )))
     }
 }

@@ -19,17 +19,11 @@ fn arr(v: &serde_json::Value) -> [f64; 3] {
 
 #[test]
 fn torus_matches_the_contract_parametrisation_and_closed_forms() {
-    let (code, out, err) = dupin(&[
+    let (code, out, err) = dupin(&command_line(
         "surface-info",
-        "--surface",
-        "torus",
-        "--set",
-        "R=3",
-        "--set",
-        "r=1",
-        "--at",
-        "0.5,0.4",
-    ]);
+        "--surface torus --set R=3 --set r=1 --at 0.5,0.4",
+        "",
+    ));
     assert_eq!(code, 0, "{err}");
     assert_eq!(out.lines().count(), 1, "one line on stdout");
     let j = json(&out);

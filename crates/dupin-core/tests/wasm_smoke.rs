@@ -57,18 +57,7 @@ fn propositions_4_and_5_conditions_agree() {
                 continue;
             };
             n += 1;
-            let c1 = star.is_valid(&ind).unwrap();
-            let (c2, c3) = if sign > 0.0 {
-                (
-                    star.dupin_center_inside(&ind).unwrap(),
-                    star.edges_not_enclosed_by_conjugate_pair(&ind).unwrap(),
-                )
-            } else {
-                (
-                    star.vertices_on_different_branches(&ind).unwrap(),
-                    star.edges_not_in_one_asymptotic_range(&ind).unwrap(),
-                )
-            };
+            let [c1, c2, c3] = star.validity_conditions(&ind).unwrap();
             assert!(c1 == c2 && c1 == c3);
         }
     }

@@ -16,7 +16,7 @@ mod presentation;
 mod readback;
 
 pub use camera::OrbitCamera;
-pub use draw::Draw;
+pub use draw::{Draw, Frame};
 pub use error::RenderError;
 pub use mesh_renderer::{BACKGROUND, MeshRenderer};
 #[cfg(not(target_arch = "wasm32"))]

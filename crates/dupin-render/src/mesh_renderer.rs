@@ -1,6 +1,7 @@
 //! The mesh renderer: one lit triangle pipeline, one flat line pipeline, a depth buffer.
 
 use crate::camera::OrbitCamera;
+use crate::draw::{Draw, Frame};
 use crate::error::RenderError;
 use crate::gpu_mesh::{self, DepthBuffer, GpuMesh, PipelineSpec, Vertex};
 use dupin_core::mesh::TriangleBuffers;
@@ -158,24 +159,17 @@ pub(crate) fn background_for(format: wgpu::TextureFormat) -> wgpu::Color {
     }
 }
 
-impl crate::Draw for MeshRenderer {
+impl Draw for MeshRenderer {
     fn format(&self) -> wgpu::TextureFormat {
         self.format
     }
 
-    /// Draws the current mesh and lines seen by `camera` into `target` (of this renderer's
-    /// format, `width` x `height` pixels), clearing it to [`BACKGROUND`] first.
-    fn draw(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        target: &wgpu::TextureView,
-        width: u32,
-        height: u32,
-        camera: &OrbitCamera,
-    ) {
-        let (width, height) = (width.max(1), height.max(1));
-        let view_proj = camera.view_proj(width as f32 / height as f32);
+    /// Draws the current mesh and lines seen by `camera`, clearing the target to
+    /// [`BACKGROUND`] first.
+    fn draw(&mut self, frame: &Frame<'_>, camera: &OrbitCamera) {
+        let (device, queue, target) = (frame.device, frame.queue, frame.target);
+        let (width, height) = frame.size();
+        let view_proj = camera.view_proj(frame.aspect());
         let eye = camera.eye();
         // Key light from above-right of the viewer, in world space.
         let fwd = (camera.target - eye).normalize_or_zero();

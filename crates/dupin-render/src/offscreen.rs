@@ -1,7 +1,7 @@
 //! Native offscreen rendering to RGBA pixels (lavapipe/llvmpipe in CI, any GPU elsewhere).
 
 use crate::camera::OrbitCamera;
-use crate::draw::Draw;
+use crate::draw::{Draw, Frame};
 use crate::error::RenderError;
 use crate::mesh_renderer::MeshRenderer;
 use crate::presentation::{FrameInstances, PresentationRenderer};
@@ -32,30 +32,17 @@ pub fn render_offscreen(
     width: u32,
     height: u32,
 ) -> Result<OffscreenImage, RenderError> {
-    pollster::block_on(render_async(
-        mesh,
-        lines,
-        camera,
-        width.max(1),
-        height.max(1),
-    ))
-}
-
-async fn render_async(
-    mesh: &TriangleBuffers,
-    lines: Option<&[f32]>,
-    camera: &OrbitCamera,
-    width: u32,
-    height: u32,
-) -> Result<OffscreenImage, RenderError> {
-    let (adapter, device, queue) = gpu().await?;
-    let mut renderer = MeshRenderer::new(&device, wgpu::TextureFormat::Rgba8UnormSrgb);
-    renderer.set_mesh(&device, &queue, mesh, None)?;
-    if let Some(l) = lines {
-        renderer.set_lines(&device, &queue, l, [0.05, 0.05, 0.06]);
-    }
-    let pending = renderer.begin_snapshot(&device, &queue, width, height, camera);
-    finish(&adapter, &device, pending)
+    let (width, height) = (width.max(1), height.max(1));
+    pollster::block_on(async {
+        let (adapter, device, queue) = gpu().await?;
+        let mut renderer = MeshRenderer::new(&device, wgpu::TextureFormat::Rgba8UnormSrgb);
+        renderer.set_mesh(&device, &queue, mesh, None)?;
+        if let Some(l) = lines {
+            renderer.set_lines(&device, &queue, l, [0.05, 0.05, 0.06]);
+        }
+        let pending = renderer.begin_snapshot(&device, &queue, (width, height), camera);
+        finish(&adapter, &device, pending)
+    })
 }
 
 /// Waits for `pending` to come back from the GPU.
@@ -206,8 +193,14 @@ impl PresentationOffscreen {
             self.target = Some((tex.create_view(&Default::default()), width, height));
         }
         let view = &self.target.as_ref().expect("created above").0;
-        self.renderer
-            .draw(&self.device, &self.queue, view, width, height, camera);
+        let frame = Frame {
+            device: &self.device,
+            queue: &self.queue,
+            target: view,
+            width,
+            height,
+        };
+        self.renderer.draw(&frame, camera);
     }
 
     /// Blocks until the GPU has finished everything submitted.
@@ -230,8 +223,7 @@ impl PresentationOffscreen {
         let pending = self.renderer.begin_snapshot(
             &self.device,
             &self.queue,
-            width.max(1),
-            height.max(1),
+            (width.max(1), height.max(1)),
             camera,
         );
         finish(&self.adapter, &self.device, pending)

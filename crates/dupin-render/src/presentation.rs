@@ -10,6 +10,7 @@
 //! [`PresentationRenderer::set_shadows`] changed something and reused by every orbit frame.
 
 use crate::camera::OrbitCamera;
+use crate::draw::{Draw, Frame};
 use crate::error::RenderError;
 use crate::gpu_mesh::{self, DEPTH_FORMAT, DepthBuffer, GpuMesh, PipelineSpec, Vertex};
 use crate::mesh_renderer::background_for;
@@ -460,31 +461,21 @@ impl PresentationRenderer {
     }
 }
 
-impl crate::Draw for PresentationRenderer {
+impl Draw for PresentationRenderer {
     fn format(&self) -> wgpu::TextureFormat {
         self.format
     }
 
-    /// Draws the scene seen by `camera` into `target` (`width` x `height`, this renderer's
-    /// format): the sun's shadow pass when the scene or the shadow setting changed since the
-    /// last frame, then frames, ground, and glass blended on top: 3 draw calls (with a shadow
-    /// pass: 4).
-    fn draw(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        target: &wgpu::TextureView,
-        width: u32,
-        height: u32,
-        camera: &OrbitCamera,
-    ) {
-        let (width, height) = (width.max(1), height.max(1));
+    /// Draws the scene seen by `camera`: the sun's shadow pass when the scene or the shadow
+    /// setting changed since the last frame, then frames, ground, and glass blended on top: 3
+    /// draw calls (with a shadow pass: 4).
+    fn draw(&mut self, frame: &Frame<'_>, camera: &OrbitCamera) {
+        let (device, queue, target) = (frame.device, frame.queue, frame.target);
+        let (width, height) = frame.size();
         let radius = self.bounds.1;
         let gamma = if self.format.is_srgb() { 0.0 } else { 1.0 };
         let u = Uniforms {
-            view_proj: camera
-                .view_proj(width as f32 / height as f32)
-                .to_cols_array_2d(),
+            view_proj: camera.view_proj(frame.aspect()).to_cols_array_2d(),
             light_view_proj: self.light_view_proj.to_cols_array_2d(),
             eye: camera.eye().extend(1.0).to_array(),
             sun: sun_direction().extend(0.0).to_array(),

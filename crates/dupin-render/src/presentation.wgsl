@@ -19,12 +19,7 @@ struct Uniforms {
 
 @vertex
 fn vs_main(v: VsIn) -> VsOut {
-    var o: VsOut;
-    o.clip = u.view_proj * vec4<f32>(v.pos, 1.0);
-    o.world = v.pos;
-    o.normal = v.normal;
-    o.color = v.color;
-    return o;
+    return project(v, u.view_proj, v.color);
 }
 
 @vertex

@@ -14,12 +14,7 @@ struct Uniforms {
 
 @vertex
 fn vs_main(v: VsIn) -> VsOut {
-    var o: VsOut;
-    o.clip = u.view_proj * vec4<f32>(v.pos, 1.0);
-    o.world = v.pos;
-    o.normal = v.normal;
-    o.color = mix(u.base_color.rgb, v.color, u.flags.y);
-    return o;
+    return project(v, u.view_proj, mix(u.base_color.rgb, v.color, u.flags.y));
 }
 
 fn encode(c: vec3<f32>) -> vec4<f32> {

@@ -1,5 +1,5 @@
-// Shared by every Dupin shader (prepended by `gpu_mesh::shader`): the vertex interface, the
-// two-sided normal and the gamma encoding for non-sRGB targets.
+// Shared by every Dupin shader (prepended by `gpu_mesh::shader`): the vertex interface and
+// projection, the two-sided normal and the gamma encoding for non-sRGB targets.
 
 struct VsIn {
     @location(0) pos: vec3<f32>,
@@ -13,6 +13,16 @@ struct VsOut {
     @location(1) normal: vec3<f32>,
     @location(2) color: vec3<f32>,
 };
+
+// A vertex projected by `view_proj`, with its world position and normal, coloured `color`.
+fn project(v: VsIn, view_proj: mat4x4<f32>, color: vec3<f32>) -> VsOut {
+    var o: VsOut;
+    o.clip = view_proj * vec4<f32>(v.pos, 1.0);
+    o.world = v.pos;
+    o.normal = v.normal;
+    o.color = color;
+    return o;
+}
 
 // The unit normal of the side facing the viewer at `eye`, whatever the winding.
 fn facing_normal(i: VsOut, eye: vec3<f32>) -> vec3<f32> {

@@ -98,20 +98,15 @@ pub use canvas::Presenter;
 #[cfg(target_arch = "wasm32")]
 mod canvas {
     use super::*;
-    use dupin_render::{Draw, OrbitCamera, PresentationRenderer, wgpu};
+    use crate::viewer::Canvas;
+    use dupin_render::{OrbitCamera, PresentationRenderer};
 
     /// Presentation view on its own canvas (WebGPU, or WebGL2), with a damped orbit.
     #[wasm_bindgen]
     pub struct Presenter {
-        surface: wgpu::Surface<'static>,
-        device: wgpu::Device,
-        queue: wgpu::Queue,
-        config: wgpu::SurfaceConfiguration,
-        renderer: PresentationRenderer,
-        camera: OrbitCamera,
+        canvas: Canvas<PresentationRenderer>,
         /// Angular velocity (yaw, pitch), radians per second, decaying with `DAMPING`.
         velocity: (f32, f32),
-        backend: &'static str,
     }
 
     /// Velocity half-life of the orbit after a drag, seconds.
@@ -124,30 +119,23 @@ mod canvas {
             canvas: web_sys::HtmlCanvasElement,
             force_webgl2: bool,
         ) -> Result<Presenter, JsError> {
-            let crate::viewer::CanvasGpu {
-                surface,
-                device,
-                queue,
-                config,
-                backend,
-            } = crate::viewer::CanvasGpu::open(canvas, force_webgl2, "dupin presentation").await?;
-            let renderer = PresentationRenderer::new(&device, config.format);
+            let canvas = Canvas::open(
+                canvas,
+                force_webgl2,
+                "dupin presentation",
+                PresentationRenderer::new,
+            )
+            .await?;
             Ok(Presenter {
-                surface,
-                device,
-                queue,
-                config,
-                renderer,
-                camera: OrbitCamera::framing(glam::Vec3::ZERO, 1.0),
+                canvas,
                 velocity: (0.0, 0.0),
-                backend,
             })
         }
 
         /// `"WebGPU"` or `"WebGL2"`.
         #[wasm_bindgen(getter)]
         pub fn backend(&self) -> String {
-            self.backend.to_string()
+            self.canvas.backend.to_string()
         }
 
         /// Shows `mesh` as glass and frames (with `offset`, also its offset layer); returns
@@ -156,11 +144,19 @@ mod canvas {
         pub fn set_mesh(&mut self, mesh: &MeshData, offset: bool) -> Result<JsValue, JsError> {
             let poly = mesh.to_polymesh()?;
             let scene = build_scene(&poly, offset);
-            self.renderer
-                .set_scene(&self.device, &self.queue, &scene.glass, None, &scene.frames)
+            let canvas = &mut self.canvas;
+            canvas
+                .renderer
+                .set_scene(
+                    &canvas.device,
+                    &canvas.queue,
+                    &scene.glass,
+                    None,
+                    &scene.frames,
+                )
                 .map_err(crate::js::err)?;
-            let (c, r) = self.renderer.bounds();
-            self.camera = OrbitCamera::framing(c, r);
+            let (c, r) = canvas.renderer.bounds();
+            canvas.camera = OrbitCamera::framing(c, r);
             let info = js_sys::Object::new();
             let set = |k: &str, v: JsValue| js_sys::Reflect::set(&info, &k.into(), &v);
             let _ = set("panels", (scene.panels as f64).into());
@@ -177,7 +173,7 @@ mod canvas {
             if !(dx.is_finite() && dy.is_finite()) {
                 return;
             }
-            self.camera.orbit(dx, dy);
+            self.canvas.camera.orbit(dx, dy);
             let dt = (dt_ms / 1000.0).max(1.0 / 240.0);
             self.velocity = (dx / dt, dy / dt);
         }
@@ -190,7 +186,7 @@ mod canvas {
                 self.velocity = (0.0, 0.0);
                 return false;
             }
-            self.camera.orbit(vx * dt, vy * dt);
+            self.canvas.camera.orbit(vx * dt, vy * dt);
             let decay = 0.5f32.powf(dt / HALF_LIFE);
             self.velocity = (vx * decay, vy * decay);
             true
@@ -203,47 +199,27 @@ mod canvas {
 
         /// Moves the camera closer (`factor` < 1) or farther.
         pub fn zoom(&mut self, factor: f32) {
-            self.camera.zoom(factor);
+            self.canvas.camera.zoom(factor);
         }
 
         /// Adapts to a new canvas size in device pixels.
         pub fn resize(&mut self, width: u32, height: u32) {
-            crate::viewer::resize_surface(
-                &self.surface,
-                &self.device,
-                &mut self.config,
-                width,
-                height,
-            );
+            self.canvas.resize(width, height);
         }
 
         /// Lets wgpu deliver finished work (snapshots on WebGL2); call every frame.
         pub fn poll(&self) {
-            let _ = self.device.poll(wgpu::PollType::Poll);
+            self.canvas.poll();
         }
 
         /// Draws one frame.
         pub fn render(&mut self) -> Result<(), JsError> {
-            let (renderer, camera) = (&mut self.renderer, &self.camera);
-            let (w, h) = (self.config.width, self.config.height);
-            crate::viewer::draw_frame(
-                &self.surface,
-                &self.device,
-                &self.queue,
-                &self.config,
-                |d, q, view| renderer.draw(d, q, view, w, h, camera),
-            )
+            self.canvas.render()
         }
 
         /// Renders at `scale` x the canvas size (2 for the 2x PNG); resolves to an `ImageData`.
         pub fn snapshot(&mut self, scale: f32) -> Result<js_sys::Promise, JsError> {
-            let (w, h) = crate::viewer::snapshot_size(&self.config, scale)?;
-            let pending =
-                self.renderer
-                    .begin_snapshot(&self.device, &self.queue, w, h, &self.camera);
-            let promise = crate::viewer::image_data_promise(pending);
-            self.poll();
-            Ok(promise)
+            self.canvas.snapshot(scale)
         }
     }
 }

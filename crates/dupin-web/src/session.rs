@@ -3,7 +3,9 @@
 use crate::js::{err, to_js};
 use crate::mesh_data::MeshData;
 use dupin_core::Stepper;
-use dupin_core::conical::{PqMode, PqSceneStepInfo, PqSceneStepper, support_structure};
+use dupin_core::conical::{
+    PqMode, PqSceneMeasures, PqSceneStepInfo, PqSceneStepper, support_structure,
+};
 use dupin_core::fabrication::{SheetOptions, panel_schedule, panel_schedule_svg};
 use dupin_core::mesh::{
     ColorMode, NOT_HEX, PLANARITY_HIST_HI, PLANARITY_HIST_LO, PLANARITY_LEGEND_LOG10, PolyMesh,
@@ -745,11 +747,14 @@ impl Session {
                     levels,
                     phase,
                     iteration,
-                    max_planarity,
-                    conical_residual,
-                    circular_residual,
-                    max_determinant,
-                    singular_points_inside,
+                    measures:
+                        PqSceneMeasures {
+                            max_planarity,
+                            conical_residual,
+                            circular_residual,
+                            max_determinant,
+                            singular_points_inside,
+                        },
                     ..
                 } = stepper.metrics();
                 Metrics {

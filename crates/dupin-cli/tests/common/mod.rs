@@ -51,6 +51,27 @@ pub fn json(p: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
 }
 
+/// The scene names docs/cli.md gives in `dupin COMMAND`'s section: the backquoted words of
+/// its `Scenes:` sentence. The outside contract's names are written there, so a test comparing
+/// them with `--list-scenes` keeps the code, the docs and the contract in step.
+pub fn documented_scenes(command: &str) -> Vec<String> {
+    let doc = include_str!("../../../../docs/cli.md");
+    let heading = format!("## `dupin {command}`");
+    let section = doc.split(&heading).nth(1).expect("the command's section");
+    let section = section.split("\n## ").next().unwrap();
+    let sentence = section
+        .split("Scenes: ")
+        .nth(1)
+        .expect("a Scenes: sentence");
+    let sentence = sentence.split(". ").next().unwrap();
+    sentence
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .map(String::from)
+        .collect()
+}
+
 /// The names `dupin COMMAND --list-scenes` prints, one a line (asserting that it succeeds).
 pub fn listed_scenes(command: &str) -> Vec<String> {
     let o = dupin_ok(&[command, "--list-scenes"]);

@@ -41,7 +41,7 @@ pub use perturbation::{
 };
 pub use principal_quads::principal_quad_mesh;
 pub use refinement::{
-    MeshRule, PqSceneError, PqScenePhase, PqSceneResult, PqSceneSpec, PqSceneStepInfo,
-    PqSceneStepper,
+    MeshRule, PqSceneError, PqSceneMeasures, PqScenePhase, PqSceneResult, PqSceneSpec,
+    PqSceneStepInfo, PqSceneStepper,
 };
 pub use support::support_structure;

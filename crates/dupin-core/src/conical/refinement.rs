@@ -42,6 +42,14 @@ pub struct PqSceneResult {
     pub iterations: usize,
     /// Whether every perturbation converged.
     pub converged: bool,
+    /// The measures of the final mesh.
+    pub measures: PqSceneMeasures,
+}
+
+/// What a PQ scene measures on a mesh: planarity always, and the residual of its mode or the
+/// strip figures where they apply.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PqSceneMeasures {
     /// Contract `max_planarity`.
     pub max_planarity: f64,
     /// `conical_residual` (conical scenes).
@@ -139,16 +147,8 @@ pub struct PqSceneStepInfo {
     pub iteration: usize,
     /// Faces of the current mesh.
     pub faces: usize,
-    /// Contract `max_planarity` of the current mesh.
-    pub max_planarity: f64,
-    /// `conical_residual` (conical scenes).
-    pub conical_residual: Option<f64>,
-    /// `circular_residual` (circular scenes).
-    pub circular_residual: Option<f64>,
-    /// Largest determinant term (strip scenes).
-    pub max_determinant: Option<f64>,
-    /// Quads whose singular-curve point lies on the strip (strip scenes).
-    pub singular_points_inside: Option<usize>,
+    /// The measures of the current mesh.
+    pub measures: PqSceneMeasures,
 }
 
 /// The refinement a stepper applies.
@@ -394,29 +394,27 @@ impl Stepper for PqSceneStepper {
             perturbation_phase: self.perturbation.as_ref().map(|p| p.phase()),
             iteration: self.iteration(),
             faces: self.mesh.num_faces(),
-            max_planarity: max_planarity(&self.mesh),
-            conical_residual: conical,
-            circular_residual: (self.options.mode == PqMode::Circular)
-                .then(|| circular_residual(&self.mesh)),
-            max_determinant: strip.map(|s| s.max_determinant()),
-            singular_points_inside: strip.map(singular_points_inside),
+            measures: PqSceneMeasures {
+                max_planarity: max_planarity(&self.mesh),
+                conical_residual: conical,
+                circular_residual: (self.options.mode == PqMode::Circular)
+                    .then(|| circular_residual(&self.mesh)),
+                max_determinant: strip.map(|s| s.max_determinant()),
+                singular_points_inside: strip.map(singular_points_inside),
+            },
         }
     }
 
     /// Runs to the end and returns the scene's result.
     fn finish(mut self) -> Result<PqSceneResult, PqSceneError> {
         self.run_to_end()?;
-        let i = self.metrics();
+        let measures = self.metrics().measures;
         Ok(PqSceneResult {
             mesh: self.mesh,
             levels: self.levels,
             iterations: self.done_iterations,
             converged: self.converged,
-            max_planarity: i.max_planarity,
-            conical_residual: i.conical_residual,
-            circular_residual: i.circular_residual,
-            max_determinant: i.max_determinant,
-            singular_points_inside: i.singular_points_inside,
+            measures,
         })
     }
 }
@@ -467,17 +465,19 @@ mod tests {
         }
         let topo = MeshTopology::new(&r.mesh)?;
         Ok(PqSceneResult {
-            max_planarity: max_planarity(&r.mesh),
-            conical_residual: (options.mode == PqMode::Conical)
-                .then(|| conical_residual(&r.mesh, &topo)),
-            circular_residual: (options.mode == PqMode::Circular)
-                .then(|| circular_residual(&r.mesh)),
+            measures: PqSceneMeasures {
+                max_planarity: max_planarity(&r.mesh),
+                conical_residual: (options.mode == PqMode::Conical)
+                    .then(|| conical_residual(&r.mesh, &topo)),
+                circular_residual: (options.mode == PqMode::Circular)
+                    .then(|| circular_residual(&r.mesh)),
+                max_determinant: None,
+                singular_points_inside: None,
+            },
             mesh: r.mesh,
             levels,
             iterations,
             converged,
-            max_determinant: None,
-            singular_points_inside: None,
         })
     }
 
@@ -486,11 +486,13 @@ mod tests {
         let mesh = last.to_mesh();
         let inside = singular_points_inside(last);
         PqSceneResult {
-            max_planarity: max_planarity(&mesh),
-            conical_residual: None,
-            circular_residual: None,
-            max_determinant: Some(last.max_determinant()),
-            singular_points_inside: Some(inside),
+            measures: PqSceneMeasures {
+                max_planarity: max_planarity(&mesh),
+                conical_residual: None,
+                circular_residual: None,
+                max_determinant: Some(last.max_determinant()),
+                singular_points_inside: Some(inside),
+            },
             mesh,
             levels: levels.len() - 1,
             iterations,
@@ -551,13 +553,17 @@ mod tests {
         // and conical, so the first step subdivides.
         let control = s.metrics();
         assert_eq!(control.faces, 24);
-        assert!(control.max_planarity <= 1e-10);
+        assert!(control.measures.max_planarity <= 1e-10);
         let mut after_subdivision = Vec::new();
         while !s.is_done() {
             let i = s.step().unwrap();
-            assert_eq!(i.max_planarity, max_planarity(s.mesh()));
+            assert_eq!(i.measures.max_planarity, max_planarity(s.mesh()));
             if i.phase == PqScenePhase::Subdivide {
-                after_subdivision.push(i.max_planarity.max(i.conical_residual.unwrap()));
+                after_subdivision.push(
+                    i.measures
+                        .max_planarity
+                        .max(i.measures.conical_residual.unwrap()),
+                );
             }
         }
         assert_eq!(after_subdivision.len(), 2);
@@ -567,9 +573,11 @@ mod tests {
         );
         let last = s.metrics();
         assert_eq!(last.faces, 24 * 16);
-        assert!(last.max_planarity <= 1e-10);
-        assert!(last.conical_residual.unwrap() <= 1e-10);
-        assert!(last.circular_residual.is_none() && last.max_determinant.is_none());
+        assert!(last.measures.max_planarity <= 1e-10);
+        assert!(last.measures.conical_residual.unwrap() <= 1e-10);
+        assert!(
+            last.measures.circular_residual.is_none() && last.measures.max_determinant.is_none()
+        );
         // Done is final: more steps change nothing.
         assert_eq!(s.step().unwrap(), last);
     }
@@ -592,9 +600,9 @@ mod tests {
         assert_eq!(faces, vec![9 + 24 + 16]);
         let r = s.finish().unwrap();
         assert!(
-            r.converged && r.max_planarity <= 1e-10,
+            r.converged && r.measures.max_planarity <= 1e-10,
             "{}",
-            r.max_planarity
+            r.measures.max_planarity
         );
     }
 

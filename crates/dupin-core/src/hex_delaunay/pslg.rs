@@ -659,23 +659,8 @@ pub(crate) mod tests {
                     "{what}: a non-exempt triangle meets a segment"
                 );
             }
-            let mag = p
-                .iter()
-                .map(|x| x.x.abs().max(x.y.abs()))
-                .fold(0.0, f64::max);
-            let short = (0..3)
-                .map(|i| (p[i] - p[(i + 1) % 3]).norm())
-                .fold(f64::INFINITY, f64::min);
-            let tol = (4.0 * f64::EPSILON * mag / short).to_degrees();
-            for i in 0..3 {
-                let a = (p[(i + 1) % 3] - p[i])
-                    .angle(&(p[(i + 2) % 3] - p[i]))
-                    .to_degrees();
-                assert!(
-                    a >= lo - tol && a <= hi + tol,
-                    "{what}: angle {a} away from the segments"
-                );
-            }
+            let away = format!("{what} (away from the segments)");
+            super::super::tests::assert_angles_in(p, (lo, hi), &away);
         }
         let qk = triangulation_quality(v, &keep);
         assert_eq!(
@@ -813,11 +798,7 @@ pub(crate) mod tests {
         use crate::hex_delaunay::HexDelaunayStepper;
         let mut rng = ChaCha8Rng::seed_from_u64(73);
         for case in 0..40 {
-            let mode = if case % 2 == 0 {
-                HexDelaunayMode::Simple
-            } else {
-                HexDelaunayMode::Extended
-            };
+            let mode = super::super::tests::alternate_mode(case);
             let (pts, segs) = sample_pslg(case, &mut rng);
             let mut s = HexDelaunayStepper::new(&pts, &segs, mode).unwrap();
             assert!(

@@ -162,21 +162,10 @@ pub(crate) fn check_with(
         HexDelaunayMode::Simple => (29.99, 120.01, SIMPLE_ASPECT),
         HexDelaunayMode::Extended => (43.89, 90.0001, EXTENDED_ASPECT),
     };
-    // Per triangle, the angle tolerance also allows for the rounding of its corners to f64:
-    // 4 ulp of the coordinates' magnitude over its shortest edge, in degrees (only matters for
-    // points 1e-9 apart at unit offset, where an exact right angle of the lattice reads
-    // 90.0001x after rounding).
+    // Per triangle, the angle tolerance also allows for the rounding of its corners to f64.
     for tri in &t.triangles {
         let p = tri.map(|i| t.vertices[i as usize]);
-        let mag = p
-            .iter()
-            .map(|v| v.x.abs().max(v.y.abs()))
-            .fold(0.0, f64::max);
-        let short = (0..3)
-            .map(|i| (p[i] - p[(i + 1) % 3]).norm())
-            .fold(f64::INFINITY, f64::min);
-        let rel = 4.0 * f64::EPSILON * mag / short;
-        let tol = rel.to_degrees();
+        let rel = rounding_tolerance(p);
         let (la, lb, lc) = (
             (p[1] - p[2]).norm(),
             (p[2] - p[0]).norm(),
@@ -188,15 +177,7 @@ pub(crate) fn check_with(
             ratio <= aspect * (1.0 + 1e-6 + 16.0 * rel),
             "{what}: aspect ratio {ratio}"
         );
-        for i in 0..3 {
-            let a = (p[(i + 1) % 3] - p[i])
-                .angle(&(p[(i + 2) % 3] - p[i]))
-                .to_degrees();
-            assert!(
-                a >= lo - tol && a <= hi + tol,
-                "{what}: angle {a} outside [{lo}, {hi}] (rounding tolerance {tol})"
-            );
-        }
+        assert_angles_in(p, (lo, hi), what);
     }
     assert!(
         q.min_angle_deg >= lo - 1e-3 && q.max_angle_deg <= hi + 1e-3,
@@ -326,16 +307,50 @@ fn extended_cached_relocation_matches_a_new_full_pass() {
     }
 }
 
+/// The angle error (radians) the rounding of a triangle's corners to f64 can cause: 4 ulp of
+/// the coordinates' magnitude over its shortest edge (only matters for points 1e-9 apart at unit
+/// offset, where an exact right angle of the lattice reads 90.0001 degrees after rounding).
+pub(super) fn rounding_tolerance(p: [Vec2; 3]) -> f64 {
+    let mag = p
+        .iter()
+        .map(|v| v.x.abs().max(v.y.abs()))
+        .fold(0.0, f64::max);
+    let short = (0..3)
+        .map(|i| (p[i] - p[(i + 1) % 3]).norm())
+        .fold(f64::INFINITY, f64::min);
+    4.0 * f64::EPSILON * mag / short
+}
+
+/// Asserts that every angle of triangle `p` is in [`lo`, `hi`] degrees, up to
+/// [`rounding_tolerance`].
+pub(super) fn assert_angles_in(p: [Vec2; 3], (lo, hi): (f64, f64), what: &str) {
+    let tol = rounding_tolerance(p).to_degrees();
+    for i in 0..3 {
+        let a = (p[(i + 1) % 3] - p[i])
+            .angle(&(p[(i + 2) % 3] - p[i]))
+            .to_degrees();
+        assert!(
+            a >= lo - tol && a <= hi + tol,
+            "{what}: angle {a} outside [{lo}, {hi}] (rounding tolerance {tol})"
+        );
+    }
+}
+
+/// Simple for even cases, extended for odd ones: the two modes over one sample sequence.
+pub(super) fn alternate_mode(case: usize) -> HexDelaunayMode {
+    if case.is_multiple_of(2) {
+        HexDelaunayMode::Simple
+    } else {
+        HexDelaunayMode::Extended
+    }
+}
+
 #[test]
 fn stepper_matches_one_shot_and_cells_tile() {
     let mut rng = ChaCha8Rng::seed_from_u64(5);
     for case in 0..60 {
         let pts = sample(FAMILIES[case % 9], &mut rng);
-        let mode = if case % 2 == 0 {
-            HexDelaunayMode::Simple
-        } else {
-            HexDelaunayMode::Extended
-        };
+        let mode = alternate_mode(case);
         let one = hex_delaunay(&pts, &[], mode).unwrap();
         let mut s = HexDelaunayStepper::new(&pts, &[], mode).unwrap();
         let mut steps = 0;

@@ -164,14 +164,18 @@ mod tests {
         for &name in PQ_SCENES {
             let r = pq_scene(name).unwrap();
             assert!(r.converged, "{name}");
-            assert!(r.max_planarity <= 1e-10, "{name}: {}", r.max_planarity);
-            if let Some(c) = r.conical_residual {
+            assert!(
+                r.measures.max_planarity <= 1e-10,
+                "{name}: {}",
+                r.measures.max_planarity
+            );
+            if let Some(c) = r.measures.conical_residual {
                 assert!(c <= 1e-10, "{name}: conical {c}");
             }
-            if let Some(c) = r.circular_residual {
+            if let Some(c) = r.measures.circular_residual {
                 assert!(c <= 1e-10, "{name}: circular {c}");
             }
-            if let Some(d) = r.max_determinant {
+            if let Some(d) = r.measures.max_determinant {
                 assert!(d <= 1e-10, "{name}: det {d}");
             }
         }

@@ -188,6 +188,29 @@ impl TriangleStar {
         Ok(q.iter().any(|&x| x > 0.0) && q.iter().any(|&x| x < 0.0))
     }
 
+    /// Conditions 1, 2 and 3 of Proposition 4 (elliptic indicatrix, K > 0) or Proposition 5
+    /// (hyperbolic, K < 0), in that order; the propositions say the three agree. Fails on a
+    /// parabolic or planar indicatrix, where neither proposition speaks.
+    pub fn validity_conditions(
+        &self,
+        ind: &DupinIndicatrix,
+    ) -> Result<[bool; 3], TriangleStarError> {
+        let c1 = self.is_valid(ind)?;
+        Ok(if ind.point_type() == PointType::Elliptic {
+            [
+                c1,
+                self.dupin_center_inside(ind)?,
+                self.edges_not_enclosed_by_conjugate_pair(ind)?,
+            ]
+        } else {
+            [
+                c1,
+                self.vertices_on_different_branches(ind)?,
+                self.edges_not_in_one_asymptotic_range(ind)?,
+            ]
+        })
+    }
+
     fn edges(&self) -> [Vec2; 3] {
         [self.a, self.b, self.b - self.a]
     }
@@ -228,17 +251,7 @@ mod tests {
             let Ok(c1) = star.is_valid(&ind) else {
                 continue;
             };
-            let (c2, c3) = if sign > 0.0 {
-                (
-                    star.dupin_center_inside(&ind).unwrap(),
-                    star.edges_not_enclosed_by_conjugate_pair(&ind).unwrap(),
-                )
-            } else {
-                (
-                    star.vertices_on_different_branches(&ind).unwrap(),
-                    star.edges_not_in_one_asymptotic_range(&ind).unwrap(),
-                )
-            };
+            let [_, c2, c3] = star.validity_conditions(&ind).unwrap();
             assert_eq!(c1, c2, "condition 1 vs 2 at k=({k1},{k2}) star {star:?}");
             assert_eq!(c1, c3, "condition 1 vs 3 at k=({k1},{k2}) star {star:?}");
             if c1 { valid += 1 } else { invalid += 1 }
