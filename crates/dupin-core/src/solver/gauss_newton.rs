@@ -44,7 +44,6 @@ struct Scalar<'a, P: ?Sized> {
     layout: BlockLayout,
     local_from: usize,
     block_of: Vec<(u32, u8)>,
-    triplets: std::cell::RefCell<SparseSystem>,
 }
 
 impl<'a, P: NonlinearLeastSquares + ?Sized> Scalar<'a, P> {
@@ -73,7 +72,6 @@ impl<'a, P: NonlinearLeastSquares + ?Sized> Scalar<'a, P> {
             layout: BlockLayout::new(sizes),
             local_from: first,
             block_of,
-            triplets: Default::default(),
         }
     }
 }
@@ -86,10 +84,11 @@ impl<P: NonlinearLeastSquares + ?Sized> BlockLeastSquares for Scalar<'_, P> {
         self.local_from
     }
     fn evaluate(&self, x: &[f64], out: &mut BlockSystem) -> Result<(), SolverError> {
-        let mut t = self.triplets.borrow_mut();
-        t.clear();
-        self.problem.evaluate(x, &mut t);
-        out.fill_from_sparse(&t, &self.block_of)
+        // A fresh triplet list per evaluation: `Scalar` lives for one step, so a kept buffer
+        // would save a few allocations at the price of interior mutability.
+        let mut triplets = SparseSystem::default();
+        self.problem.evaluate(x, &mut triplets);
+        out.fill_from_sparse(&triplets, &self.block_of)
     }
 }
 
