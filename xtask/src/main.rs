@@ -6,10 +6,13 @@
 //! - `cargo xtask build-web`: build the wasm package into the page (settings: `wasm-pack.toml`).
 //! - `cargo xtask serve [--port 8080]`: set up, build, and serve `web/` at http://127.0.0.1:8080/.
 //! - `cargo xtask test`: everything CI runs (`.ci/run` is exactly this).
+//! - `cargo xtask fuzz [TARGET...] [--runs N] [--seconds S] [--keep]`: coverage-guided fuzzing
+//!   of the `dupin-fuzz` targets with libFuzzer on the stable toolchain.
 //! - `cargo xtask layering`: print each crate's top-level module graph; fails on a cycle (also a
 //!   step of `test`).
 
 mod config;
+mod fuzz;
 mod layering;
 mod serve;
 mod setup;
@@ -45,6 +48,22 @@ enum Command {
     },
     /// Run every check CI runs.
     Test,
+    /// Fuzz the entry points that take outside data (libFuzzer, stable toolchain); fails when
+    /// an input makes a target panic, hang over 10 s or allocate over 2 GB (kept in
+    /// fuzz/artifacts/TARGET/).
+    Fuzz {
+        /// Targets to run (default: all, see fuzz/fuzz_targets/).
+        targets: Vec<String>,
+        /// Executions per target.
+        #[arg(long)]
+        runs: Option<u64>,
+        /// Seconds per target.
+        #[arg(long)]
+        seconds: Option<u64>,
+        /// Add the inputs that reach new coverage to fuzz/corpus/TARGET (minimised).
+        #[arg(long)]
+        keep: bool,
+    },
     /// Print each crate's top-level module dependencies (`a -> b`) and fail on any cycle.
     Layering {
         /// Check the workspace at this directory instead of this one (e.g. another checkout).
@@ -65,6 +84,17 @@ fn main() -> ExitCode {
         }),
         Command::Serve { port } => serve::run(port),
         Command::Test => test::run(),
+        Command::Fuzz {
+            targets,
+            runs,
+            seconds,
+            keep,
+        } => fuzz::run(&fuzz::FuzzRun {
+            targets: &targets,
+            runs,
+            seconds,
+            keep,
+        }),
         Command::Layering { workspace } => layering::print(workspace.as_deref()),
     };
     match result {

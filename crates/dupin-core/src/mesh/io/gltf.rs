@@ -165,12 +165,34 @@ fn add_mesh(
     Ok(())
 }
 
+/// The GLB header's total length must cover the 12-byte header itself: gltf 1.4 subtracts the
+/// header size from it unchecked (a panic in builds with overflow checks, found by fuzzing).
+fn check_glb_header(bytes: &[u8]) -> Result<(), ImportError> {
+    let Some(length) = bytes
+        .strip_prefix(b"glTF")
+        .and_then(|rest| rest.get(4..8))
+        .map(|l| u32::from_le_bytes([l[0], l[1], l[2], l[3]]))
+    else {
+        return Ok(()); // JSON glTF, or too short for gltf's own header check.
+    };
+    if length < 12 {
+        return Err(ImportError::Syntax {
+            format: FORMAT,
+            message: format!(
+                "the GLB header gives a total length of {length} bytes, less than the header's 12"
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// Reads a glTF 2.0 file (JSON `.gltf` or binary `.glb`) into one welded triangle mesh: every
 /// triangle primitive of every mesh of the default scene's nodes (of all scenes if there is no
 /// default, of every mesh if there are no nodes), transformed by the node hierarchy. Triangles
 /// that collapse after welding are dropped and counted in the second result.
 pub fn read_gltf(bytes: &[u8], options: &ImportOptions) -> Result<(PolyMesh, usize), ImportError> {
     options.check_bytes(bytes.len())?;
+    check_glb_header(bytes)?;
     let doc = gltf::Gltf::from_slice(bytes).map_err(|e| ImportError::Syntax {
         format: FORMAT,
         message: e.to_string(),
