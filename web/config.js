@@ -43,8 +43,9 @@ export function readHash(hash, { scenes, catalog, torusParams }) {
     if (SCHEMA.initialisations.some((m) => m.name === h.get('init'))) c.free.init = h.get('init');
     for (const k of ['size', 'bound', 'lambda', 'mu']) if (h.has(k)) c.free[k] = num(h.get(k));
   }
+  // The torus preview does not step (writeHash leaves its steps out).
   const steps = Number(h.get('steps'));
-  if (Number.isInteger(steps) && steps >= 1 && steps <= 100000) c.steps = steps;
+  if (c.scene !== 'torus' && Number.isInteger(steps) && steps >= 1 && steps <= 100000) c.steps = steps;
   if (SCHEMA.colorModes.includes(h.get('color'))) c.color = h.get('color');
   const edge = Number(h.get('edge'));
   if (h.has('edge') && Number.isFinite(edge) && edge > 0) c.panelEdge = edge;

@@ -71,6 +71,7 @@ function updateButtons() {
   setProp($('step'), 'disabled', !running || done);
   setProp($('play'), 'disabled', !running || done);
   setProp($('reset'), 'disabled', !running);
+  setProp($('stop'), 'disabled', !running || done);
   setProp($('play'), 'textContent', playing ? 'Pause' : 'Play');
   for (const id of ['export-json', 'export-svg']) setProp($(id), 'disabled', !running);
 }
@@ -130,7 +131,9 @@ function applyState(s) {
     if (candidate.field) showFieldError(fieldsBox, candidate.field, '');
     candidate = null;
     running = true;
-    showStatus(viewer.backend);
+    showStatus(notice ? `${viewer.backend} · ${notice.text}` : viewer.backend, !!notice?.isError);
+    notice = null;
+    recovering = false;
   }
   const m = s.metrics;
   m.steps = s.steps;
@@ -145,6 +148,7 @@ function applyState(s) {
   lastFaces = m.faces;
   lastPhase = m.phase;
   lastMetrics = m;
+  if (m.phase === 'warning') showStatus(`${viewer.backend} · NOT done: ${m.reason}`, true);
   const entry = { phase: m.phase, layer: m.layer, iteration: m.iteration, faces: m.faces, maxPlanarity: m.maxPlanarity, steps: s.steps, ms: m.ms, timing: m.timing, mainMs: performance.now() - t0main, panelMs: null, at: performance.now() };
   stepLog.push(entry);
   if (stepLog.length > 5000) stepLog.shift();
@@ -256,6 +260,44 @@ function reportError(message, field) {
   if (!(field && showFieldError(fieldsBox, field, message))) showStatus(`${viewer.backend} · ${message}`, true);
 }
 
+// ---- stopping and recovering -----------------------------------------------------------------
+// Stop, a trap or an out-of-memory in the worker: a fresh worker, and the last state the page
+// showed (the confirmed configuration at its step count) replayed into it. A fault during that
+// replay is not retried (it would fault again): the message stays and Reset or another scene
+// start over.
+let notice = null;     // { text, isError } shown in the status once the replayed state arrives
+let recovering = false;
+
+async function restartSolver(message, isError) {
+  playing = false;
+  candidate = null;
+  updateButtons();
+  showStatus(`${viewer.backend} · ${message}`, isError);
+  await solver.restart();
+  if (config.scene === 'torus') return;
+  notice = { text: message, isError };
+  recovering = true;
+  load(config, { reframe: false });
+}
+
+function onFault(message) {
+  if (recovering) {
+    recovering = false;
+    running = false;
+    notice = null;
+    updateButtons();
+    solver.restart();
+    showStatus(`${viewer.backend} · the solver failed again while restoring (${message}); press Reset or pick another scene`, true);
+    return;
+  }
+  restartSolver(`the solver failed (${message}) and was restarted at step ${config.steps}`, true);
+}
+
+function stop() {
+  if (!running || done) return;
+  restartSolver(`stopped; back at step ${config.steps}`, false);
+}
+
 function onError(e) {
   playing = false;
   if (e.load) {
@@ -305,6 +347,8 @@ window.dupin = {
   get picked() { return pickedPoint; },
   stepLog,
   slowTasks,
+  /** Makes the solver worker trap (`'trap'`) or run out of memory (`'oom'`), to test recovery. */
+  fault: (kind) => solver.post('fault', { kind }),
 };
 
 // ---- orbit: mouse drag, wheel, touch (one finger orbits, two pinch) ---------------------------
@@ -461,7 +505,7 @@ async function main() {
     TORUS = Object.fromEntries(schema.torus.map((p) => [p.key, { label: p.key, value: p.default }]));
     config = defaults();
     ctx = { scenes: sceneNames(), catalog: surfaceCatalog(), defaults: freeDefaults() };
-    solver = new Solver({ onState, onError, onExport, onPick });
+    solver = new Solver({ onState, onError, onExport, onPick, onFault });
     const backend = readHash(location.hash, { scenes: ctx.scenes, catalog: ctx.catalog, torusParams: TORUS }).backend;
     canvas.width = Math.max(1, canvas.clientWidth);
     canvas.height = Math.max(1, canvas.clientHeight);
@@ -499,6 +543,7 @@ async function main() {
     if (!playing) syncHash(); // the URL was left behind while playing (showPanel)
     updateButtons();
   });
+  $('stop').addEventListener('click', stop);
   $('reset').addEventListener('click', () => { if (running) load({ ...config, steps: 1 }, { reframe: true }); });
   $('color-mode').addEventListener('change', (e) => setColorMode(e.target.value));
   $('panel-edge').addEventListener('change', (e) => {

@@ -1,15 +1,32 @@
 // The page's side of web/worker.js: starts the worker and turns its messages into callbacks.
 // Every load gets a new generation number; replies for older loads are ignored.
+//
+// A wasm trap or out-of-memory leaves the worker's module unusable, and a step may run longer
+// than anyone wants to wait: `restart()` terminates the worker (whatever it is computing) and
+// starts a fresh one, and the page reloads its last good state into it.
 export class Solver {
-  constructor({ onState, onError, onExport, onPick }) {
+  constructor({ onState, onError, onExport, onPick, onFault }) {
     this.gen = 0;
-    this.worker = new Worker(new URL('./worker.js', import.meta.url), { type: 'module' });
+    this.callbacks = { onState, onError, onExport, onPick, onFault };
+    this.start();
+  }
+
+  start() {
+    const { onState, onError, onExport, onPick, onFault } = this.callbacks;
+    const worker = new Worker(new URL('./worker.js', import.meta.url), { type: 'module' });
+    this.worker = worker;
     this.ready = new Promise((resolve, reject) => {
-      this.worker.addEventListener('error', (e) => reject(new Error(`solver worker: ${e.message ?? 'failed to start'}`)), { once: true });
-      this.worker.addEventListener('message', (e) => { if (e.data.type === 'ready') resolve(); });
+      worker.addEventListener('error', (e) => reject(new Error(`solver worker: ${e.message ?? 'failed to start'}`)), { once: true });
+      worker.addEventListener('message', (e) => { if (e.data.type === 'ready') resolve(); });
     });
-    this.worker.addEventListener('message', (e) => {
+    // An error that escaped the worker's handlers: the worker is in an unknown state.
+    worker.addEventListener('error', (e) => {
+      if (this.worker === worker) onFault?.(e.message ?? 'the solver worker failed');
+    });
+    worker.addEventListener('message', (e) => {
+      if (this.worker !== worker) return;
       const m = e.data;
+      if (m.type === 'error' && m.fatal) { onFault?.(m.message); return; }
       if (m.type === 'error' && m.load) { // a rejected load keeps the old run going
         if (m.gen === this.gen) this.gen = m.active;
         onError(m);
@@ -21,6 +38,15 @@ export class Solver {
       else if (m.type === 'export') onExport(m);
       else if (m.type === 'pick') onPick?.(m);
     });
+  }
+
+  /** Terminates the worker, cancelling whatever it computes, and starts a fresh one; resolves
+   * once the new worker is ready. */
+  restart() {
+    this.gen += 1;
+    this.worker.terminate();
+    this.start();
+    return this.ready;
   }
 
   /** Starts `config` (a Session config) and replays `steps` steps; `field` names the input

@@ -4,10 +4,12 @@
 //   in:  load {config, steps, mode, layers} | step | play | pause | ack | mode {mode}
 //        | layers {layers} (offset/support, Session.setLayers) | export {kind, panelEdge}
 //        | pick {origin, direction} (a view ray)
+//        | fault {kind} (debugFault: a deliberate trap or out-of-memory, for recovery tests)
 //   out: ready | state {metrics, steps, done, mesh: typed arrays (transferred), layers:
 //        {unavailable, info}} | error {message, field}
 //        | export {kind, text} | pick {pick | error} (Session.pickVertex's answer)
-import init, { Session } from './pkg/dupin_web.js';
+//        error {fatal: true} after a wasm trap: the module is unusable and the page restarts us
+import init, { Session, debugFault } from './pkg/dupin_web.js';
 
 let session = null;
 let gen = 0;
@@ -60,9 +62,13 @@ function stepOnce() {
   lastMetrics = m;
 }
 
+// A wasm trap (a Rust panic or a failed allocation) poisons the module: every later call would
+// trap too, so it is reported as fatal and the page replaces this worker.
 function fail(e, field = null) {
   playing = false;
-  postMessage({ type: 'error', gen, message: e?.message ?? String(e), field });
+  const fatal = e instanceof WebAssembly.RuntimeError;
+  const message = fatal ? `wasm trap "${e.message}": out of memory or a bug` : e?.message ?? String(e);
+  postMessage({ type: 'error', gen, message, field, fatal });
 }
 
 const handlers = {
@@ -72,6 +78,7 @@ const handlers = {
     try {
       next = new Session(msg.config);
     } catch (e) {
+      if (e instanceof WebAssembly.RuntimeError) { fail(e); return; }
       postMessage({ type: 'error', gen: msg.gen, active: gen, message: e?.message ?? String(e), field: msg.field ?? null, load: true });
       return;
     }
@@ -101,6 +108,9 @@ const handlers = {
     try { stepOnce(); send(); } catch (e) { fail(e); }
   },
   pause() { playing = false; },
+  fault(msg) {
+    try { debugFault(msg.kind); } catch (e) { fail(e); }
+  },
   // The page has drawn the last state: take the next step while playing (back-pressure keeps
   // the page from queueing meshes it cannot draw).
   ack(msg) {

@@ -24,8 +24,11 @@ use dupin_core::phex::{
 use dupin_core::scenes::{phex_scene, pq_scene_spec};
 use dupin_core::surface::{surface_by_name, surface_catalog};
 
+/// A fuzz target: takes any bytes, panics only on a bug.
+pub type Target = fn(&[u8]);
+
 /// The names of the targets, as the binaries, corpus folders and `cargo xtask fuzz` call them.
-pub const TARGETS: &[(&str, fn(&[u8]))] = &[
+pub const TARGETS: &[(&str, Target)] = &[
     ("obj", obj),
     ("point_set", point_set),
     ("mesh_file", mesh_file),

@@ -1,6 +1,7 @@
 //! `cargo xtask test`: every check, in the order a failure is cheapest to find.
 
 use crate::config::WebBuild;
+use crate::fuzz::{self, FuzzRun};
 use crate::layering;
 use crate::serve;
 use crate::setup;
@@ -60,6 +61,14 @@ pub fn run() -> Result<()> {
     })?;
     step("native tests", &mut || {
         util::run(cargo().args(["test", "--workspace"]))
+    })?;
+    step("short fuzz run (5 s per target)", &mut || {
+        fuzz::run(&FuzzRun {
+            targets: &[],
+            runs: None,
+            seconds: Some(5),
+            keep: false,
+        })
     })?;
     step("docs", &mut || {
         util::run(

@@ -4,7 +4,7 @@ use crate::common::{CliError, write_report, write_text};
 use clap::Args;
 use dupin_core::Stepper;
 use dupin_core::mesh::write_obj;
-use dupin_core::phex::{PhexConfig, PhexPipeline, TriangulationMethod};
+use dupin_core::phex::{PhexConfig, PhexGoals, PhexPipeline, TriangulationMethod};
 use dupin_core::scenes::{PHEX_SCENES, phex_scene};
 use dupin_core::surface::parse_assignment;
 use serde_json::json;
@@ -132,8 +132,9 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
         .clone()
         .or(args.surface.clone())
         .unwrap_or_default();
-    let optimize = config.optimize;
-    let tolerance = config.planarity_options().tolerance;
+    // Planar faces (unless the optimisation is off) and simple faces (unless the scene shows
+    // invalid ones).
+    let goals = PhexGoals::of(&config, expect_valid);
     let start = std::time::Instant::now();
     let r = PhexPipeline::new(config)
         .and_then(Stepper::finish)
@@ -146,25 +147,12 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
         .iter()
         .map(|(k, v)| (k.to_string(), json!(v)))
         .collect();
-    // What was asked and missed: planar faces (unless the optimisation was switched off) and
-    // simple faces (unless the scene shows invalid ones).
-    let mut missed = Vec::new();
-    // NaN counts as a miss.
-    let planar = rep.max_planarity <= tolerance;
-    if optimize && !planar {
-        missed.push(format!(
-            "max_planarity {:.3e} is above the tolerance {tolerance:.0e} after {} iterations",
-            rep.max_planarity, rep.iterations
-        ));
-    }
-    if expect_valid && rep.invalid_faces > 0 {
-        missed.push(format!(
-            "{} of {} faces are self-intersecting (invalid); try a larger --size or another \
-             --method",
-            rep.invalid_faces, rep.faces
-        ));
-    }
-    let reason = (!missed.is_empty()).then(|| missed.join("; "));
+    let reason = goals.shortfall(
+        rep.max_planarity,
+        rep.iterations,
+        rep.invalid_faces,
+        rep.faces,
+    );
     let mut report = json!({
         "vertices": rep.vertices,
         "faces": rep.faces,

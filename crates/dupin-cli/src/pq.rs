@@ -4,6 +4,7 @@
 use crate::common::{CliError, write_report, write_text};
 use clap::Args;
 use dupin_core::Stepper;
+use dupin_core::conical::pq_scene_shortfall;
 use dupin_core::mesh::write_obj;
 use dupin_core::scenes::{PQ_SCENES, pq_scene_stepper};
 use serde_json::json;
@@ -54,11 +55,8 @@ pub fn run(args: PqArgs) -> Result<(), CliError> {
         "converged": r.converged,
         "seconds": seconds,
     });
-    if !r.converged {
-        report["reason"] = json!(format!(
-            "a perturbation level did not reach the tolerance (max_planarity {:.3e})",
-            r.measures.max_planarity
-        ));
+    if let Some(reason) = pq_scene_shortfall(r.converged, &r.measures) {
+        report["reason"] = json!(reason);
     }
     if let Some(c) = r.measures.conical_residual {
         report["conical_residual"] = json!(c);

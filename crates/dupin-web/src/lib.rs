@@ -37,3 +37,26 @@ pub fn start() {
         web_sys::console::error_1(&format!("dupin panicked: {info}").into());
     }));
 }
+
+/// Fails the way a bug would, so that the page's recovery can be tested: `"trap"` panics (a
+/// wasm `unreachable` trap with panic = abort) and `"oom"` asks for more memory than wasm32 can
+/// address (an allocation failure, also a trap). The module instance is unusable afterwards,
+/// as after a real fault; the page's worker is restarted. Anything else is a JS `Error`.
+#[wasm_bindgen(js_name = debugFault)]
+pub fn debug_fault(kind: &str) -> Result<(), JsError> {
+    match kind {
+        "trap" => panic!("debugFault(\"trap\"): a deliberate panic"),
+        "oom" => {
+            // Keeps taking 256 MB blocks (untouched, so the browser commits no pages) until
+            // wasm32's 4 GB is gone and the allocator fails: a real out-of-memory trap.
+            let mut blocks: Vec<Vec<u8>> = Vec::new();
+            loop {
+                blocks.push(Vec::with_capacity(256 << 20));
+                std::hint::black_box(&blocks);
+            }
+        }
+        _ => Err(js::err(format!(
+            "debugFault takes \"trap\" or \"oom\", got {kind:?}"
+        ))),
+    }
+}

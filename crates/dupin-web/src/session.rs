@@ -4,7 +4,7 @@ use crate::js::{err, to_js};
 use crate::mesh_data::MeshData;
 use dupin_core::Stepper;
 use dupin_core::conical::{
-    PqMode, PqSceneMeasures, PqSceneStepInfo, PqSceneStepper, support_structure,
+    PqMode, PqSceneMeasures, PqSceneStepInfo, PqSceneStepper, pq_scene_shortfall, support_structure,
 };
 use dupin_core::fabrication::{SheetOptions, panel_schedule, panel_schedule_svg};
 use dupin_core::mesh::{
@@ -13,8 +13,8 @@ use dupin_core::mesh::{
     planarity_color, planarity_histogram, regularity_color, write_obj,
 };
 use dupin_core::phex::{
-    Initialisation, LayerRule, PhexConfig, PhexPipeline, TriangulationMethod, count_invalid_faces,
-    face_info,
+    Initialisation, LayerRule, PhexConfig, PhexGoals, PhexPipeline, TriangulationMethod,
+    count_invalid_faces, face_info,
 };
 use dupin_core::scenes::{PHEX_SCENES, PQ_SCENES, phex_scene, pq_scene_stepper};
 use dupin_core::surface::surface_catalog;
@@ -99,7 +99,12 @@ fn refuse_unknown_keys(value: &JsValue, what: &str, allowed: &[&str]) -> Result<
 #[derive(Serialize, Clone)]
 #[serde(rename_all = "camelCase")]
 struct Metrics {
+    /// The stepper's phase; a finished run that misses what it was asked ends in `warning`
+    /// (with `reason`), never `done`.
     phase: &'static str,
+    /// Why the finished run is a `warning`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    reason: Option<String>,
     layer: usize,
     iteration: usize,
     faces: usize,
@@ -163,7 +168,8 @@ struct LayerInfo {
 }
 
 enum Run {
-    Phex(Box<PhexPipeline>),
+    /// A P-Hex run and what it is asked for (a finished run that misses it is a `warning`).
+    Phex(Box<PhexPipeline>, PhexGoals),
     /// A PQ scene, one perturbation iteration or one subdivision a step; the first step shows
     /// the control mesh.
     Pq {
@@ -324,7 +330,11 @@ impl Session {
             },
             (Some(scene), None) => {
                 let scene = phex_scene(scene).map_err(err)?;
-                Run::Phex(Box::new(PhexPipeline::new(scene.config).map_err(err)?))
+                let goals = PhexGoals::of(&scene.config, scene.expect_valid);
+                Run::Phex(
+                    Box::new(PhexPipeline::new(scene.config).map_err(err)?),
+                    goals,
+                )
             }
             (None, Some(surface)) => {
                 let method: TriangulationMethod = cfg
@@ -351,7 +361,8 @@ impl Session {
                     .unwrap_or("tangent-duality")
                     .parse()
                     .map_err(err)?;
-                Run::Phex(Box::new(PhexPipeline::new(config).map_err(err)?))
+                let goals = PhexGoals::of(&config, true);
+                Run::Phex(Box::new(PhexPipeline::new(config).map_err(err)?), goals)
             }
             _ => {
                 return Err(JsError::new(
@@ -380,7 +391,7 @@ impl Session {
     pub fn advance(&mut self) -> Result<(), JsError> {
         self.per_face = None;
         match &mut self.run {
-            Run::Phex(p) => {
+            Run::Phex(p, _) => {
                 if !p.is_done() {
                     p.step().map_err(err)?;
                 }
@@ -399,7 +410,7 @@ impl Session {
     /// True once the run has finished.
     pub fn done(&self) -> bool {
         match &self.run {
-            Run::Phex(p) => p.is_done(),
+            Run::Phex(p, _) => p.is_done(),
             Run::Pq { stepper, started } => *started && stepper.is_done(),
         }
     }
@@ -426,7 +437,7 @@ impl Session {
         let mesh = self.current_mesh().unwrap_or_default();
         let metrics = self.metrics_struct();
         let report = match &self.run {
-            Run::Phex(p) => p.report().map(|r| {
+            Run::Phex(p, _) => p.report().map(|r| {
                 serde_json::json!({
                     "vertices": r.vertices,
                     "faces": r.faces,
@@ -509,7 +520,7 @@ impl Session {
     /// Throws for a PQ scene (no triangulation) or a malformed ray.
     #[wasm_bindgen(js_name = pickVertex)]
     pub fn pick_vertex(&self, origin: Vec<f64>, direction: Vec<f64>) -> Result<JsValue, JsError> {
-        let Run::Phex(p) = &self.run else {
+        let Run::Phex(p, _) = &self.run else {
             return Err(JsError::new(
                 "vertex picking needs a P-Hex run: PQ scenes have no triangulation",
             ));
@@ -628,7 +639,7 @@ impl Session {
                 // The regularity measure depends on the sign of K at the face: the P-Hex report
                 // has it per face; other meshes are compared with the affine-regular hexagon.
                 let report = match &self.run {
-                    Run::Phex(p) => p.report(),
+                    Run::Phex(p, _) => p.report(),
                     Run::Pq { .. } => None,
                 };
                 (0..m.num_faces())
@@ -708,7 +719,7 @@ impl Session {
 
     fn current_mesh(&self) -> Option<PolyMesh> {
         match &self.run {
-            Run::Phex(p) => Some(p.mesh()),
+            Run::Phex(p, _) => Some(p.mesh()),
             Run::Pq { stepper, .. } => Some(stepper.mesh().clone()),
         }
     }
@@ -720,10 +731,21 @@ impl Session {
         let histogram = planarity_histogram(&per_face);
         let hist_log10 = [PLANARITY_HIST_LO, PLANARITY_HIST_HI];
         match &self.run {
-            Run::Phex(p) => {
+            Run::Phex(p, goals) => {
                 let m = p.metrics();
+                let reason = p
+                    .is_done()
+                    .then(|| {
+                        goals.shortfall(m.max_planarity, m.iteration, m.invalid_faces, m.faces)
+                    })
+                    .flatten();
                 Metrics {
-                    phase: m.phase.name(),
+                    phase: if reason.is_some() {
+                        "warning"
+                    } else {
+                        m.phase.name()
+                    },
+                    reason,
                     layer: m.layer,
                     iteration: m.iteration,
                     faces: m.faces,
@@ -757,9 +779,18 @@ impl Session {
                         },
                     ..
                 } = stepper.metrics();
+                let reason = stepper
+                    .is_done()
+                    .then(|| pq_scene_shortfall(stepper.converged(), &stepper.metrics().measures))
+                    .flatten();
                 Metrics {
                     // Before the first step nothing is shown yet.
-                    phase: if *started { phase.name() } else { "ready" },
+                    phase: match (*started, &reason) {
+                        (false, _) => "ready",
+                        (true, Some(_)) => "warning",
+                        (true, None) => phase.name(),
+                    },
+                    reason,
                     layer: level,
                     iteration,
                     faces: mesh.num_faces(),
@@ -846,6 +877,29 @@ mod tests {
         );
     }
 
+    /// A finished run that misses what it was asked ends in `warning` with the reason, never
+    /// `done`: the free-mode torus at panel size 0.2 ends with self-intersecting faces.
+    #[test]
+    fn a_missed_result_ends_in_warning_not_done() {
+        let cfg =
+            PhexConfig::for_surface("torus", &[], TriangulationMethod::Progressive, Some(0.2));
+        let goals = PhexGoals::of(&cfg, true);
+        let mut session = Session {
+            run: Run::Phex(Box::new(PhexPipeline::new(cfg).unwrap()), goals),
+            config: serde_json::from_str(r#"{"surface": "torus"}"#).unwrap(),
+            per_face: None,
+            layers: LayerConfig::default(),
+        };
+        while !session.done() {
+            assert_ne!(session.metrics_struct().phase, "warning");
+            session.advance().unwrap();
+        }
+        let m = session.metrics_struct();
+        assert!(m.invalid_faces > 0, "the case no longer has invalid faces");
+        assert_eq!(m.phase, "warning");
+        assert!(m.reason.unwrap().contains("faces are self-intersecting"));
+    }
+
     /// The per-face planarity cache follows every step: the metrics' mean and histogram and
     /// the planarity colours always match a fresh computation on the current mesh.
     #[test]
@@ -853,8 +907,9 @@ mod tests {
         let mut cfg =
             PhexConfig::for_surface("torus", &[], TriangulationMethod::Prescribed, Some(0.6));
         cfg.initialisation = dupin_core::phex::Initialisation::DupinDuality;
+        let goals = PhexGoals::of(&cfg, true);
         let mut session = Session {
-            run: Run::Phex(Box::new(PhexPipeline::new(cfg).unwrap())),
+            run: Run::Phex(Box::new(PhexPipeline::new(cfg).unwrap()), goals),
             config: serde_json::from_str(r#"{"surface": "torus"}"#).unwrap(),
             per_face: None,
             layers: LayerConfig::default(),

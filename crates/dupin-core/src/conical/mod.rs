@@ -42,6 +42,6 @@ pub use perturbation::{
 pub use principal_quads::principal_quad_mesh;
 pub use refinement::{
     MeshRule, PqSceneError, PqSceneMeasures, PqScenePhase, PqSceneResult, PqSceneSpec,
-    PqSceneStepInfo, PqSceneStepper,
+    PqSceneStepInfo, PqSceneStepper, pq_scene_shortfall,
 };
 pub use support::support_structure;

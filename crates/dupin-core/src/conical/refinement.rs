@@ -180,7 +180,23 @@ pub struct PqSceneStepper {
     converged: bool,
 }
 
+/// Why a finished PQ scene misses what it was asked (a perturbation level that did not reach
+/// its tolerance), or `None` when every level converged.
+pub fn pq_scene_shortfall(converged: bool, measures: &PqSceneMeasures) -> Option<String> {
+    (!converged).then(|| {
+        format!(
+            "a perturbation level did not reach the tolerance (max_planarity {:.3e})",
+            measures.max_planarity
+        )
+    })
+}
+
 impl PqSceneStepper {
+    /// Whether every perturbation run so far reached its tolerance.
+    pub fn converged(&self) -> bool {
+        self.converged
+    }
+
     /// The scene `spec` at its control mesh.
     pub fn from_spec(spec: PqSceneSpec) -> Result<Self, PqSceneError> {
         match spec {

@@ -163,3 +163,76 @@ pub fn phex_report(
         per_face,
     }
 }
+
+/// What a P-Hex run is asked for, so that a finished run that misses it says so (CLI exit 3, the
+/// page's `warning` phase) instead of passing as done.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PhexGoals {
+    /// Faces planar to this `max_planarity` (the optimiser's tolerance); `None` when the
+    /// planarity optimisation was switched off.
+    pub planarity: Option<f64>,
+    /// No self-intersecting face (off only for scenes made to show invalid faces).
+    pub valid: bool,
+}
+
+impl PhexGoals {
+    /// The goals of a run of `config`; `valid` as above.
+    pub fn of(config: &super::PhexConfig, valid: bool) -> Self {
+        PhexGoals {
+            planarity: config
+                .optimize
+                .then(|| config.planarity_options().tolerance),
+            valid,
+        }
+    }
+
+    /// What a finished run with these figures misses, each miss in a sentence (joined by `; `);
+    /// `None` when it meets every goal. A NaN planarity is a miss.
+    pub fn shortfall(
+        &self,
+        max_planarity: f64,
+        iterations: usize,
+        invalid_faces: usize,
+        faces: usize,
+    ) -> Option<String> {
+        let mut missed = Vec::new();
+        if let Some(tolerance) = self.planarity
+            && !(max_planarity <= tolerance)
+        {
+            missed.push(format!(
+                "max_planarity {max_planarity:.3e} is above the tolerance {tolerance:.0e} after \
+                 {iterations} iterations"
+            ));
+        }
+        if self.valid && invalid_faces > 0 {
+            missed.push(format!(
+                "{invalid_faces} of {faces} faces are self-intersecting (invalid); try a larger \
+                 size or another method"
+            ));
+        }
+        (!missed.is_empty()).then(|| missed.join("; "))
+    }
+}
+
+#[cfg(test)]
+mod goal_tests {
+    use super::PhexGoals;
+
+    #[test]
+    fn shortfall_names_each_missed_goal_and_nan_misses() {
+        let goals = PhexGoals {
+            planarity: Some(1e-10),
+            valid: true,
+        };
+        assert_eq!(goals.shortfall(1e-12, 4, 0, 100), None);
+        let both = goals.shortfall(1e-6, 10, 3, 100).unwrap();
+        assert!(both.contains("1.000e-6 is above the tolerance 1e-10 after 10 iterations"));
+        assert!(both.contains("3 of 100 faces are self-intersecting"));
+        assert!(goals.shortfall(f64::NAN, 1, 0, 1).is_some());
+        let lax = PhexGoals {
+            planarity: None,
+            valid: false,
+        };
+        assert_eq!(lax.shortfall(f64::NAN, 0, 50, 100), None);
+    }
+}
