@@ -270,6 +270,7 @@ let recovering = false;
 
 async function restartSolver(message, isError) {
   playing = false;
+  running = false; // Step, Play and Stop wait for the restored state
   candidate = null;
   updateButtons();
   showStatus(`${viewer.backend} · ${message}`, isError);

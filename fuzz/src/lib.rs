@@ -109,10 +109,28 @@ pub fn mesh_file(data: &[u8]) {
 /// NaN and extremes), up to 8 segments, either mode, run to the end. Every input point must be a
 /// vertex of the result, at its exact position.
 pub fn hex_delaunay(data: &[u8]) {
-    let _ = hex_delaunay_input(&mut Unstructured::new(data));
+    let Ok((points, segments, mode)) = hex_delaunay_case(data) else {
+        return;
+    };
+    // A budget of 20 000 splits (about 120 000 triangles) keeps each input under a second.
+    let Ok(stepper) = HexDelaunayStepper::new(&points, &segments, mode) else {
+        return;
+    };
+    let mut stepper = stepper.with_max_splits(20_000);
+    if stepper.run_to_end().is_err() {
+        return;
+    }
+    let t = stepper.triangulation();
+    for (i, p) in points.iter().enumerate() {
+        let v = t.input_vertex[i] as usize;
+        assert_eq!(t.vertices[v], *p, "input point {i} is not an exact vertex");
+    }
 }
 
-fn hex_delaunay_input(u: &mut Unstructured) -> ArbitraryResult<()> {
+/// The points, segments and mode [`hex_delaunay`] reads from `data` (for looking at a failing
+/// input).
+pub fn hex_delaunay_case(data: &[u8]) -> ArbitraryResult<HexDelaunayCase> {
+    let u = &mut Unstructured::new(data);
     let mode = if u.arbitrary()? {
         HexDelaunayMode::Extended
     } else {
@@ -128,19 +146,11 @@ fn hex_delaunay_input(u: &mut Unstructured) -> ArbitraryResult<()> {
     for _ in 0..m {
         segments.push([u.int_in_range(0..=n + 1)?, u.int_in_range(0..=n + 1)?]);
     }
-    let Ok(mut stepper) = HexDelaunayStepper::new(&points, &segments, mode) else {
-        return Ok(());
-    };
-    if stepper.run_to_end().is_err() {
-        return Ok(());
-    }
-    let t = stepper.triangulation();
-    for (i, p) in points.iter().enumerate() {
-        let v = t.input_vertex[i] as usize;
-        assert_eq!(t.vertices[v], *p, "input point {i} is not an exact vertex");
-    }
-    Ok(())
+    Ok((points, segments, mode))
 }
+
+/// Input points, segments (point index pairs) and mode of a hexagonal Delaunay run.
+pub type HexDelaunayCase = (Vec<Vec2>, Vec<[usize; 2]>, HexDelaunayMode);
 
 /// A coordinate as people and programs write them: small integers and decimals mostly, with
 /// every f64 (NaN, infinities, subnormals, 1e300) reachable.

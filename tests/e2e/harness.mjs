@@ -37,6 +37,12 @@ export async function openPage({ webgpu = true, hash = '' } = {}) {
   const errors = [];
   page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
   page.on('pageerror', (e) => errors.push(String(e)));
+  // The page fetches nothing from anywhere but its own origin.
+  const origin = new URL(URL_BASE).origin;
+  page.on('request', (r) => {
+    const u = new URL(r.url());
+    if (!['data:', 'blob:'].includes(u.protocol) && u.origin !== origin) errors.push(`request outside the page's origin: ${r.url()}`);
+  });
   await page.goto(URL_BASE + hash);
   await page.waitForFunction(() => document.body.dataset.ready === 'true', null, { timeout: 90_000 });
   return { browser, page, errors };

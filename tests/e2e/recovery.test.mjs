@@ -18,6 +18,8 @@ test('a trap and an out-of-memory in the worker leave the page working', async (
       const before = await metrics(page);
       await page.evaluate((k) => window.dupin.fault(k), kind);
       await page.waitForFunction(() => /restarted at step 2/.test(document.querySelector('[data-testid=status]').textContent), null, { timeout: 60_000 });
+      // Step comes back with the restored state.
+      await page.waitForFunction(() => !document.querySelector('[data-testid=step]').disabled, null, { timeout: 60_000 });
       await waitSteps(page, 2);
       const after = await metrics(page);
       assert.equal(after.faces, before.faces, `${kind}: the restored state differs`);
@@ -48,6 +50,7 @@ test('Stop cancels a long computation and returns to the last state', async () =
     await byId(page, 'stop').click();
     await page.waitForFunction(() => /stopped; back at step/.test(document.querySelector('[data-testid=status]').textContent), null, { timeout: 10_000 });
     assert.ok(Date.now() - t0 < 5_000, `Stop took ${Date.now() - t0} ms`);
+    await page.waitForFunction(() => !document.querySelector('[data-testid=step]').disabled, null, { timeout: 180_000 });
     await page.waitForFunction((n) => Number(document.querySelector('[data-testid=metrics]').dataset.steps) >= n, Number(at.steps), { timeout: 180_000 });
     assert.notEqual((await metrics(page)).phase, 'done');
     assert.deepEqual(errors, []);

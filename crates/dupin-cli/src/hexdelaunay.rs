@@ -29,6 +29,10 @@ pub struct HexDelaunayArgs {
     /// JSON report file.
     #[arg(long)]
     report: Option<PathBuf>,
+    /// Most split hexagons the refinement may make (each adds about six triangles); a run
+    /// that needs more is refused (exit 2).
+    #[arg(long, default_value_t = dupin_core::hex_delaunay::MAX_SPLITS)]
+    max_splits: usize,
 }
 
 /// Runs the command.
@@ -47,6 +51,7 @@ pub fn run(args: HexDelaunayArgs) -> Result<(), CliError> {
     let mode = args.mode;
     let start = Instant::now();
     let tri = HexDelaunayStepper::new(&points, &segments, mode)
+        .map(|s| s.with_max_splits(args.max_splits))
         .and_then(Stepper::finish)
         .map_err(|e| CliError::input("", e))?;
     let seconds = start.elapsed().as_secs_f64();

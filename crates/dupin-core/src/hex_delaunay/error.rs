@@ -42,6 +42,17 @@ pub enum HexDelaunayError {
         /// The cap on full-hexagon levels.
         max_level: u32,
     },
+    /// The refinement would split more hexagons than its budget allows.
+    #[error(
+        "the refinement passes its limit of {limit} split hexagons (about {} triangles): points \
+         very close together relative to the extent of the set, above all near segments, need \
+         that many; space them out, or raise the limit (--max-splits) if this is intended",
+        6 * limit
+    )]
+    TooManySplits {
+        /// The cap on split hexagons.
+        limit: usize,
+    },
     /// A point inserted into an existing triangulation lies outside (or on) its bounding
     /// hexagon Ω.
     #[error("inserted point {index} lies outside the bounding hexagon")]

@@ -56,6 +56,8 @@ pub struct Hierarchy {
     pub max_level: u32,
     /// Number of split hexagons.
     pub split_count: usize,
+    /// The most split hexagons the refinement may make ([`super::MAX_SPLITS`] by default).
+    pub max_splits: usize,
 }
 
 /// Why [`Hierarchy::merge`] refused (section 3.2: a merge must leave a balanced hierarchy).
@@ -98,6 +100,7 @@ impl Hierarchy {
             per_level: vec![1],
             max_level,
             split_count: 1,
+            max_splits: super::MAX_SPLITS,
         }
     }
 
@@ -281,6 +284,11 @@ impl Hierarchy {
         if level >= self.max_level {
             return Err(HexDelaunayError::DepthLimit {
                 max_level: self.max_level,
+            });
+        }
+        if self.split_count >= self.max_splits {
+            return Err(HexDelaunayError::TooManySplits {
+                limit: self.max_splits,
             });
         }
         // Usually `v` and its neighbours are present already: one window read says so.

@@ -162,6 +162,12 @@ pub const MAX_COORDINATE: f64 = 1e100;
 pub const MIN_EXTENT: f64 = 1e-100;
 /// Cap on the full-hexagon levels of the hierarchy.
 pub const MAX_LEVEL: u32 = 48;
+/// Default cap on split hexagons, about 3 million triangles (each split adds about six; a few
+/// seconds and under a gigabyte natively). Points far closer together than their extent, with
+/// segments, can ask for tens of millions; the refinement stops there with
+/// [`HexDelaunayError::TooManySplits`] instead ([`HexDelaunayStepper::with_max_splits`]
+/// raises it).
+pub const MAX_SPLITS: usize = 500_000;
 
 /// Triangulates `points` and the segments `segments` (each a pair of point indices; they may
 /// share endpoints but not cross or overlap) by hexagonal subdivision: [`HexDelaunayStepper`]

@@ -94,6 +94,14 @@ impl HexDelaunayStepper {
         Ok(s)
     }
 
+    /// The same run with at most `max_splits` split hexagons (default [`super::MAX_SPLITS`];
+    /// each adds about six triangles); a step that would pass it fails with
+    /// [`HexDelaunayError::TooManySplits`].
+    pub fn with_max_splits(mut self, max_splits: usize) -> Self {
+        self.refinement.hierarchy.max_splits = max_splits;
+        self
+    }
+
     /// Like [`new`](Self::new) but triangulating a given bounding hexagon Ω (centre `center`,
     /// inradius `inradius`, corners at 30° + 60° i) instead of the one derived from the points'
     /// enclosing circle, as the paper's "two close points in a unit hexagon" benchmark does.
