@@ -39,9 +39,9 @@ pub fn serve_forever(listener: TcpListener, dir: PathBuf) {
 
 /// The page loads everything from its own origin: scripts and the wasm module ('wasm-unsafe-eval'
 /// lets WebAssembly compile, nothing else evaluates strings), its worker, styles and data or blob
-/// images (snapshots); no plugin, no frame, no form target, no base URL from outside.
+/// images and reads (snapshots); no plugin, no frame, no form target, no base URL from outside.
 const CSP: &str = "default-src 'self'; script-src 'self' 'wasm-unsafe-eval'; worker-src 'self'; \
-                   connect-src 'self'; img-src 'self' data: blob:; style-src 'self'; \
+                   connect-src 'self' data: blob:; img-src 'self' data: blob:; style-src 'self'; \
                    object-src 'none'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'";
 
 fn handle(mut stream: TcpStream, dir: &Path) -> std::io::Result<()> {

@@ -34,7 +34,7 @@ pub use picking::{VertexPick, VertexStarError, pick_vertex, vertex_ring};
 pub use planarity::{
     PLANARITY_HIST_BINS, PLANARITY_HIST_HI, PLANARITY_HIST_LO, face_planarities, face_planarity,
     flipped_faces, least_squares_plane, max_planarity, mean_planarity, planarity_histogram,
-    plane_basis,
+    plane_basis, representable_planarity,
 };
 pub use polygon::{PolygonError, is_simple_polygon, segments_intersect, strictly_inside_triangle};
 pub use polymesh::{MeshError, PolyMesh};

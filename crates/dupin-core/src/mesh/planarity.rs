@@ -137,6 +137,23 @@ pub fn max_planarity(mesh: &PolyMesh) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The planarity f64 coordinates can hold: their spacing at the mesh's largest coordinate over
+/// its mean edge. A design far from the origin (state-plane coordinates of 1e7 m with 1.5 m
+/// panels: 1.2e-9) cannot be planar much below this, whatever the solver does.
+pub fn representable_planarity(mesh: &PolyMesh) -> f64 {
+    let magnitude = mesh
+        .positions
+        .iter()
+        .map(|p| p.x.abs().max(p.y.abs()).max(p.z.abs()))
+        .fold(0.0, f64::max);
+    let edge = mesh.mean_edge();
+    if edge > 0.0 {
+        f64::EPSILON * magnitude / edge
+    } else {
+        0.0
+    }
+}
+
 /// [`face_planarity`] of every face of `mesh`, in face order.
 pub fn face_planarities(mesh: &PolyMesh) -> Vec<f64> {
     (0..mesh.num_faces())

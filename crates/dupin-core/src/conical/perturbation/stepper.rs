@@ -9,6 +9,7 @@ use crate::conical::conical_residual;
 use crate::mesh::MeshTopology;
 use crate::mesh::PolyMesh;
 use crate::mesh::max_planarity;
+use crate::mesh::representable_planarity;
 use crate::solver::{LevenbergMarquardt, LmOptions, LmStep, Sqp, SqpOptions};
 use crate::{Stepper, Vec3};
 use std::convert::Infallible;
@@ -327,10 +328,19 @@ impl PqPerturbation {
             self.converged = true;
         } else if self.iteration >= self.options.max_iterations {
             self.phase = PqPhase::Done;
-            self.reason = Some(format!(
+            let mut reason = format!(
                 "iteration cap {} reached (max_planarity {:.3e}, mode residual {:.3e})",
                 self.options.max_iterations, self.last.0, self.last.1
-            ));
+            );
+            let floor = representable_planarity(&self.mesh);
+            if floor > 0.1 * self.options.tolerance {
+                reason.push_str(&format!(
+                    "; the coordinates' precision at this distance from the origin allows \
+                     planarity of about {floor:.1e} only: move the design near the origin \
+                     (subtract a reference point, add it back after)"
+                ));
+            }
+            self.reason = Some(reason);
         } else if self.phase == PqPhase::Penalty {
             if self.iteration >= self.options.penalty_iterations
                 || self.last.0.max(self.last.1) < 1e-4
@@ -441,6 +451,32 @@ mod tests {
             r.iterations, r.converged, r.max_planarity, r.max_move, r.reason
         );
         r
+    }
+
+    /// A design 1e7 from the origin with edges of about 0.1 cannot be planar to 1e-10 in f64:
+    /// the run ends not converged, and its reason says why and what to do; the same mesh at the
+    /// origin converges.
+    #[test]
+    fn far_from_the_origin_the_reason_names_the_coordinate_precision() {
+        let near = skew_quad_grid(6, 20.0);
+        let mut far = near.clone();
+        for p in &mut far.positions {
+            *p += Vec3::new(1e7, -1e7, 1e7);
+        }
+        let options = PqOptions {
+            max_iterations: 20,
+            ..PqOptions::default()
+        };
+        assert!(run(&near, options.clone()).converged);
+        let r = run(&far, options);
+        assert!(!r.converged);
+        let reason = r.reason.unwrap();
+        assert!(
+            reason.contains("precision") && reason.contains("near the origin"),
+            "{reason}"
+        );
+        assert!(representable_planarity(&far) > 1e-10);
+        assert!(representable_planarity(&near) < 1e-14);
     }
 
     /// The exact phase is a Newton-KKT (SQP) iteration on the constraints (see
