@@ -877,19 +877,24 @@ mod tests {
         );
     }
 
+    /// A free-mode torus session of `cfg`, as `new Session({ surface: "torus", ... })` makes it.
+    fn torus_session(cfg: PhexConfig) -> Session {
+        let goals = PhexGoals::of(&cfg, true);
+        Session {
+            run: Run::Phex(Box::new(PhexPipeline::new(cfg).unwrap()), goals),
+            config: serde_json::from_str(r#"{"surface": "torus"}"#).unwrap(),
+            per_face: None,
+            layers: LayerConfig::default(),
+        }
+    }
+
     /// A finished run that misses what it was asked ends in `warning` with the reason, never
     /// `done`: the free-mode torus at panel size 0.2 ends with self-intersecting faces.
     #[test]
     fn a_missed_result_ends_in_warning_not_done() {
         let cfg =
             PhexConfig::for_surface("torus", &[], TriangulationMethod::Progressive, Some(0.2));
-        let goals = PhexGoals::of(&cfg, true);
-        let mut session = Session {
-            run: Run::Phex(Box::new(PhexPipeline::new(cfg).unwrap()), goals),
-            config: serde_json::from_str(r#"{"surface": "torus"}"#).unwrap(),
-            per_face: None,
-            layers: LayerConfig::default(),
-        };
+        let mut session = torus_session(cfg);
         while !session.done() {
             assert_ne!(session.metrics_struct().phase, "warning");
             session.advance().unwrap();
@@ -907,13 +912,7 @@ mod tests {
         let mut cfg =
             PhexConfig::for_surface("torus", &[], TriangulationMethod::Prescribed, Some(0.6));
         cfg.initialisation = dupin_core::phex::Initialisation::DupinDuality;
-        let goals = PhexGoals::of(&cfg, true);
-        let mut session = Session {
-            run: Run::Phex(Box::new(PhexPipeline::new(cfg).unwrap()), goals),
-            config: serde_json::from_str(r#"{"surface": "torus"}"#).unwrap(),
-            per_face: None,
-            layers: LayerConfig::default(),
-        };
+        let mut session = torus_session(cfg);
         let mut optimised = 0;
         while !session.done() {
             session.advance().unwrap();
