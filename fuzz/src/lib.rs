@@ -112,11 +112,11 @@ pub fn hex_delaunay(data: &[u8]) {
     let Ok((points, segments, mode)) = hex_delaunay_case(data) else {
         return;
     };
-    // A budget of 20 000 splits (about 120 000 triangles) keeps each input under a second.
+    // A budget of 5 000 splits (about 30 000 triangles) keeps each input in milliseconds.
     let Ok(stepper) = HexDelaunayStepper::new(&points, &segments, mode) else {
         return;
     };
-    let mut stepper = stepper.with_max_splits(20_000);
+    let mut stepper = stepper.with_max_splits(5_000);
     if stepper.run_to_end().is_err() {
         return;
     }
