@@ -11,6 +11,7 @@ use super::{ImportError, ImportOptions};
 use crate::Vec3;
 use crate::mesh::PolyMesh;
 use base64::Engine as _;
+use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 use nalgebra::Matrix4;
 use std::collections::HashMap;
@@ -103,6 +104,19 @@ fn add_mesh(
         ) {
             continue;
         }
+        if let Some(a) = prim.get(&gltf::Semantic::Positions) {
+            check_accessor(
+                &a,
+                Dimensions::Vec3,
+                &[DataType::F32],
+                mesh.index(),
+                "POSITION",
+            )?;
+        }
+        if let Some(a) = prim.indices() {
+            let types = [DataType::U8, DataType::U16, DataType::U32];
+            check_accessor(&a, Dimensions::Scalar, &types, mesh.index(), "indices")?;
+        }
         let reader = prim.reader(|b| data.get(b.index()).map(Vec::as_slice));
         let Some(positions) = reader.read_positions() else {
             continue;
@@ -182,6 +196,44 @@ fn check_glb_header(bytes: &[u8]) -> Result<(), ImportError> {
                 "the GLB header gives a total length of {length} bytes, less than the header's 12"
             ),
         });
+    }
+    Ok(())
+}
+
+/// The shape glTF 2.0 (section 3.7.2.1) requires of a primitive's POSITION (VEC3 of FLOAT) and
+/// indices (SCALAR of unsigned integers), a buffer-view stride of at least one element and a
+/// sparse count of at least one: gltf's readers assume them (debug assertions, and a
+/// `count - 1` on sparse accessors), found by fuzzing.
+fn check_accessor(
+    a: &gltf::Accessor<'_>,
+    dimensions: Dimensions,
+    types: &[DataType],
+    mesh: usize,
+    what: &str,
+) -> Result<(), ImportError> {
+    let fail = |problem: String| ImportError::Syntax {
+        format: FORMAT,
+        message: format!("mesh {mesh}: {what} accessor {}: {problem}", a.index()),
+    };
+    if a.dimensions() != dimensions || !types.contains(&a.data_type()) {
+        return Err(fail(format!(
+            "is {:?} of {:?}, glTF 2.0 requires {dimensions:?} of {types:?}",
+            a.dimensions(),
+            a.data_type()
+        )));
+    }
+    if let Some(stride) = a.view().and_then(|v| v.stride())
+        && stride < a.size()
+    {
+        return Err(fail(format!(
+            "its buffer view's stride {stride} is shorter than one element ({} bytes)",
+            a.size()
+        )));
+    }
+    if let Some(sparse) = a.sparse()
+        && sparse.count() == 0
+    {
+        return Err(fail("a sparse accessor with count 0".into()));
     }
     Ok(())
 }
