@@ -201,9 +201,9 @@ fn check_glb_header(bytes: &[u8]) -> Result<(), ImportError> {
 }
 
 /// The shape glTF 2.0 (section 3.7.2.1) requires of a primitive's POSITION (VEC3 of FLOAT) and
-/// indices (SCALAR of unsigned integers), a buffer-view stride of at least one element and a
-/// sparse count of at least one: gltf's readers assume them (debug assertions, and a
-/// `count - 1` on sparse accessors), found by fuzzing.
+/// indices (SCALAR of unsigned integers), counts of at least one, a buffer-view stride of at
+/// least one element, elements inside their view: gltf's readers assume them (debug assertions
+/// and unchecked `count - 1` and `stride * count`), found by fuzzing.
 fn check_accessor(
     a: &gltf::Accessor<'_>,
     dimensions: Dimensions,
@@ -222,13 +222,31 @@ fn check_accessor(
             a.data_type()
         )));
     }
-    if let Some(stride) = a.view().and_then(|v| v.stride())
-        && stride < a.size()
-    {
-        return Err(fail(format!(
-            "its buffer view's stride {stride} is shorter than one element ({} bytes)",
-            a.size()
-        )));
+    if a.count() == 0 {
+        return Err(fail("count 0 (glTF 2.0 requires at least 1)".into()));
+    }
+    if let Some(view) = a.view() {
+        let stride = view.stride().unwrap_or(a.size());
+        if stride < a.size() {
+            return Err(fail(format!(
+                "its buffer view's stride {stride} is shorter than one element ({} bytes)",
+                a.size()
+            )));
+        }
+        // The last element's end, computed without overflow, must lie inside the view.
+        let end = (a.count() - 1)
+            .checked_mul(stride)
+            .and_then(|x| x.checked_add(a.size()))
+            .and_then(|x| x.checked_add(a.offset()));
+        if end.is_none_or(|e| e > view.length()) {
+            return Err(fail(format!(
+                "{} elements of {} bytes from offset {} do not fit its buffer view of {} bytes",
+                a.count(),
+                stride,
+                a.offset(),
+                view.length()
+            )));
+        }
     }
     if let Some(sparse) = a.sparse()
         && sparse.count() == 0
