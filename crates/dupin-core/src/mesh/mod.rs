@@ -6,6 +6,7 @@
 //! | concept | file |
 //! |---|---|
 //! | compact polygon mesh | `polymesh.rs` |
+//! | the solvers' coordinates: centred, power-of-two scaled | `frame.rs` |
 //! | halfedges, manifold and orientation checks | `topology.rs` |
 //! | least-squares plane, `max_planarity` (contract), mean and histogram of planarity | `planarity.rs` |
 //! | face colour maps: planarity, convexity, regularity (P-Hex secs. 4.1, 4.2) and legend stops | `colors.rs` |
@@ -16,6 +17,7 @@
 //! | Catmull-Clark, Doo-Sabin, Chaikin, Lane-Riesenfeld (conical paper, sec. 3) | `subdivision/` |
 
 mod colors;
+mod frame;
 pub mod io;
 mod picking;
 mod planarity;
@@ -29,6 +31,7 @@ pub use colors::{
     CONVEX, ColorMode, ColorModeError, INVALID, NONCONVEX, NOT_HEX, PLANARITY_LEGEND_LOG10,
     REGULARITY_LEGEND, convexity_color, planarity_color, regularity_color,
 };
+pub use frame::SolverFrame;
 pub use io::{ObjError, PointSetError, parse_obj, parse_points, parse_segments, write_obj};
 pub use picking::{VertexPick, VertexStarError, pick_vertex, vertex_ring};
 pub use planarity::{
