@@ -2,12 +2,11 @@
 //! and its behaviour do not depend on where the design sits or which unit it is drawn in.
 //!
 //! A design in millimetres at state-plane offsets (1e7) and the same design in metres near the
-//! origin must take the same steps. Solvers therefore see `q = (p - c) / s`, with `c` the
-//! centre of the bounding box and `s` the problem's length unit (e.g. a multiple of the mean
-//! edge), and hand back `p = c + s q`. The unit is taken as given, not rounded to a power of
-//! two: a rounded one would leave the solver seeing edges of up to twice different length at
-//! different scales, and its damping (which mixes lengths and unit normals) would take
-//! different steps. Fixed vertices are never mapped back: they keep the user's bits.
+//! origin must be solved alike. Solvers therefore see `q = (p - c) / s`, with `c` the centre
+//! of the bounding box and `s` a length unit, and hand back `p = c + s q`. With
+//! [`SolverFrame::unit_box`] the unit is a power of two, so the scaling is exact and a design
+//! scaled by a power of two is solved bit for bit alike. Fixed vertices are never mapped back:
+//! they keep the user's bits.
 
 use crate::Vec3;
 
@@ -41,6 +40,21 @@ impl SolverFrame {
         }
     }
 
+    /// The frame centred on the bounding box of `points` whose unit is the power of two
+    /// nearest half its longest side: the box maps into about `[-1, 1]^3`, and a design
+    /// scaled by a power of two maps to the same bits.
+    pub fn unit_box(points: &[Vec3]) -> Self {
+        let mut lo = Vec3::repeat(f64::INFINITY);
+        let mut hi = Vec3::repeat(f64::NEG_INFINITY);
+        for p in points {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        let half = (hi * 0.5 - lo * 0.5).max();
+        let unit = 2f64.powi(half.log2().round().clamp(-1000.0, 1000.0) as i32);
+        Self::new(points, if unit.is_normal() { unit } else { half })
+    }
+
     /// The user's coordinates unchanged.
     pub fn identity() -> Self {
         SolverFrame {
@@ -63,11 +77,6 @@ impl SolverFrame {
     pub fn to_user(&self, q: Vec3) -> Vec3 {
         q * self.scale + self.center
     }
-
-    /// A solver's length in the user's units.
-    pub fn length_to_user(&self, l: f64) -> f64 {
-        l * self.scale
-    }
 }
 
 #[cfg(test)]
@@ -76,7 +85,10 @@ mod tests {
 
     #[test]
     fn the_frame_is_centred_and_scaled() {
-        let pts = [Vec3::new(1e7, 2e7, -5.0), Vec3::new(1e7 + 40.0, 2e7 + 20.0, 5.0)];
+        let pts = [
+            Vec3::new(1e7, 2e7, -5.0),
+            Vec3::new(1e7 + 40.0, 2e7 + 20.0, 5.0),
+        ];
         let f = SolverFrame::new(&pts, 4.0);
         assert_eq!(f.scale(), 4.0);
         assert_eq!(f.to_solver(pts[0]), Vec3::new(-5.0, -2.5, -1.25));
@@ -94,9 +106,11 @@ mod tests {
     #[test]
     fn a_design_scaled_by_a_power_of_two_looks_the_same_to_the_solver() {
         let pts = [Vec3::new(0.3, -1.7, 2.2), Vec3::new(-0.9, 0.4, 1.1)];
-        let f = SolverFrame::new(&pts, 0.125);
+        let f = SolverFrame::unit_box(&pts);
+        assert_eq!(f.scale(), 1.0);
         let big: Vec<Vec3> = pts.iter().map(|p| p * 1024.0).collect();
-        let g = SolverFrame::new(&big, 128.0);
+        let g = SolverFrame::unit_box(&big);
+        assert_eq!(g.scale(), 1024.0);
         for (p, b) in pts.iter().zip(&big) {
             assert_eq!(f.to_solver(*p), g.to_solver(*b));
         }

@@ -72,6 +72,8 @@ pub struct PqPerturbation {
     /// The same mesh in the solver's frame, where the problem is posed.
     work: PolyMesh,
     frame: SolverFrame,
+    /// The input positions, for the displacement reported at the end.
+    input: Vec<Vec3>,
     topo: MeshTopology,
     terms: Terms,
     options: PqOptions,
@@ -171,13 +173,11 @@ impl PqPerturbation {
     pub fn new(mesh: &PolyMesh, options: PqOptions) -> Result<Self, PqError> {
         check_options(&options)?;
         let topo = MeshTopology::new(mesh)?;
-        // Posed in a centred frame whose unit is twice the mean edge: the same steps for a
-        // design in any unit and at any distance from the origin. The unit sets how the
-        // damping weighs vertex moves against plane normals. Measured on the benchmark meshes
-        // (factorisations with the probe) for units of 1, 2, 4 and 8 mean edges rounded to
-        // powers of two: torus dual 5/4/3/3, skew grid 24/20/20/25, noisy vase 3/3/7/7 (its
-        // max_move 0.37/0.37/1.10/1.02 mean edges); 16 leaves the noisy vase unconverged.
-        let frame = SolverFrame::new(&mesh.positions, 2.0 * mesh.mean_edge());
+        // Posed in a centred frame scaled by a power of two to the unit box: a design at any
+        // distance from the origin, and in any unit, is solved as the same design near the
+        // origin at a size in (0.7, 1.4], where the solver's settings were tuned (its damping
+        // weighs vertex moves in lengths against unit normals, so the size matters).
+        let frame = SolverFrame::unit_box(&mesh.positions);
         let mut work = mesh.clone();
         for p in &mut work.positions {
             *p = frame.to_solver(*p);
@@ -190,6 +190,7 @@ impl PqPerturbation {
             mesh: mesh.clone(),
             work,
             frame,
+            input: mesh.positions.clone(),
             topo,
             terms,
             w_fair: o.fairness,
@@ -440,14 +441,13 @@ impl Stepper for PqPerturbation {
     /// Runs to the end and returns the result (the best mesh reached when not converged).
     fn finish(mut self) -> Result<PqResult, Infallible> {
         self.run_to_end()?;
-        let max_move = self.frame.length_to_user(
-            self.work
-                .positions
-                .iter()
-                .zip(&self.terms.positions0)
-                .map(|(a, b)| (a - b).norm())
-                .fold(0.0, f64::max),
-        );
+        let max_move = self
+            .mesh
+            .positions
+            .iter()
+            .zip(&self.input)
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f64::max);
         let factorizations = self.factorizations();
         Ok(PqResult {
             conical_residual: (self.options.mode == PqMode::Conical).then_some(self.last.1),
@@ -511,11 +511,11 @@ mod tests {
 
     /// The exact phase is a Newton-KKT (SQP) iteration on the constraints (see
     /// [`Refinement::GaussNewton`]): once the constraint residual is small its Newton steps
-    /// converge quadratically, r_{k+1} <= r_k^1.5 at every step below 5e-3 (measured: skew
-    /// grid 10x10 5.9e-3 -> 1.6e-5, 4.1e-8 -> 1.7e-14; torus dual 5.9e-5 -> 1.6e-9), and once
-    /// they contract by [`CHORD_RATE`] the chord steps that follow (no factorisation) keep
-    /// contracting at about that rate (skew grid 1.6e-5, 6.4e-7, 4.1e-8; torus dual 4.7e-4,
-    /// 5.9e-5 and 1.6e-9, 5.6e-14).
+    /// converge quadratically, r_{k+1} <= r_k^1.5 at every step below 3e-2 (measured: skew
+    /// grid 10x10 1.8e-2, 6.3e-4, 7.1e-6; torus dual 2.8e-2, 3.1e-4), and once they contract
+    /// by [`CHORD_RATE`] the chord steps that follow (no factorisation) keep contracting at
+    /// about that rate (torus dual 3.1e-4, 1.9e-5, 2.0e-7, 5.4e-9, 1.5e-10, 3.3e-12: 5 chord
+    /// steps instead of a second and third factorisation).
     #[test]
     fn exact_phase_converges_quadratically() {
         for (name, m) in [
@@ -545,21 +545,21 @@ mod tests {
                 result.factorizations < result.iterations,
                 "{name}: no chord step"
             );
-            let fast: Vec<_> = newton.iter().filter(|&&(a, _)| a < 5e-3).collect();
+            let fast: Vec<_> = newton.iter().filter(|&&(a, _)| a < 3e-2).collect();
             assert!(!fast.is_empty(), "{name}: {newton:?}");
             for &&(a, b) in &fast {
                 assert!(b <= a.powf(1.5), "{name}: {a:e} -> {b:e} not superlinear");
             }
             assert!(!chord.is_empty(), "{name}");
             for &(a, b) in &chord {
-                assert!(b <= 0.2 * a, "{name}: chord step {a:e} -> {b:e}");
+                assert!(b <= 0.1 * a, "{name}: chord step {a:e} -> {b:e}");
             }
         }
     }
 
     /// The probe after the first penalty iteration (`PROBE_CONTRACTION`): kept on the torus
-    /// dual and the noisy conical vase (one penalty factorisation instead of four, the exact
-    /// phase converges from there), discarded on the skew grid, where the run is then
+    /// dual (one penalty factorisation instead of four, the exact phase converges from
+    /// there), discarded on the skew grid and the noisy conical vase, where the run is then
     /// exactly one without a probe (same penalty settings, same mesh at the end of the
     /// penalty phase and at the end, bit for bit) at the price of one factorisation.
     #[test]
@@ -581,7 +581,7 @@ mod tests {
                 PqOptions::default(),
                 false,
             ),
-            ("noisy vase", noisy_vase(30), conical, true),
+            ("noisy vase", noisy_vase(30), conical, false),
         ] {
             let run = |probe: bool| {
                 let mut s = PqPerturbation::new(&m, options.clone()).unwrap();
@@ -606,12 +606,12 @@ mod tests {
             let (penalty, probed_penalty, probed) = run(true);
             let (penalty_without, without_penalty, without) = run(false);
             assert!(probed.converged && without.converged, "{name}");
-            assert!(penalty_without >= 4, "{name}");
+            assert_eq!(penalty_without, 4, "{name}");
             if kept {
                 assert_eq!(penalty, 1, "{name}");
-                assert!(probed.factorizations + 1 < without.factorizations, "{name}");
+                assert!(probed.factorizations + 2 < without.factorizations, "{name}");
             } else {
-                assert_eq!(penalty, penalty_without, "{name}");
+                assert_eq!(penalty, 4, "{name}");
                 assert!(probed_penalty.is_some(), "{name}");
                 assert_eq!(probed_penalty, without_penalty, "{name}");
                 assert_eq!(probed.factorizations, without.factorizations + 1, "{name}");
@@ -620,15 +620,38 @@ mod tests {
         }
     }
 
-    /// The solver works in a centred frame scaled to the mesh (`SolverFrame`): the same
-    /// design from 1e-6 to 1e6 in size and at state-plane offsets (1e7) takes the same
-    /// iterations to the same shape, planar to the tolerance in the user's coordinates.
-    /// Before, the skew grid stalled at some scales and took 17-31 iterations at others.
+    /// The solver works in a centred frame scaled by a power of two to the unit box
+    /// (`SolverFrame::unit_box`): a design scaled by a power of two takes exactly the same
+    /// steps, and at any size from 1e-6 to 1e6 and at state-plane offsets (1e7) it ends
+    /// planar to the tolerance in the user's coordinates, with moves in proportion to its
+    /// size. Between powers of two the steps differ as the solver sees the design at a size
+    /// in (0.7, 1.4] (measured: 10-17 iterations, max_move 0.33-0.44 of the scale). Before,
+    /// this grid stalled at some sizes and took 17-31 iterations at others.
     #[test]
     fn planarisation_is_free_of_scale_and_offset() {
         let base = skew_quad_grid(20, 30.0);
         let reference = run(&base, PqOptions::default());
         assert!(reference.converged);
+        let scaled = |scale: f64, offset: f64| {
+            let mut m = base.clone();
+            for p in &mut m.positions {
+                *p = *p * scale + Vec3::repeat(offset);
+            }
+            (m.clone(), run(&m, PqOptions::default()))
+        };
+        for scale in [
+            0.5f64.powi(20),
+            0.5f64.powi(7),
+            2f64.powi(10),
+            2f64.powi(20),
+        ] {
+            let (_, r) = scaled(scale, 0.0);
+            assert_eq!(r.iterations, reference.iterations, "scale {scale:e}");
+            assert_eq!(r.factorizations, reference.factorizations);
+            for (p, q) in r.mesh.positions.iter().zip(&reference.mesh.positions) {
+                assert_eq!(p / scale, *q, "scale {scale:e}");
+            }
+        }
         for (scale, offset) in [
             (1e-6, 0.0),
             (1e-3, 0.0),
@@ -638,26 +661,23 @@ mod tests {
             (1e4, 1e7),
             (1e6, -1e7),
         ] {
-            let mut m = base.clone();
-            for p in &mut m.positions {
-                *p = *p * scale + Vec3::repeat(offset);
-            }
-            let r = run(&m, PqOptions::default());
+            let (m, r) = scaled(scale, offset);
             let at = format!("scale {scale:e}, offset {offset:e}");
             assert!(r.converged, "{at}: {:?}", r.reason);
             assert!(max_planarity(&r.mesh) <= 1e-11, "{at}");
-            assert_eq!(r.iterations, reference.iterations, "{at}");
-            assert_eq!(r.factorizations, reference.factorizations, "{at}");
+            assert!(r.iterations <= 2 * reference.iterations, "{at}");
+            let relative_move = r.max_move / scale / reference.max_move;
             assert!(
-                (r.max_move / scale - reference.max_move).abs() <= 1e-6 * reference.max_move,
-                "{at}: {} vs {}",
-                r.max_move / scale,
-                reference.max_move
+                (0.75..1.33).contains(&relative_move),
+                "{at}: {relative_move}"
             );
-            for (p, q) in r.mesh.positions.iter().zip(&reference.mesh.positions) {
-                let back = (p - Vec3::repeat(offset)) / scale;
-                assert!((back - q).norm() <= 1e-6, "{at}");
-            }
+            let moved = m
+                .positions
+                .iter()
+                .zip(&r.mesh.positions)
+                .map(|(a, b)| (a - b).norm())
+                .fold(0.0, f64::max);
+            assert_eq!(moved, r.max_move, "{at}");
         }
     }
 
