@@ -325,12 +325,15 @@ impl PqPerturbation {
         match outcome {
             Ok(()) => {
                 let old = std::mem::replace(&mut self.x, x);
+                // The positions themselves, not `old` mapped again: the input's user
+                // coordinates need not survive a round trip through the frame.
+                let old_positions = (self.mesh.positions.clone(), self.work.positions.clone());
                 self.sync_mesh();
                 self.last = self.measures();
                 // Keep the best mesh: reject a step that made both measures worse.
                 if self.last.0.max(self.last.1) > 10.0 * before.0.max(before.1) {
                     self.x = old;
-                    self.sync_mesh();
+                    (self.mesh.positions, self.work.positions) = old_positions;
                     self.last = before;
                 }
             }
