@@ -37,6 +37,12 @@ pub struct PlanarizeArgs {
     /// Initial closeness weight (>= 0).
     #[arg(long, default_value_t = 0.01, allow_hyphen_values = true)]
     pub closeness: f64,
+    /// Make a fair mesh rather than keep the design: the paper's fairness of the mesh itself
+    /// (which also straightens boundaries and pulls corners in) and its step metric, as for
+    /// the `pq` scenes. By default the design is kept: fairness smooths the move from the
+    /// input and steps turn face planes rather than slide vertices.
+    #[arg(long)]
+    pub fair_mesh: bool,
     /// Iteration cap.
     #[arg(long, default_value_t = 100)]
     pub max_iterations: usize,
@@ -77,6 +83,7 @@ pub fn run(args: PlanarizeArgs) -> Result<(), CliError> {
         },
         fix_boundary: args.fix_boundary,
         closeness: args.closeness,
+        keep_design: !args.fair_mesh,
         max_iterations: args.max_iterations,
         tolerance: args.tolerance,
         ..PqOptions::default()

@@ -35,6 +35,12 @@ pub(crate) trait BlockLeastSquares {
     }
     /// Fills `out` (cleared by the caller) with r(x) and its block Jacobian at `x`.
     fn evaluate(&self, x: &[f64], out: &mut BlockSystem) -> Result<(), SolverError>;
+    /// Relative damping weight of every variable (all 1 by default): the metric in which a
+    /// damped step is short. Variables of different units (lengths and unit normals) need
+    /// weights that make their moves comparable.
+    fn damping_weights(&self) -> Option<&[f64]> {
+        None
+    }
 }
 
 /// A scalar [`NonlinearLeastSquares`] seen as blocks of one unknown (with its
@@ -253,6 +259,11 @@ impl LevenbergMarquardt {
             } else {
                 scale
             };
+        }
+        if let Some(w) = problem.damping_weights() {
+            for (v, w) in diag.iter_mut().zip(w) {
+                *v *= w;
+            }
         }
         Ok((g, diag))
     }

@@ -37,6 +37,11 @@ pub(super) struct Terms {
     pub(super) normals0: Vec<Vec3>,
     pub(super) positions0: Vec<Vec3>,
     pub(super) scale: f64,
+    /// [`PqOptions::keep_design`].
+    pub(super) keep_design: bool,
+    /// Per variable (with `keep_design`): 1 for positions and plane offsets, L² for the unit
+    /// normals.
+    pub(super) damping_weights: Vec<f64>,
 }
 
 /// The penalty and constraint rows of one iteration: the mesh, its unknowns and the current
@@ -247,6 +252,11 @@ impl Problem<'_> {
                 for &(v, c) in st {
                     val += c * self.pos(x, v);
                 }
+                if t.keep_design {
+                    for &(v, c) in st {
+                        val -= c * t.positions0[v as usize];
+                    }
+                }
                 for k in 0..3 {
                     out.axis_row(s * val[k], k as u8);
                     for &(v, c) in st {
@@ -306,6 +316,14 @@ impl Problem<'_> {
         }
     }
 
+    /// A step's metric with [`PqOptions::keep_design`]: a plane normal's change weighs as the
+    /// move of points at the mean edge's distance.
+    fn damping_weights(&self) -> Option<&[f64]> {
+        self.terms
+            .keep_design
+            .then_some(self.terms.damping_weights.as_slice())
+    }
+
     /// The 4 plane unknowns of a face are seen by that face's plane residuals only: the
     /// solver eliminates them and factors a matrix on the vertex unknowns. Done for quad
     /// meshes only: eliminating the plane of an n-gon couples all its 3n vertex unknowns,
@@ -325,6 +343,9 @@ impl BlockLeastSquares for Problem<'_> {
     }
     fn local_from(&self) -> usize {
         Problem::local_from(self)
+    }
+    fn damping_weights(&self) -> Option<&[f64]> {
+        Problem::damping_weights(self)
     }
     fn evaluate(&self, x: &[f64], out: &mut BlockSystem) -> Result<(), SolverError> {
         self.penalty(
@@ -403,6 +424,9 @@ impl BlockLeastSquares for Feasibility<'_, '_> {
     fn local_from(&self) -> usize {
         self.0.local_from()
     }
+    fn damping_weights(&self) -> Option<&[f64]> {
+        self.0.damping_weights()
+    }
     fn evaluate(&self, x: &[f64], out: &mut BlockSystem) -> Result<(), SolverError> {
         self.0.constraint_rows(
             x,
@@ -452,7 +476,16 @@ impl Terms {
         let (stencil_start, stencil) = fairness_stencils(topo, &used);
         let scale = mean_edge_length(mesh, topo);
         let x = start_values(mesh, &var_of, &plane_of, plane_init, num_vars);
+        let mut damping_weights = vec![1.0; if o.keep_design { num_vars } else { 0 }];
+        for &pb in plane_of.iter().filter(|_| o.keep_design) {
+            if pb != NONE {
+                for k in 0..3 {
+                    damping_weights[pb as usize + k] = scale * scale;
+                }
+            }
+        }
         let terms = Terms {
+            damping_weights,
             plane_of,
             first_plane,
             centers,
@@ -470,6 +503,7 @@ impl Terms {
             normals0,
             positions0: mesh.positions.clone(),
             scale,
+            keep_design: o.keep_design,
         };
         Ok((terms, x))
     }
