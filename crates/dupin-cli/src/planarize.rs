@@ -99,6 +99,8 @@ pub fn run(args: PlanarizeArgs) -> Result<(), CliError> {
         "faces": result.mesh.num_faces(),
         "max_planarity": result.max_planarity,
         "max_move": result.max_move,
+        "max_normal_move": result.max_normal_move,
+        "max_tangential_move": result.max_tangential_move,
         "iterations": result.iterations,
         "seconds": seconds,
         "converged": result.converged,

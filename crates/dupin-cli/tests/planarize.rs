@@ -68,11 +68,21 @@ fn planarizes_a_skew_grid_and_reports_exact_fields() {
         "faces",
         "max_planarity",
         "max_move",
+        "max_normal_move",
+        "max_tangential_move",
         "iterations",
         "seconds",
     ] {
         assert!(r.get(key).is_some(), "missing {key}");
     }
+    // The move splits into its parts along and across the input's normals.
+    let (all, normal, tangential) = (
+        r["max_move"].as_f64().unwrap(),
+        r["max_normal_move"].as_f64().unwrap(),
+        r["max_tangential_move"].as_f64().unwrap(),
+    );
+    assert!(normal > 0.0 && normal <= all && tangential <= all, "{r}");
+    assert!(all <= (normal * normal + tangential * tangential).sqrt() * (1.0 + 1e-12));
     assert_eq!(r["faces"], 36);
     assert_eq!(r["vertices"], 49);
     assert!(r["max_planarity"].as_f64().unwrap() <= 1e-10);

@@ -58,6 +58,12 @@ pub struct PqResult {
     pub circular_residual: Option<f64>,
     /// Largest vertex displacement from the input.
     pub max_move: f64,
+    /// Largest vertex displacement along the input's vertex normal (area-weighted): how far
+    /// the design's surface moved.
+    pub max_normal_move: f64,
+    /// Largest vertex displacement across the input's vertex normal: how far a vertex slid
+    /// along the design's surface.
+    pub max_tangential_move: f64,
     /// Sparse factorisations used (one per tried Gauss-Newton step; the chord steps of the
     /// exact phase reuse the last one).
     pub factorizations: usize,
@@ -444,13 +450,20 @@ impl Stepper for PqPerturbation {
     /// Runs to the end and returns the result (the best mesh reached when not converged).
     fn finish(mut self) -> Result<PqResult, Infallible> {
         self.run_to_end()?;
-        let max_move = self
+        let (mut max_move, mut max_normal_move, mut max_tangential_move) = (0.0f64, 0.0f64, 0.0f64);
+        for ((now, was), n) in self
             .mesh
             .positions
             .iter()
             .zip(&self.input)
-            .map(|(a, b)| (a - b).norm())
-            .fold(0.0, f64::max);
+            .zip(&self.terms.normals0)
+        {
+            let d = now - was;
+            let along = d.dot(n);
+            max_move = max_move.max(d.norm());
+            max_normal_move = max_normal_move.max(along.abs());
+            max_tangential_move = max_tangential_move.max((d - n * along).norm());
+        }
         let factorizations = self.factorizations();
         Ok(PqResult {
             conical_residual: (self.options.mode == PqMode::Conical).then_some(self.last.1),
@@ -460,6 +473,8 @@ impl Stepper for PqPerturbation {
             converged: self.converged,
             reason: self.reason,
             max_move,
+            max_normal_move,
+            max_tangential_move,
             factorizations,
             mesh: self.mesh,
         })
@@ -712,6 +727,20 @@ mod tests {
         );
         assert!(kept.converged, "{:?}", kept.reason);
         assert!(kept.max_move <= 2e-3, "{}", kept.max_move);
+        // The noise is along the normal; the vertices barely slide.
+        assert!(kept.max_normal_move <= kept.max_move);
+        assert!(
+            kept.max_tangential_move <= 0.1 * kept.max_normal_move,
+            "{kept:?}"
+        );
+        let slide = |r: &PqResult| {
+            m.positions
+                .iter()
+                .zip(&r.mesh.positions)
+                .map(|(a, b)| ((b - a).x.powi(2) + (b - a).y.powi(2)).sqrt())
+                .fold(0.0, f64::max)
+        };
+        assert!((slide(&kept) - kept.max_tangential_move).abs() <= 1e-2 * kept.max_normal_move);
         let fair = run(&m, PqOptions::default());
         assert!(fair.max_move > 0.1, "{}", fair.max_move);
     }
