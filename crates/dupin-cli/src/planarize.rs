@@ -43,6 +43,10 @@ pub struct PlanarizeArgs {
     /// input and steps turn face planes rather than slide vertices.
     #[arg(long)]
     pub fair_mesh: bool,
+    /// The most memory the sparse factorisation may take, in GB: a mesh whose factor needs
+    /// more is refused (exit 2) before the factor is allocated.
+    #[arg(long, default_value_t = 2.0, allow_hyphen_values = true)]
+    pub max_memory: f64,
     /// Iteration cap.
     #[arg(long, default_value_t = 100)]
     pub max_iterations: usize,
@@ -60,6 +64,15 @@ pub struct PlanarizeArgs {
     pub report: Option<PathBuf>,
 }
 
+/// A size in GB as a person reads it (exponent form beyond everyday magnitudes).
+fn gigabytes(v: f64) -> String {
+    if (1e-3..1e6).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
 /// Runs `dupin planarize`.
 pub fn run(args: PlanarizeArgs) -> Result<(), CliError> {
     let mesh = read_mesh_file(&args.input)?;
@@ -74,8 +87,15 @@ pub fn run(args: PlanarizeArgs) -> Result<(), CliError> {
         }
         fixed_vertices.push(i - 1);
     }
+    if !(args.max_memory.is_finite() && args.max_memory > 0.0) {
+        return Err(CliError::Input(format!(
+            "bad --max-memory {}: must be a positive number of GB",
+            gigabytes(args.max_memory)
+        )));
+    }
     let options = PqOptions {
         mode,
+        max_factor_bytes: (args.max_memory * 1e9).min(usize::MAX as f64).max(1.0) as usize,
         fixed_vertices,
         refinement: match args.refinement {
             RefineArg::GaussNewton => Refinement::GaussNewton,
@@ -93,6 +113,13 @@ pub fn run(args: PlanarizeArgs) -> Result<(), CliError> {
         .map_err(|e| CliError::input("", e))?
         .finish();
     let seconds = start.elapsed().as_secs_f64();
+    if result.refused {
+        return Err(CliError::Input(format!(
+            "{}; or raise --max-memory (now {} GB)",
+            result.reason.as_deref().unwrap_or("the mesh is too large"),
+            gigabytes(args.max_memory)
+        )));
+    }
     write_text(&args.out, &write_obj(&result.mesh))?;
     let mut report = json!({
         "vertices": result.mesh.num_vertices(),

@@ -1,7 +1,7 @@
 //! End-to-end tests of `dupin planarize`.
 
 mod common;
-use common::{Run, run_reported, tmp};
+use common::{Run, refused, run_reported, tmp};
 
 /// A 6 x 6 quad grid on the saddle z = xy, rotated 30 degrees: far from planar.
 fn skew_grid_obj() -> String {
@@ -212,4 +212,42 @@ fn folded_faces_are_not_a_planarised_design() {
     assert!(r["reason"].as_str().unwrap().contains("turned over"), "{r}");
     let fine = planarize("nofold", &skew_grid_obj(), &[]);
     assert_eq!(fine.ok()["flipped_faces"], 0);
+}
+
+/// A mesh whose sparse factor would pass `--max-memory` is refused from its pattern alone,
+/// before the factor is allocated: exit 2, one line naming both sizes and the option, no
+/// output file.
+#[test]
+fn beyond_the_memory_limit_is_refused_before_the_factor() {
+    let input = tmp("memory_limit.obj");
+    std::fs::write(&input, skew_grid(20, 15.0)).unwrap();
+    let out = tmp("memory_limit_out.obj");
+    let _ = std::fs::remove_file(&out);
+    let (_, err) = refused(&[
+        "planarize",
+        "--input",
+        input.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--max-memory",
+        "1e-6",
+    ]);
+    assert!(
+        err.contains("sparse factorisation needs")
+            && err.contains("raise --max-memory (now 1e-6 GB)"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    for bad in ["0", "-1", "nan"] {
+        refused(&[
+            "planarize",
+            "--input",
+            input.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--max-memory",
+            bad,
+        ]);
+    }
+    let _ = std::fs::remove_file(input);
 }

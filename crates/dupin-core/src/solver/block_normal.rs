@@ -99,6 +99,7 @@ impl Structure {
         layout: &BlockLayout,
         nk: usize,
         pairs: &[(u32, u32)],
+        factor_limit: usize,
     ) -> Result<(Self, Vec<u32>), SolverError> {
         let (pattern, slots) = csc_pattern(nk, pairs)?;
         let col_ptr = pattern.col_ptr().to_vec();
@@ -144,7 +145,7 @@ impl Structure {
             let o = layout.offset(b as usize);
             fwd.extend((o..o + layout.size(b as usize)).map(|v| v as u32));
         }
-        let chol = SparseCholesky::analyse(upper.as_ref(), &fwd)?;
+        let chol = SparseCholesky::analyse_within(upper.as_ref(), &fwd, factor_limit)?;
         let positions = chol.positions();
         // Per block slot, the positions (row-major 4 x 4) of its scalar entries in the values
         // `chol` factors (`NONE` outside the blocks' sizes and below a diagonal block's
@@ -235,6 +236,8 @@ pub(crate) struct BlockNormal {
     factored: bool,
     /// Number of symbolic analyses made (for tests and benchmarks).
     analyses: usize,
+    /// The most memory the factor may take, in bytes (`None`: [`super::MAX_FACTOR_BYTES`]).
+    factor_limit: Option<usize>,
 }
 
 impl BlockNormal {
@@ -247,6 +250,12 @@ impl BlockNormal {
     /// Number of symbolic analyses so far.
     pub(crate) fn analyses(&self) -> usize {
         self.analyses
+    }
+
+    /// Sets the most memory the factor may take, in bytes; an analysis beyond it fails with
+    /// [`SolverError::TooLarge`] before the factor is allocated.
+    pub(crate) fn set_factor_limit(&mut self, bytes: usize) {
+        self.factor_limit = Some(bytes);
     }
 
     /// Makes sure the analysis fits the pattern of `sys` with local blocks `elim..` (ignored,
@@ -322,7 +331,8 @@ impl BlockNormal {
             Some(slots) => slots,
             None => {
                 self.structure = None;
-                let (s, slots) = Structure::analyse(layout, nk, pairs)?;
+                let limit = self.factor_limit.unwrap_or(super::MAX_FACTOR_BYTES);
+                let (s, slots) = Structure::analyse(layout, nk, pairs, limit)?;
                 self.analyses += 1;
                 self.structure = Some(s);
                 slots

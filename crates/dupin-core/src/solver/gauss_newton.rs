@@ -123,6 +123,9 @@ pub struct LmOptions {
     /// Factor by which the damping shrinks after an accepted step with a good model (gain
     /// ratio ρ > 0.75; less, by Nielsen's rule, for 0.5 < ρ ≤ 0.75; > 1).
     pub decrease: f64,
+    /// The most memory the sparse factor may take, in bytes: a step whose analysis needs more
+    /// fails with [`SolverError::TooLarge`] before the factor is allocated.
+    pub max_factor_bytes: usize,
 }
 
 impl Default for LmOptions {
@@ -135,6 +138,7 @@ impl Default for LmOptions {
             step_halvings: 0,
             second_order_correction: false,
             marquardt_scaling: false,
+            max_factor_bytes: super::MAX_FACTOR_BYTES,
         }
     }
 }
@@ -179,10 +183,12 @@ pub struct LevenbergMarquardt {
 impl LevenbergMarquardt {
     /// A new iteration with the given settings.
     pub fn new(options: LmOptions) -> Self {
+        let mut normal = BlockNormal::default();
+        normal.set_factor_limit(options.max_factor_bytes);
         LevenbergMarquardt {
             options,
             damping: options.initial_damping,
-            normal: BlockNormal::default(),
+            normal,
             sys: BlockSystem::default(),
             trial_sys: BlockSystem::default(),
             cached_x: None,

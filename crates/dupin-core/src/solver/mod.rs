@@ -62,7 +62,7 @@ pub enum SolverError {
     /// The factorisation would need more memory than the limit (estimated from the sparsity
     /// pattern before any numeric work).
     #[error(
-        "the sparse factorisation needs {:.1} GB, more than the limit of {:.1} GB; use a coarser \
+        "the sparse factorisation needs {:.2} GB, more than the limit of {:.2} GB; use a coarser \
          mesh or split it into parts",
         *.needed as f64 / 1e9,
         *.limit as f64 / 1e9

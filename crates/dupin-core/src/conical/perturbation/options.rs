@@ -50,6 +50,9 @@ pub struct PqOptions {
     /// Convergence: contract `max_planarity` and the mode's residual (radians) both at most
     /// this (> 0).
     pub tolerance: f64,
+    /// The most memory a sparse factorisation may take, in bytes (≥ 1): a mesh whose factor
+    /// would need more is refused before the factor is allocated ([`super::PqResult::refused`]).
+    pub max_factor_bytes: usize,
     /// Iteration cap (penalty and SQP iterations together, ≥ 1).
     pub max_iterations: usize,
     /// Largest number of penalty iterations before switching to the exact phase. With
@@ -78,6 +81,7 @@ impl Default for PqOptions {
             keep_design: false,
             tolerance: 1e-11,
             max_iterations: 100,
+            max_factor_bytes: crate::solver::MAX_FACTOR_BYTES,
             penalty_iterations: 4,
             determinant_terms: false,
             identify: Vec::new(),

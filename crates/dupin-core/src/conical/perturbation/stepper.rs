@@ -11,7 +11,7 @@ use crate::mesh::PolyMesh;
 use crate::mesh::SolverFrame;
 use crate::mesh::max_planarity;
 use crate::mesh::representable_planarity;
-use crate::solver::{LevenbergMarquardt, LmOptions, LmStep, Sqp, SqpOptions};
+use crate::solver::{LevenbergMarquardt, LmOptions, LmStep, SolverError, Sqp, SqpOptions};
 use crate::{Stepper, Vec3};
 use std::convert::Infallible;
 
@@ -67,6 +67,10 @@ pub struct PqResult {
     /// Sparse factorisations used (one per tried Gauss-Newton step; the chord steps of the
     /// exact phase reuse the last one).
     pub factorizations: usize,
+    /// The problem was refused before any numeric work: its sparse factor would need more
+    /// memory than [`PqOptions::max_factor_bytes`] (`reason` names both sizes). The mesh is
+    /// the input, untouched.
+    pub refused: bool,
 }
 
 /// A PQ / conical / circular perturbation that can be stepped and watched (one step is one
@@ -104,11 +108,14 @@ pub struct PqPerturbation {
     last: (f64, f64),
     /// The next exact-phase step tries a chord step first (see [`CHORD_RATE`]).
     chord: bool,
+    /// See [`PqResult::refused`].
+    refused: bool,
 }
 
 /// Settings of the penalty and exact-phase Levenberg-Marquardt iterations.
-fn lm_options() -> LmOptions {
+fn lm_options(max_factor_bytes: usize) -> LmOptions {
     LmOptions {
+        max_factor_bytes,
         decrease: 10.0,
         step_halvings: 2,
         ..LmOptions::default()
@@ -166,6 +173,12 @@ fn check_options(o: &PqOptions) -> Result<(), PqError> {
         "must be finite and > 0",
     )?;
     check(
+        "max_factor_bytes",
+        o.max_factor_bytes as f64,
+        o.max_factor_bytes >= 1,
+        "must be >= 1",
+    )?;
+    check(
         "max_iterations",
         o.max_iterations as f64,
         o.max_iterations >= 1,
@@ -191,6 +204,7 @@ impl PqPerturbation {
         let (terms, x) = Terms::new(&work, &topo, &options)?;
         let o = &options;
         let scale_for_sqp = terms.scale;
+        let factor_limit = o.max_factor_bytes;
         let probe_allowed = o.refinement == Refinement::GaussNewton && o.penalty_iterations > 1;
         let mut s = PqPerturbation {
             mesh: mesh.clone(),
@@ -203,8 +217,8 @@ impl PqPerturbation {
             w_close: o.closeness,
             options,
             x,
-            lm: LevenbergMarquardt::new(lm_options()),
-            exact: LevenbergMarquardt::new(lm_options()),
+            lm: LevenbergMarquardt::new(lm_options(factor_limit)),
+            exact: LevenbergMarquardt::new(lm_options(factor_limit)),
             probe: false,
             probe_allowed,
             sqp: Sqp::new(SqpOptions {
@@ -217,6 +231,7 @@ impl PqPerturbation {
             reason: None,
             last: (f64::INFINITY, f64::INFINITY),
             chord: false,
+            refused: false,
         };
         s.last = s.measures();
         if s.is_converged() {
@@ -342,6 +357,14 @@ impl PqPerturbation {
                     (self.mesh.positions, self.work.positions) = old_positions;
                     self.last = before;
                 }
+            }
+            Err(e @ SolverError::TooLarge { .. }) => {
+                // Known from the sparsity pattern before any numeric work: no other phase
+                // would fit either.
+                self.phase = PqPhase::Done;
+                self.refused = true;
+                self.reason = Some(e.to_string());
+                return;
             }
             Err(e) => {
                 if self.phase == PqPhase::Penalty {
@@ -476,6 +499,7 @@ impl Stepper for PqPerturbation {
             max_normal_move,
             max_tangential_move,
             factorizations,
+            refused: self.refused,
             mesh: self.mesh,
         })
     }
@@ -612,7 +636,11 @@ mod tests {
                     s.step().unwrap();
                     // Penalty steps keep the penalty settings, probe or not.
                     if s.phase() == PqPhase::Penalty {
-                        assert_eq!(s.lm.options(), lm_options(), "{name}");
+                        assert_eq!(
+                            s.lm.options(),
+                            lm_options(options.max_factor_bytes),
+                            "{name}"
+                        );
                     }
                     if penalty && s.phase() == PqPhase::Sqp && !s.probe {
                         after_penalty = Some(s.mesh().clone());
@@ -768,6 +796,29 @@ mod tests {
             let relative_move = r.max_move / scale / reference.max_move;
             assert!((relative_move - 1.0).abs() < 1e-6, "{at}: {relative_move}");
         }
+    }
+
+    /// A factor beyond `max_factor_bytes` is refused from the sparsity pattern, before any
+    /// numeric work: the mesh comes back untouched and the reason names both sizes.
+    #[test]
+    fn beyond_the_factor_limit_the_run_is_refused_untouched() {
+        let m = skew_quad_grid(20, 30.0);
+        let r = run(
+            &m,
+            PqOptions {
+                max_factor_bytes: 1000,
+                ..PqOptions::default()
+            },
+        );
+        assert!(r.refused && !r.converged);
+        assert_eq!(r.mesh, m);
+        assert_eq!(r.factorizations, 0);
+        let reason = r.reason.unwrap();
+        assert!(
+            reason.contains("needs") && reason.contains("limit"),
+            "{reason}"
+        );
+        assert!(!run(&m, PqOptions::default()).refused);
     }
 
     /// Anchors keep the user's bits although the solver moves everything into its frame.
