@@ -14,9 +14,11 @@ if [[ "${1:-}" == "--compare" ]]; then
   wt="$out/base-tree"
   git -C "$root" worktree add --detach "$wt" "$base" >/dev/null
   trap 'git -C "$root" worktree remove --force "$wt"' EXIT
-  # The old tree may not have this script: use ours for both builds.
-  (cd "$wt" && CARGO_TARGET_DIR="$root/target" cargo build --release -q -p dupin-cli)
-  cp "$root/target/release/dupin" "$out/dupin-base"
+  # The old tree may not have this script: use ours for both builds. The base builds into a
+  # target folder of its own: sharing ours, cargo would leave the base binary in
+  # target/release when the HEAD build that follows finds nothing to compile.
+  (cd "$wt" && CARGO_TARGET_DIR="$out/base-target" cargo build --release -q -p dupin-cli)
+  cp "$out/base-target/release/dupin" "$out/dupin-base"
   (cd "$root" && cargo build --release -q -p dupin-cli)
   "$0" "$out/dupin-base" "$out/base"
   "$0" "$root/target/release/dupin" "$out/head"

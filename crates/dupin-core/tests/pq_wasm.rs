@@ -19,7 +19,7 @@ fn torus_dual_1152_hexagons_five_runs() {
     for _ in 0..5 {
         let r = pq_perturb(&m, PqOptions::default()).unwrap();
         assert!(r.converged, "{:?}", r.reason);
-        assert_eq!((r.iterations, r.factorizations), (7, 2));
+        assert_eq!((r.iterations, r.factorizations), (6, 3));
         assert!(max_planarity(&r.mesh) <= 1e-10);
     }
 }

@@ -192,11 +192,18 @@ impl PqPerturbation {
     pub fn new(mesh: &PolyMesh, options: PqOptions) -> Result<Self, PqError> {
         check_options(&options)?;
         let topo = MeshTopology::new(mesh)?;
-        // Posed in a centred frame scaled by a power of two to the unit box: a design at any
-        // distance from the origin, and in any unit, is solved as the same design near the
-        // origin at a size in (0.7, 1.4], where the solver's settings were tuned (its damping
-        // weighs vertex moves in lengths against unit normals, so the size matters).
-        let frame = SolverFrame::unit_box(&mesh.positions);
+        // Keeping a design, the problem is posed in a centred frame scaled by a power of two
+        // to the unit box: a design at any distance from the origin and in any unit is solved
+        // as the same design near the origin (its step metric is in lengths, so the size
+        // does not matter either). The paper's settings stay in the user's coordinates:
+        // their Levenberg metric weighs vertex moves (lengths) against unit normals and was
+        // tuned on the library's scenes at their size; in the unit box the developable
+        // trefoil ended with 30 singular points inside its strips instead of none.
+        let frame = if options.keep_design {
+            SolverFrame::unit_box(&mesh.positions)
+        } else {
+            SolverFrame::identity()
+        };
         let mut work = mesh.clone();
         for p in &mut work.positions {
             *p = frame.to_solver(*p);
@@ -553,11 +560,11 @@ mod tests {
 
     /// The exact phase is a Newton-KKT (SQP) iteration on the constraints (see
     /// [`Refinement::GaussNewton`]): once the constraint residual is small its Newton steps
-    /// converge quadratically, r_{k+1} <= r_k^1.5 at every step below 3e-2 (measured: skew
-    /// grid 10x10 1.8e-2, 6.3e-4, 7.1e-6; torus dual 2.8e-2, 3.1e-4), and once they contract
-    /// by [`CHORD_RATE`] the chord steps that follow (no factorisation) keep contracting at
-    /// about that rate (torus dual 3.1e-4, 1.9e-5, 2.0e-7, 5.4e-9, 1.5e-10, 3.3e-12: 5 chord
-    /// steps instead of a second and third factorisation).
+    /// converge quadratically, r_{k+1} <= r_k^1.5 at every step below 5e-3 (measured: skew
+    /// grid 10x10 1.8e-2, 6.3e-4, 7.1e-6; torus dual 2.9e-2, 3.8e-3, 8.8e-6), and once they
+    /// contract by [`CHORD_RATE`] the chord steps that follow (no factorisation) keep
+    /// contracting at about that rate (torus dual 8.8e-6, 4.0e-8, 2.0e-10, 9.7e-13: 3 chord
+    /// steps instead of a third factorisation).
     #[test]
     fn exact_phase_converges_quadratically() {
         for (name, m) in [
@@ -587,7 +594,7 @@ mod tests {
                 result.factorizations < result.iterations,
                 "{name}: no chord step"
             );
-            let fast: Vec<_> = newton.iter().filter(|&&(a, _)| a < 3e-2).collect();
+            let fast: Vec<_> = newton.iter().filter(|&&(a, _)| a < 5e-3).collect();
             assert!(!fast.is_empty(), "{name}: {newton:?}");
             for &&(a, b) in &fast {
                 assert!(b <= a.powf(1.5), "{name}: {a:e} -> {b:e} not superlinear");
@@ -666,24 +673,27 @@ mod tests {
         }
     }
 
-    /// The solver works in a centred frame scaled by a power of two to the unit box
-    /// (`SolverFrame::unit_box`): a design scaled by a power of two takes exactly the same
-    /// steps, and at any size from 1e-6 to 1e6 and at state-plane offsets (1e7) it ends
-    /// planar to the tolerance in the user's coordinates, with moves in proportion to its
-    /// size. Between powers of two the steps differ as the solver sees the design at a size
-    /// in (0.7, 1.4] (measured: 10-17 iterations, max_move 0.33-0.44 of the scale). Before,
-    /// this grid stalled at some sizes and took 17-31 iterations at others.
+    /// Keeping the design, the solver works in a centred frame scaled by a power of two to
+    /// the unit box (`SolverFrame::unit_box`): a design scaled by a power of two takes exactly
+    /// the same steps to the same shape bit for bit, and at any size from 1e-6 to 1e6 and at
+    /// state-plane offsets (1e7) it ends planar to the tolerance in the user's coordinates,
+    /// with moves in proportion to its size. In the user's coordinates the paper's settings
+    /// stall on this grid at some sizes and take 17-31 iterations at others.
     #[test]
     fn planarisation_is_free_of_scale_and_offset() {
         let base = skew_quad_grid(20, 30.0);
-        let reference = run(&base, PqOptions::default());
+        let options = PqOptions {
+            keep_design: true,
+            ..PqOptions::default()
+        };
+        let reference = run(&base, options.clone());
         assert!(reference.converged);
         let scaled = |scale: f64, offset: f64| {
             let mut m = base.clone();
             for p in &mut m.positions {
                 *p = *p * scale + Vec3::repeat(offset);
             }
-            (m.clone(), run(&m, PqOptions::default()))
+            (m.clone(), run(&m, options.clone()))
         };
         for scale in [
             0.5f64.powi(20),
@@ -833,6 +843,7 @@ mod tests {
             &m,
             PqOptions {
                 fixed_vertices: fixed.clone(),
+                keep_design: true,
                 ..PqOptions::default()
             },
         );
