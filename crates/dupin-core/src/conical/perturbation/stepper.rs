@@ -677,8 +677,9 @@ mod tests {
     /// the unit box (`SolverFrame::unit_box`): a design scaled by a power of two takes exactly
     /// the same steps to the same shape bit for bit, and at any size from 1e-6 to 1e6 and at
     /// state-plane offsets (1e7) it ends planar to the tolerance in the user's coordinates,
-    /// with moves in proportion to its size. In the user's coordinates the paper's settings
-    /// stall on this grid at some sizes and take 17-31 iterations at others.
+    /// with moves in proportion to its size. (The paper's settings, in the user's
+    /// coordinates, take different steps at different sizes: a z = xy grid stalled at some
+    /// sizes and took 17-31 iterations at others.)
     #[test]
     fn planarisation_is_free_of_scale_and_offset() {
         let base = skew_quad_grid(20, 30.0);
