@@ -223,22 +223,7 @@ fn beyond_the_memory_limit_is_refused_before_the_factor() {
     std::fs::write(&input, skew_grid(20, 15.0)).unwrap();
     let out = tmp("memory_limit_out.obj");
     let _ = std::fs::remove_file(&out);
-    let (_, err) = refused(&[
-        "planarize",
-        "--input",
-        input.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--max-memory",
-        "1e-6",
-    ]);
-    assert!(
-        err.contains("sparse factorisation needs")
-            && err.contains("raise --max-memory (now 1e-6 GB)"),
-        "{err}"
-    );
-    assert!(!out.exists());
-    for bad in ["0", "-1", "nan"] {
+    let with_limit = |gb: &str| {
         refused(&[
             "planarize",
             "--input",
@@ -246,8 +231,19 @@ fn beyond_the_memory_limit_is_refused_before_the_factor() {
             "--out",
             out.to_str().unwrap(),
             "--max-memory",
-            bad,
-        ]);
+            gb,
+        ])
+        .1
+    };
+    let err = with_limit("1e-6");
+    assert!(
+        err.contains("sparse factorisation needs")
+            && err.contains("raise --max-memory (now 1e-6 GB)"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    for bad in ["0", "-1", "nan"] {
+        with_limit(bad);
     }
     let _ = std::fs::remove_file(input);
 }
