@@ -8,6 +8,7 @@ mod closest_point;
 mod curvature;
 mod library;
 mod mesh_surface;
+mod nurbs;
 mod registry;
 mod sampling;
 
@@ -21,6 +22,10 @@ pub use library::{
     HyperbolicParaboloid, Hyperboloid, Sphere, SurfaceOfRevolution, Torus, TwistedSurface, Vase,
 };
 pub use mesh_surface::{MeshClosestPoint, MeshSurface, MeshSurfaceError, VertexCurvature};
+pub use nurbs::{
+    MAX_NURBS_CONTROL_POINTS, MAX_NURBS_DEGREE, MAX_NURBS_JSON_BYTES, NurbsDefinition, NurbsError,
+    NurbsSurface,
+};
 pub use registry::{
     ParamSpec, RegistryError, SurfaceSpec, parse_assignment, surface_by_name, surface_catalog,
 };

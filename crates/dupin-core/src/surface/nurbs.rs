@@ -1,0 +1,785 @@
+//! NURBS surfaces brought from a CAD tool: a documented JSON form (`docs/nurbs-json.md`), checked
+//! into typed errors, and evaluated with exact derivatives to second order, so that the P-Hex
+//! pipeline panels an imported design as it panels a library surface (P-Hex paper, section 3:
+//! the Dupin indicatrix needs the second fundamental form).
+//!
+//! Evaluation follows The NURBS Book (Piegl and Tiller, 2nd ed.): the knot span by bisection
+//! (A2.1), the basis functions and their derivatives (A2.3) and the rational derivatives of the
+//! homogeneous surface (A4.4). It is written here rather than taken from `curvo` (which the tests
+//! and benchmarks use as the reference): curvo returns each evaluation in nested `Vec`s (several
+//! allocations per call, in the inner loop of the triangulation, the closest-point searches and
+//! every Gauss-Newton step) and would bring geo, argmin and i_overlay into the page's wasm;
+//! BENCHMARKS.md has the two side by side.
+
+use super::{Domain, Surface, SurfaceDerivatives};
+use crate::Vec3;
+use crate::fabrication::{LengthUnit, UnknownUnit};
+use crate::math::Num;
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+/// The largest degree in either direction (OpenNURBS's limit for surfaces is 11 as well).
+pub const MAX_NURBS_DEGREE: usize = 11;
+
+/// The most control points a surface may have (a 1000 x 1000 net; a roof from Rhino has hundreds).
+pub const MAX_NURBS_CONTROL_POINTS: usize = 1_000_000;
+
+/// The longest JSON text [`NurbsSurface::from_json`] reads (256 MiB): a larger file is refused
+/// before it is parsed.
+pub const MAX_NURBS_JSON_BYTES: usize = 256 << 20;
+
+const P1: usize = MAX_NURBS_DEGREE + 1;
+
+/// Why a NURBS surface was refused. Indices are 0-based, as in the JSON arrays.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum NurbsError {
+    /// The text is not JSON of the documented shape.
+    #[error("not a NURBS surface (docs/nurbs-json.md), line {line}, column {column}: {message}")]
+    Json {
+        /// 1-based line of the problem.
+        line: usize,
+        /// 1-based column of the problem.
+        column: usize,
+        /// serde_json's description.
+        message: String,
+    },
+    /// The text is longer than [`MAX_NURBS_JSON_BYTES`].
+    #[error(
+        "the NURBS JSON has {bytes} bytes, more than the limit of {limit}; simplify the surface \
+         in the CAD tool (fewer control points)"
+    )]
+    TooLong {
+        /// Length of the text.
+        bytes: usize,
+        /// [`MAX_NURBS_JSON_BYTES`].
+        limit: usize,
+    },
+    /// A degree is 0 or above [`MAX_NURBS_DEGREE`].
+    #[error("degree_{direction} is {degree}; use a degree from 1 to {max}", max = MAX_NURBS_DEGREE)]
+    Degree {
+        /// `u` or `v`.
+        direction: char,
+        /// The degree given.
+        degree: usize,
+    },
+    /// Fewer control points than degree + 1 along a direction.
+    #[error(
+        "{count} control points along {direction} are too few for degree {degree}; give at \
+         least {}", .degree + 1
+    )]
+    TooFewPoints {
+        /// `u` or `v`.
+        direction: char,
+        /// Control points along that direction.
+        count: usize,
+        /// Its degree.
+        degree: usize,
+    },
+    /// More than [`MAX_NURBS_CONTROL_POINTS`] control points.
+    #[error(
+        "{nu} x {nv} control points are more than the limit of {max}; rebuild the surface \
+         with fewer in the CAD tool", max = MAX_NURBS_CONTROL_POINTS
+    )]
+    TooLarge {
+        /// Rows (along u).
+        nu: usize,
+        /// Points per row (along v).
+        nv: usize,
+    },
+    /// The rows of `control_points` (or `weights`) differ in length.
+    #[error("row {row} of {what} has {len} entries, row 0 has {expected}")]
+    RaggedNet {
+        /// `control_points` or `weights`.
+        what: &'static str,
+        /// The row.
+        row: usize,
+        /// Its length.
+        len: usize,
+        /// Row 0's length.
+        expected: usize,
+    },
+    /// `weights` has another number of rows than `control_points`.
+    #[error("weights has {rows} rows, control_points has {expected}")]
+    WeightRows {
+        /// Rows of weights.
+        rows: usize,
+        /// Rows of control points.
+        expected: usize,
+    },
+    /// A knot vector has the wrong length.
+    #[error(
+        "knots_{direction} has {got} knots; {count} control points of degree {degree} need {} \
+         (or {} in Rhino's convention, without the two end knots)",
+        .count + .degree + 1, .count + .degree - 1
+    )]
+    KnotCount {
+        /// `u` or `v`.
+        direction: char,
+        /// Knots given.
+        got: usize,
+        /// Control points along that direction.
+        count: usize,
+        /// Its degree.
+        degree: usize,
+    },
+    /// A knot is NaN or infinite.
+    #[error("knots_{direction}[{index}] is not finite")]
+    KnotNotFinite {
+        /// `u` or `v`.
+        direction: char,
+        /// Index in the vector as given.
+        index: usize,
+    },
+    /// A knot is smaller than the one before it.
+    #[error("knots_{direction}[{index}] = {} is smaller than the knot before it", Num(*.value))]
+    KnotOrder {
+        /// `u` or `v`.
+        direction: char,
+        /// Index in the vector as given.
+        index: usize,
+        /// The knot.
+        value: f64,
+    },
+    /// An interior knot repeats more often than the degree: the surface would tear there.
+    #[error(
+        "knot {} of knots_{direction} repeats {multiplicity} times inside the domain, more \
+         than the degree {degree}: the surface would be discontinuous there",
+        Num(*.value)
+    )]
+    KnotMultiplicity {
+        /// `u` or `v`.
+        direction: char,
+        /// The knot.
+        value: f64,
+        /// How often it repeats.
+        multiplicity: usize,
+        /// The degree.
+        degree: usize,
+    },
+    /// The knots give an empty parameter interval.
+    #[error("knots_{direction} give an empty domain: the knots at {degree} and {end} are equal")]
+    EmptyDomain {
+        /// `u` or `v`.
+        direction: char,
+        /// First index of the domain in the full vector (the degree).
+        degree: usize,
+        /// Last index of the domain in the full vector (the control point count).
+        end: usize,
+    },
+    /// A control point has a NaN or infinite coordinate.
+    #[error("control point ({i}, {j}) is not finite")]
+    PointNotFinite {
+        /// Row (along u).
+        i: usize,
+        /// Column (along v).
+        j: usize,
+    },
+    /// A weight is not positive and finite.
+    #[error("weight ({i}, {j}) is {}; weights must be positive and finite", Num(*.w))]
+    Weight {
+        /// Row (along u).
+        i: usize,
+        /// Column (along v).
+        j: usize,
+        /// The weight.
+        w: f64,
+    },
+    /// The `unit` is not one Dupin knows.
+    #[error("{0}")]
+    Unit(#[from] UnknownUnit),
+}
+
+/// The JSON form of a NURBS surface, as documented in `docs/nurbs-json.md`: degrees, knot
+/// vectors (full, `count + degree + 1` knots, or Rhino's `count + degree - 1`), control points
+/// as `control_points[i][j] = [x, y, z]` with `i` along u and `j` along v, optional weights of
+/// the same shape (all 1 when absent: a non-rational B-spline) and an optional length unit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NurbsDefinition {
+    /// Degree along u (1 to [`MAX_NURBS_DEGREE`]).
+    pub degree_u: usize,
+    /// Degree along v.
+    pub degree_v: usize,
+    /// Knot vector along u, non-decreasing.
+    pub knots_u: Vec<f64>,
+    /// Knot vector along v, non-decreasing.
+    pub knots_v: Vec<f64>,
+    /// Control points, `nu` rows of `nv` points (Euclidean, not multiplied by the weight).
+    pub control_points: Vec<Vec<[f64; 3]>>,
+    /// Weights, the shape of `control_points`; `None`: all 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weights: Option<Vec<Vec<f64>>>,
+    /// Length unit of the coordinates (`mm`, `cm`, `m`, `in`, `ft`); `None`: not stated.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unit: Option<String>,
+}
+
+/// A checked NURBS surface, evaluated with exact first and second derivatives.
+///
+/// Input: a [`NurbsDefinition`] (or its JSON); output: a [`Surface`] on the domain
+/// `[U[p], U[nu]] x [V[q], V[nv]]`. Outside the domain the end spans' polynomials continue, so
+/// searches that step slightly over the boundary see a smooth surface. A closed surface (a
+/// cylinder or torus from a CAD tool) is panelled as an open patch with a seam.
+///
+/// (P-Hex paper, section 3; The NURBS Book, A2.1, A2.3, A4.4.)
+#[derive(Debug, Clone, PartialEq)]
+pub struct NurbsSurface {
+    degree: [usize; 2],
+    /// Full knot vectors (`count + degree + 1` knots).
+    knots: [Vec<f64>; 2],
+    count: [usize; 2],
+    /// Control points as given (Euclidean), point (i, j) at `i * nv + j`.
+    points: Vec<[f64; 3]>,
+    /// Homogeneous control points `(w x, w y, w z, w)`, point (i, j) at `i * nv + j`.
+    homogeneous: Vec<[f64; 4]>,
+    unit: Option<LengthUnit>,
+}
+
+fn direction(d: usize) -> char {
+    if d == 0 { 'u' } else { 'v' }
+}
+
+/// Checks one knot vector and returns it in the full convention.
+fn full_knots(
+    d: usize,
+    knots: &[f64],
+    count: usize,
+    degree: usize,
+) -> Result<Vec<f64>, NurbsError> {
+    let direction = direction(d);
+    let full_len = count + degree + 1;
+    let full: Vec<f64> = if knots.len() == full_len {
+        knots.to_vec()
+    } else if knots.len() + 2 == full_len && !knots.is_empty() {
+        // Rhino and OpenNURBS leave out the first and the last knot: they never reach the domain.
+        let mut v = Vec::with_capacity(full_len);
+        v.push(knots[0]);
+        v.extend_from_slice(knots);
+        v.push(knots[knots.len() - 1]);
+        v
+    } else {
+        return Err(NurbsError::KnotCount {
+            direction,
+            got: knots.len(),
+            count,
+            degree,
+        });
+    };
+    for (index, &k) in knots.iter().enumerate() {
+        if !k.is_finite() {
+            return Err(NurbsError::KnotNotFinite { direction, index });
+        }
+        if index > 0 && k < knots[index - 1] {
+            return Err(NurbsError::KnotOrder {
+                direction,
+                index,
+                value: k,
+            });
+        }
+    }
+    let (lo, hi) = (full[degree], full[count]);
+    if lo >= hi {
+        return Err(NurbsError::EmptyDomain {
+            direction,
+            degree,
+            end: count,
+        });
+    }
+    let mut i = degree + 1;
+    while i < count {
+        let value = full[i];
+        let multiplicity = full[i..count].iter().take_while(|&&k| k == value).count();
+        if value > lo && multiplicity > degree {
+            return Err(NurbsError::KnotMultiplicity {
+                direction,
+                value,
+                multiplicity,
+                degree,
+            });
+        }
+        i += multiplicity;
+    }
+    Ok(full)
+}
+
+impl TryFrom<NurbsDefinition> for NurbsSurface {
+    type Error = NurbsError;
+
+    fn try_from(def: NurbsDefinition) -> Result<Self, NurbsError> {
+        let degree = [def.degree_u, def.degree_v];
+        for (d, &p) in degree.iter().enumerate() {
+            if !(1..=MAX_NURBS_DEGREE).contains(&p) {
+                return Err(NurbsError::Degree {
+                    direction: direction(d),
+                    degree: p,
+                });
+            }
+        }
+        let nu = def.control_points.len();
+        let nv = def.control_points.first().map_or(0, Vec::len);
+        if nu.saturating_mul(nv) > MAX_NURBS_CONTROL_POINTS {
+            return Err(NurbsError::TooLarge { nu, nv });
+        }
+        for (row, r) in def.control_points.iter().enumerate() {
+            if r.len() != nv {
+                return Err(NurbsError::RaggedNet {
+                    what: "control_points",
+                    row,
+                    len: r.len(),
+                    expected: nv,
+                });
+            }
+        }
+        let count = [nu, nv];
+        for d in 0..2 {
+            if count[d] <= degree[d] {
+                return Err(NurbsError::TooFewPoints {
+                    direction: direction(d),
+                    count: count[d],
+                    degree: degree[d],
+                });
+            }
+        }
+        if let Some(w) = &def.weights {
+            if w.len() != nu {
+                return Err(NurbsError::WeightRows {
+                    rows: w.len(),
+                    expected: nu,
+                });
+            }
+            for (row, r) in w.iter().enumerate() {
+                if r.len() != nv {
+                    return Err(NurbsError::RaggedNet {
+                        what: "weights",
+                        row,
+                        len: r.len(),
+                        expected: nv,
+                    });
+                }
+            }
+        }
+        let knots = [
+            full_knots(0, &def.knots_u, nu, degree[0])?,
+            full_knots(1, &def.knots_v, nv, degree[1])?,
+        ];
+        let mut homogeneous = Vec::with_capacity(nu * nv);
+        let mut points = Vec::with_capacity(nu * nv);
+        for (i, row) in def.control_points.iter().enumerate() {
+            for (j, p) in row.iter().enumerate() {
+                if !p.iter().all(|c| c.is_finite()) {
+                    return Err(NurbsError::PointNotFinite { i, j });
+                }
+                let w = def.weights.as_ref().map_or(1.0, |w| w[i][j]);
+                if !(w.is_finite() && w > 0.0) {
+                    return Err(NurbsError::Weight { i, j, w });
+                }
+                let h = [w * p[0], w * p[1], w * p[2], w];
+                if !h.iter().all(|c| c.is_finite()) {
+                    return Err(NurbsError::PointNotFinite { i, j });
+                }
+                homogeneous.push(h);
+                points.push(*p);
+            }
+        }
+        let unit = def.unit.as_deref().map(str::parse).transpose()?;
+        Ok(NurbsSurface {
+            degree,
+            knots,
+            count,
+            points,
+            homogeneous,
+            unit,
+        })
+    }
+}
+
+impl NurbsSurface {
+    /// Reads the JSON form (`docs/nurbs-json.md`). Errors name the line and column of malformed
+    /// JSON, or the array entry that breaks a rule.
+    pub fn from_json(text: &str) -> Result<Self, NurbsError> {
+        if text.len() > MAX_NURBS_JSON_BYTES {
+            return Err(NurbsError::TooLong {
+                bytes: text.len(),
+                limit: MAX_NURBS_JSON_BYTES,
+            });
+        }
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let def: NurbsDefinition = serde_json::from_str(text).map_err(|e| NurbsError::Json {
+            line: e.line(),
+            column: e.column(),
+            message: crate::mesh::io::quoted(&e.to_string()),
+        })?;
+        Self::try_from(def)
+    }
+
+    /// The JSON form, with full knot vectors and explicit weights; [`NurbsSurface::from_json`]
+    /// reads it back to the same surface, bit for bit.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(&self.definition())
+            .expect("a definition of finite numbers serialises")
+    }
+
+    /// The surface as a [`NurbsDefinition`] (full knots, Euclidean points, explicit weights).
+    pub fn definition(&self) -> NurbsDefinition {
+        let [nu, nv] = self.count;
+        let rows = |i: usize| i * nv..(i + 1) * nv;
+        NurbsDefinition {
+            degree_u: self.degree[0],
+            degree_v: self.degree[1],
+            knots_u: self.knots[0].clone(),
+            knots_v: self.knots[1].clone(),
+            control_points: (0..nu).map(|i| self.points[rows(i)].to_vec()).collect(),
+            weights: Some(
+                (0..nu)
+                    .map(|i| self.homogeneous[rows(i)].iter().map(|h| h[3]).collect())
+                    .collect(),
+            ),
+            unit: self.unit.map(|u| u.name().to_string()),
+        }
+    }
+
+    /// Degrees along u and v.
+    pub fn degrees(&self) -> (usize, usize) {
+        (self.degree[0], self.degree[1])
+    }
+
+    /// Control points along u and v.
+    pub fn control_net_size(&self) -> (usize, usize) {
+        (self.count[0], self.count[1])
+    }
+
+    /// The length unit the file states, if any.
+    pub fn unit(&self) -> Option<LengthUnit> {
+        self.unit
+    }
+
+    /// Axis-aligned bounds of the control points (the surface lies in their convex hull).
+    pub fn control_bounds(&self) -> (Vec3, Vec3) {
+        let mut lo = Vec3::repeat(f64::INFINITY);
+        let mut hi = Vec3::repeat(f64::NEG_INFINITY);
+        for p in &self.points {
+            let p = Vec3::from(*p);
+            lo = lo.inf(&p);
+            hi = hi.sup(&p);
+        }
+        (lo, hi)
+    }
+}
+
+/// A2.1: the span index `i` in `[p, n]` with `U[i] <= t < U[i + 1]` (the last span for
+/// `t >= U[n + 1]`, the first for `t < U[p]`).
+fn find_span(knots: &[f64], count: usize, p: usize, t: f64) -> usize {
+    let inside = &knots[p + 1..count];
+    p + inside.partition_point(|&k| k <= t)
+}
+
+/// A2.3: the non-zero basis functions `N[i - p + r]` (r = 0..=p) at `t` and their first and
+/// second derivatives, `ders[k][r]`.
+fn basis_derivatives(knots: &[f64], span: usize, p: usize, t: f64) -> [[f64; P1]; 3] {
+    let mut ndu = [[0.0; P1]; P1];
+    let mut left = [0.0; P1];
+    let mut right = [0.0; P1];
+    ndu[0][0] = 1.0;
+    for j in 1..=p {
+        left[j] = t - knots[span + 1 - j];
+        right[j] = knots[span + j] - t;
+        let mut saved = 0.0;
+        for r in 0..j {
+            ndu[j][r] = right[r + 1] + left[j - r];
+            let temp = ndu[r][j - 1] / ndu[j][r];
+            ndu[r][j] = saved + right[r + 1] * temp;
+            saved = left[j - r] * temp;
+        }
+        ndu[j][j] = saved;
+    }
+    let mut ders = [[0.0; P1]; 3];
+    for j in 0..=p {
+        ders[0][j] = ndu[j][p];
+    }
+    let nd = p.min(2);
+    let mut a = [[0.0; P1]; 2];
+    for r in 0..=p {
+        let (mut s1, mut s2) = (0, 1);
+        a[0][0] = 1.0;
+        for k in 1..=nd {
+            let mut d = 0.0;
+            let rk = r as isize - k as isize;
+            let pk = p - k;
+            if r >= k {
+                a[s2][0] = a[s1][0] / ndu[pk + 1][rk as usize];
+                d = a[s2][0] * ndu[rk as usize][pk];
+            }
+            let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
+            let j2 = if r as isize - 1 <= pk as isize {
+                k - 1
+            } else {
+                p - r
+            };
+            for j in j1..=j2 {
+                let idx = (rk + j as isize) as usize;
+                a[s2][j] = (a[s1][j] - a[s1][j - 1]) / ndu[pk + 1][idx];
+                d += a[s2][j] * ndu[idx][pk];
+            }
+            if r <= pk {
+                a[s2][k] = -a[s1][k - 1] / ndu[pk + 1][r];
+                d += a[s2][k] * ndu[r][pk];
+            }
+            ders[k][r] = d;
+            std::mem::swap(&mut s1, &mut s2);
+        }
+    }
+    let mut factor = p as f64;
+    for (k, row) in ders.iter_mut().enumerate().take(nd + 1).skip(1) {
+        for x in row.iter_mut().take(p + 1) {
+            *x *= factor;
+        }
+        factor *= (p - k) as f64;
+    }
+    ders
+}
+
+impl Surface for NurbsSurface {
+    fn domain(&self) -> Domain {
+        let [p, q] = self.degree;
+        let [nu, nv] = self.count;
+        Domain {
+            u: (self.knots[0][p], self.knots[0][nu]),
+            v: (self.knots[1][q], self.knots[1][nv]),
+            periodic_u: false,
+            periodic_v: false,
+        }
+    }
+
+    /// A4.4 for derivatives up to second order: the homogeneous derivatives `A(k, l)` and
+    /// `w(k, l)`, then `S(k, l) = (A(k, l) - sum of binomial(k, i) binomial(l, j) w(i, j)
+    /// S(k - i, l - j) over (i, j) != (0, 0)) / w`.
+    fn derivatives(&self, u: f64, v: f64) -> SurfaceDerivatives {
+        let [p, q] = self.degree;
+        let [nu, nv] = self.count;
+        let su = find_span(&self.knots[0], nu, p, u);
+        let sv = find_span(&self.knots[1], nv, q, v);
+        let bu = basis_derivatives(&self.knots[0], su, p, u);
+        let bv = basis_derivatives(&self.knots[1], sv, q, v);
+        // h[k][l]: the homogeneous derivative d^(k+l)/du^k dv^l, k + l <= 2.
+        let mut h = [[[0.0f64; 4]; 3]; 3];
+        for r in 0..=p {
+            let row = (su - p + r) * nv + (sv - q);
+            let mut t = [[0.0f64; 4]; 3];
+            for s in 0..=q {
+                let c = &self.homogeneous[row + s];
+                for (l, tl) in t.iter_mut().enumerate() {
+                    let b = bv[l][s];
+                    for x in 0..4 {
+                        tl[x] += b * c[x];
+                    }
+                }
+            }
+            for (k, hk) in h.iter_mut().enumerate() {
+                let b = bu[k][r];
+                for (l, hkl) in hk.iter_mut().enumerate().take(3 - k) {
+                    for x in 0..4 {
+                        hkl[x] += b * t[l][x];
+                    }
+                }
+            }
+        }
+        let a = |k: usize, l: usize| Vec3::new(h[k][l][0], h[k][l][1], h[k][l][2]);
+        let w = |k: usize, l: usize| h[k][l][3];
+        let w0 = w(0, 0);
+        let s00 = a(0, 0) / w0;
+        let s10 = (a(1, 0) - s00 * w(1, 0)) / w0;
+        let s01 = (a(0, 1) - s00 * w(0, 1)) / w0;
+        let s20 = (a(2, 0) - s10 * (2.0 * w(1, 0)) - s00 * w(2, 0)) / w0;
+        let s11 = (a(1, 1) - s10 * w(0, 1) - s01 * w(1, 0) - s00 * w(1, 1)) / w0;
+        let s02 = (a(0, 2) - s01 * (2.0 * w(0, 1)) - s00 * w(0, 2)) / w0;
+        SurfaceDerivatives {
+            p: s00,
+            pu: s10,
+            pv: s01,
+            puu: s20,
+            puv: s11,
+            pvv: s02,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A bilinear-by-biquadratic net (degree 1 along u, 2 along v) as JSON, with `edit` applied
+    /// to the definition first.
+    fn json_with(edit: impl FnOnce(&mut serde_json::Value)) -> String {
+        let mut v = serde_json::json!({
+            "degree_u": 1,
+            "degree_v": 2,
+            "knots_u": [0, 0, 1, 1],
+            "knots_v": [0, 0, 0, 1, 1, 1],
+            "control_points": [
+                [[0, 0, 0], [0, 1, 1], [0, 2, 0]],
+                [[1, 0, 0], [1, 1, 1], [1, 2, 0]]
+            ],
+            "unit": "mm"
+        });
+        edit(&mut v);
+        v.to_string()
+    }
+
+    fn error(edit: impl FnOnce(&mut serde_json::Value)) -> NurbsError {
+        NurbsSurface::from_json(&json_with(edit)).unwrap_err()
+    }
+
+    #[test]
+    fn a_small_net_reads_with_its_unit_and_domain() {
+        let s = NurbsSurface::from_json(&json_with(|_| {})).unwrap();
+        assert_eq!(s.unit(), Some(LengthUnit::Millimetre));
+        assert_eq!(s.degrees(), (1, 2));
+        assert_eq!(s.control_net_size(), (2, 3));
+        let d = s.domain();
+        assert_eq!((d.u, d.v), ((0.0, 1.0), (0.0, 1.0)));
+        // The middle of a quadratic Bezier arch of control height 1 is at height 1/2.
+        let m = s.derivatives(0.5, 0.5);
+        assert_eq!(m.p, Vec3::new(0.5, 1.0, 0.5));
+        assert_eq!(m.pvv, Vec3::new(0.0, 0.0, -4.0));
+        assert_eq!(m.puu, Vec3::zeros());
+        let (lo, hi) = s.control_bounds();
+        assert_eq!((lo, hi), (Vec3::zeros(), Vec3::new(1.0, 2.0, 1.0)));
+    }
+
+    #[test]
+    fn derivatives_match_finite_differences() {
+        let text = json_with(|v| {
+            v["weights"] = serde_json::json!([[1, 0.5, 2], [1.5, 1, 0.7]]);
+        });
+        let s = NurbsSurface::from_json(&text).unwrap();
+        let h = 1e-5;
+        for (u, v) in [(0.3, 0.2), (0.7, 0.9), (0.5, 0.5)] {
+            let d = s.derivatives(u, v);
+            let du = |f: &dyn Fn(f64, f64) -> Vec3| (f(u + h, v) - f(u - h, v)) / (2.0 * h);
+            let dv = |f: &dyn Fn(f64, f64) -> Vec3| (f(u, v + h) - f(u, v - h)) / (2.0 * h);
+            let pu = |a, b| s.derivatives(a, b).pu;
+            let pv = |a, b| s.derivatives(a, b).pv;
+            let p = |a, b| s.derivatives(a, b).p;
+            for (got, want) in [
+                (d.pu, du(&p)),
+                (d.pv, dv(&p)),
+                (d.puu, du(&pu)),
+                (d.puv, dv(&pu)),
+                (d.pvv, dv(&pv)),
+            ] {
+                assert!(
+                    (got - want).norm() < 1e-6 * (1.0 + want.norm()),
+                    "{got:?} {want:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn every_rule_has_its_error() {
+        let msg = |e: NurbsError| e.to_string();
+        assert!(matches!(
+            NurbsSurface::from_json("{\"degree_u\": 1,\n \"degree_v\": }").unwrap_err(),
+            NurbsError::Json { line: 2, .. }
+        ));
+        assert!(
+            msg(error(|v| v["degree_u"] = 0.into()))
+                .contains("degree_u is 0; use a degree from 1 to 11")
+        );
+        assert!(matches!(
+            error(|v| v["degree_v"] = 3.into()),
+            NurbsError::TooFewPoints {
+                direction: 'v',
+                count: 3,
+                degree: 3
+            }
+        ));
+        assert!(matches!(
+            error(|v| v["control_points"][1] = serde_json::json!([[1, 0, 0]])),
+            NurbsError::RaggedNet {
+                what: "control_points",
+                row: 1,
+                len: 1,
+                expected: 3
+            }
+        ));
+        assert_eq!(
+            msg(error(|v| v["knots_v"] = serde_json::json!([0, 1, 1]))),
+            "knots_v has 3 knots; 3 control points of degree 2 need 6 (or 4 in Rhino's \
+             convention, without the two end knots)"
+        );
+        assert!(matches!(
+            error(|v| v["knots_u"] = serde_json::json!([0, 1, 0.5, 1])),
+            NurbsError::KnotOrder {
+                direction: 'u',
+                index: 2,
+                ..
+            }
+        ));
+        assert!(matches!(
+            error(|v| v["knots_u"] = serde_json::json!([1, 1, 1, 1])),
+            NurbsError::EmptyDomain { direction: 'u', .. }
+        ));
+        assert!(matches!(
+            error(|v| v["weights"] = serde_json::json!([[1, 1, 1], [1, 0, 1]])),
+            NurbsError::Weight { i: 1, j: 1, .. }
+        ));
+        assert!(matches!(
+            error(|v| v["weights"] = serde_json::json!([[1, 1, 1]])),
+            NurbsError::WeightRows {
+                rows: 1,
+                expected: 2
+            }
+        ));
+        assert!(msg(error(|v| v["unit"] = "furlong".into())).contains("unknown length unit"));
+        // An unknown field is a typo, not something to ignore.
+        assert!(matches!(
+            error(|v| v["degre_u"] = 1.into()),
+            NurbsError::Json { .. }
+        ));
+        // Finite in the file but not once weighted.
+        assert!(matches!(
+            error(|v| {
+                v["control_points"][0][0] = serde_json::json!([1e308, 0, 0]);
+                v["weights"] = serde_json::json!([[10, 1, 1], [1, 1, 1]]);
+            }),
+            NurbsError::PointNotFinite { i: 0, j: 0 }
+        ));
+        // Five equal interior knots on a degree-2 direction tear the surface.
+        let torn = error(|v| {
+            v["control_points"] = serde_json::json!([
+                [
+                    [0, 0, 0],
+                    [0, 1, 0],
+                    [0, 2, 0],
+                    [0, 3, 0],
+                    [0, 4, 0],
+                    [0, 5, 0]
+                ],
+                [
+                    [1, 0, 0],
+                    [1, 1, 0],
+                    [1, 2, 0],
+                    [1, 3, 0],
+                    [1, 4, 0],
+                    [1, 5, 0]
+                ]
+            ]);
+            v["knots_v"] = serde_json::json!([0, 0, 0, 0.5, 0.5, 0.5, 1, 1, 1]);
+        });
+        assert!(matches!(
+            torn,
+            NurbsError::KnotMultiplicity {
+                direction: 'v',
+                multiplicity: 3,
+                degree: 2,
+                ..
+            }
+        ));
+        let big = "x".repeat(MAX_NURBS_JSON_BYTES + 1);
+        assert!(matches!(
+            NurbsSurface::from_json(&big),
+            Err(NurbsError::TooLong { .. })
+        ));
+    }
+}
