@@ -6,9 +6,10 @@ use dupin_core::Stepper;
 use dupin_core::mesh::write_obj;
 use dupin_core::phex::{PhexConfig, PhexGoals, PhexPipeline, TriangulationMethod};
 use dupin_core::scenes::{PHEX_SCENES, phex_scene};
+use dupin_core::surface::NurbsSurface;
 use dupin_core::surface::parse_assignment;
 use serde_json::json;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Arguments of `dupin phex`.
 #[derive(Debug, Args)]
@@ -17,8 +18,12 @@ pub struct PhexArgs {
     #[arg(long, conflicts_with = "surface")]
     pub scene: Option<String>,
     /// Library surface name (see `dupin surface-info --list`).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "input")]
     pub surface: Option<String>,
+    /// A design to panel: a NURBS surface as JSON (docs/nurbs-json.md); --size is then in the
+    /// file's unit.
+    #[arg(long, conflicts_with = "scene")]
+    pub input: Option<PathBuf>,
     /// Surface parameter KEY=VALUE (repeatable).
     #[arg(long = "set")]
     pub set: Vec<String>,
@@ -72,6 +77,17 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
     // A scene made to show invalid faces (Fig. 11's hyperboloid) has them by design.
     let mut expect_valid = true;
     let mut config = match (&args.scene, &args.surface) {
+        _ if args.input.is_some() => {
+            if !args.set.is_empty() {
+                return Err(CliError::Input(
+                    "--set applies to --surface, not to --input".into(),
+                ));
+            }
+            let path = args.input.as_deref().unwrap_or(Path::new(""));
+            let surface = read_design_surface(path)?;
+            let label = path.display().to_string();
+            PhexConfig::for_nurbs(&label, surface, None)
+        }
         (Some(name), None) => {
             if !args.set.is_empty() {
                 return Err(CliError::Input(
@@ -97,7 +113,7 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
         }
         _ => {
             return Err(CliError::Input(
-                "give exactly one of --scene NAME or --surface NAME".into(),
+                "give exactly one of --scene NAME, --surface NAME or --input FILE".into(),
             ));
         }
     };
@@ -131,7 +147,8 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
         .scene
         .clone()
         .or(args.surface.clone())
-        .unwrap_or_default();
+        .unwrap_or_else(|| config.surface.clone());
+    let unit = config.nurbs.as_ref().and_then(|n| n.unit());
     // Planar faces (unless the optimisation is off) and simple faces (unless the scene shows
     // invalid ones).
     let goals = PhexGoals::of(&config, expect_valid);
@@ -168,6 +185,9 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
     if let Some(r) = &reason {
         report["reason"] = json!(r);
     }
+    if let Some(u) = unit {
+        report["unit"] = json!(u.name());
+    }
     write_report(args.report.as_deref(), &report)?;
     println!(
         "phex {label}: {} faces, max_planarity {:.3e}, {} invalid faces, {} iterations, {:.3} s{}",
@@ -184,4 +204,34 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
         Some(r) => Err(CliError::Unmet(r)),
         None => Ok(()),
     }
+}
+
+/// Reads the surface of a design file: a NURBS surface as JSON (told by the `.json` name or a
+/// first `{`). Errors name the file.
+fn read_design_surface(path: &Path) -> Result<NurbsSurface, CliError> {
+    let name = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|source| CliError::Io {
+        path: name.clone(),
+        source,
+    })?;
+    let is_json = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+        || bytes
+            .iter()
+            .find(|b| !b.is_ascii_whitespace())
+            .is_some_and(|&b| b == b'{');
+    if !is_json {
+        return Err(CliError::Input(format!(
+            "{name}: phex --input reads a NURBS surface as JSON (docs/nurbs-json.md); a mesh \
+             (OBJ, STL, glTF) is panelled with dupin planarize --input"
+        )));
+    }
+    let text = String::from_utf8(bytes).map_err(|e| {
+        CliError::Input(format!(
+            "{name}: not UTF-8 text (byte {})",
+            e.utf8_error().valid_up_to()
+        ))
+    })?;
+    NurbsSurface::from_json(&text).map_err(|e| CliError::input(&name, e))
 }

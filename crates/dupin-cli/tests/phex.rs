@@ -136,3 +136,82 @@ fn missed_results_exit_3_with_output_and_reason() {
     assert!(rep["invalid_faces"].as_u64().unwrap() > 0);
     assert_eq!(rep["converged"], true);
 }
+
+/// A design from a CAD tool: a bicubic NURBS dome 12 m x 12 m in metres, written as
+/// the documented JSON; its control heights are f(x) + g(y), so the parameter lines are
+/// conjugate and method 2 applies.
+fn nurbs_dome_json() -> String {
+    let knots = serde_json::json!([0, 0, 0, 0, 1, 2, 3, 3, 3, 3]);
+    let points: Vec<Vec<[f64; 3]>> = (0..6)
+        .map(|i| {
+            (0..6)
+                .map(|j| {
+                    let (x, y) = (2.4 * i as f64 - 6.0, 2.4 * j as f64 - 6.0);
+                    [x, y, 3.0 - (x * x + y * y) / 24.0]
+                })
+                .collect()
+        })
+        .collect();
+    serde_json::json!({
+        "degree_u": 3, "degree_v": 3, "knots_u": knots, "knots_v": knots,
+        "control_points": points, "unit": "m"
+    })
+    .to_string()
+}
+
+#[test]
+fn input_panels_a_nurbs_design_in_its_unit() {
+    let design = tmp("dome-design.json");
+    std::fs::write(&design, nurbs_dome_json()).unwrap();
+    let path = design.to_str().unwrap();
+    let run = run_reported(
+        "dome",
+        &[
+            "phex",
+            "--input",
+            path,
+            "--method",
+            "prescribed",
+            "--size",
+            "0.8",
+        ],
+    );
+    let r = run.ok();
+    assert_eq!(r["unit"], "m");
+    assert_eq!(r["invalid_faces"], 0);
+    assert!(r["max_planarity"].as_f64().unwrap() <= 1e-10);
+    assert!(r["faces"].as_u64().unwrap() > 100, "{r}");
+    // The panels lie on the 12 m dome, within 0.5% of its diagonal.
+    assert!(
+        r["max_surface_distance"].as_f64().unwrap() <= 0.005 * r["bbox_diagonal"].as_f64().unwrap()
+    );
+    assert!(run.stdout().contains("dome-design.json"));
+    let out = tmp("dome-bad.obj");
+    let out = out.to_str().unwrap();
+    // Malformed JSON names the file and the line; a mesh is sent to planarize.
+    let broken = tmp("broken.json");
+    std::fs::write(&broken, "{\n  \"degree_u\": 3,\n  \"degree_v\": x\n}").unwrap();
+    let (_, err) = refused(&["phex", "--input", broken.to_str().unwrap(), "--out", out]);
+    assert!(
+        err.contains("broken.json") && err.contains("line 3"),
+        "{err}"
+    );
+    let mesh = tmp("mesh.obj");
+    std::fs::write(&mesh, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let (_, err) = refused(&["phex", "--input", mesh.to_str().unwrap(), "--out", out]);
+    assert!(err.contains("dupin planarize"), "{err}");
+    refused(&["phex", "--input", path, "--set", "R=2", "--out", out]);
+    refused(&[
+        "phex",
+        "--input",
+        path,
+        "--scene",
+        "torus-bound",
+        "--out",
+        out,
+    ]);
+    refused(&["phex", "--input", "/no/such/file.json", "--out", out]);
+    for p in [design, broken, mesh] {
+        let _ = std::fs::remove_file(p);
+    }
+}

@@ -198,3 +198,75 @@ fn the_json_form_reads_back_bit_for_bit_in_both_knot_conventions() {
         assert_eq!(rhino.derivatives(u, v), s.derivatives(u, v));
     }
 }
+
+/// A bicubic B-spline roof 20 m x 15 m whose control heights are f(x) + g(y): the surface is
+/// then exactly translational, (X(s), Y(t), F(s) + G(t)), so its parameter lines are conjugate
+/// (method 2 applies), and F = 2 sin(x / 5), G = 0.06 y^2 give K > 0 for x < 0, K < 0 for x > 0
+/// and a parabolic line between (the imported stand-in of the paper's Fig. 22).
+fn translational_roof() -> NurbsDefinition {
+    let p = 3;
+    let knots = |n: usize| {
+        let spans = n - p;
+        let mut k = vec![0.0; p + 1];
+        k.extend((1..spans).map(|i| i as f64));
+        k.extend(vec![spans as f64; p + 1]);
+        k
+    };
+    let greville = |k: &[f64], n: usize| -> Vec<f64> {
+        (0..n)
+            .map(|i| k[i + 1..i + p + 1].iter().sum::<f64>() / p as f64 / (n - p) as f64)
+            .collect()
+    };
+    let (nu, nv) = (12, 9);
+    let (ku, kv) = (knots(nu), knots(nv));
+    let control_points = greville(&ku, nu)
+        .iter()
+        .map(|a| {
+            let x = -10.0 + 20.0 * a;
+            greville(&kv, nv)
+                .iter()
+                .map(|b| {
+                    let y = -7.5 + 15.0 * b;
+                    [x, y, 2.0 * (x / 5.0).sin() + 0.06 * y * y]
+                })
+                .collect()
+        })
+        .collect();
+    NurbsDefinition {
+        degree_u: p,
+        degree_v: p,
+        knots_u: ku,
+        knots_v: kv,
+        control_points,
+        weights: None,
+        unit: Some("m".into()),
+    }
+}
+
+#[test]
+fn phex_panels_an_imported_roof_with_both_curvature_signs() {
+    use dupin_core::Stepper;
+    use dupin_core::phex::{PhexConfig, PhexPipeline, TriangulationMethod};
+    let roof = NurbsSurface::try_from(translational_roof()).unwrap();
+    let d = roof.domain();
+    // Both signs of K: the paper's case of a parabolic curve crossing every layer.
+    let k = |a: f64| {
+        let u = d.u.0 + a * (d.u.1 - d.u.0);
+        let v = (d.v.0 + d.v.1) / 2.0;
+        roof.curvature(u, v).unwrap().gaussian
+    };
+    assert!(k(0.2) > 1e-4 && k(0.8) < -1e-4, "{} {}", k(0.2), k(0.8));
+    let mut config = PhexConfig::for_nurbs("roof", roof, Some(0.6));
+    config.method = TriangulationMethod::Prescribed;
+    let r = PhexPipeline::new(config).and_then(Stepper::finish).unwrap();
+    let rep = &r.report;
+    assert!(rep.faces > 1000, "{} faces", rep.faces);
+    assert_eq!(rep.invalid_faces, 0);
+    assert!(rep.max_planarity <= 1e-10, "{}", rep.max_planarity);
+    assert!(
+        rep.max_surface_distance <= 0.005 * rep.bbox_diagonal,
+        "{} of a {} m diagonal",
+        rep.max_surface_distance,
+        rep.bbox_diagonal
+    );
+}

@@ -13,14 +13,20 @@ use super::triangulation::{
 };
 use crate::Stepper;
 use crate::mesh::{PolyMesh, max_planarity};
-use crate::surface::{FREEFORM, FreeformSurface, Surface, TwistedSurface, surface_by_name};
+use crate::surface::{
+    FREEFORM, FreeformSurface, NurbsSurface, Surface, TwistedSurface, surface_by_name,
+};
+use std::sync::Arc;
 
 /// Everything a run needs. Build it from a scene ([`crate::scenes::phex_scene`]) or with
 /// [`PhexConfig::for_surface`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct PhexConfig {
-    /// Library surface name (see `surface_catalog`).
+    /// Library surface name (see `surface_catalog`), or the label of the imported surface.
     pub surface: String,
+    /// An imported NURBS surface (a design from a CAD tool); when set it is the surface meshed,
+    /// `surface` only names it and `params` must be empty.
+    pub nurbs: Option<Arc<NurbsSurface>>,
     /// Surface parameters.
     pub params: Vec<(String, f64)>,
     /// Shear of the parametrisation, P(u + twist v, v) (0 for none).
@@ -81,6 +87,16 @@ impl PhexConfig {
         }
     }
 
+    /// A configuration for an imported NURBS surface named `label`: its whole domain, method 1
+    /// (progressive conjugation, section 5.2: a design's parameter lines are seldom conjugate,
+    /// which method 2 needs), lower bound b = 0.3.
+    pub fn for_nurbs(label: &str, surface: NurbsSurface, size: Option<f64>) -> PhexConfig {
+        PhexConfig {
+            nurbs: Some(Arc::new(surface)),
+            ..PhexConfig::for_surface(label, &[], TriangulationMethod::Progressive, size)
+        }
+    }
+
     /// A configuration for a library surface with the whole domain (the sphere and ellipsoid
     /// stop at latitude +-1.2 to avoid the singular poles), lower bound b = 0.3.
     pub fn for_surface(
@@ -92,6 +108,7 @@ impl PhexConfig {
         let across = matches!(surface, "sphere" | "ellipsoid").then_some((-1.2, 1.2));
         PhexConfig {
             surface: surface.to_string(),
+            nurbs: None,
             params: params.to_vec(),
             twist: 0.0,
             method,
@@ -194,7 +211,14 @@ fn build_surface(config: &PhexConfig) -> Result<Box<dyn Surface>, PhexError> {
         .iter()
         .map(|(k, v)| (k.as_str(), *v))
         .collect();
-    let s: Box<dyn Surface> = if config.surface == FREEFORM {
+    let s: Box<dyn Surface> = if let Some(nurbs) = &config.nurbs {
+        if !params.is_empty() {
+            return Err(PhexError::BadParameter(
+                "an imported surface has no parameters to set".into(),
+            ));
+        }
+        Box::new(NurbsSurface::clone(nurbs))
+    } else if config.surface == FREEFORM {
         let (mut amplitude, mut curl) = (0.4, 0.3);
         for (k, v) in &params {
             let slot = match *k {
@@ -401,7 +425,7 @@ impl PhexPipeline {
     }
 
     fn from_loop(config: PhexConfig, surface: Box<dyn Surface>) -> Result<Self, PhexError> {
-        if config.surface != "ellipsoid" {
+        if config.surface != "ellipsoid" || config.nurbs.is_some() {
             return Err(PhexError::BadParameter(
                 "Loop subdivision (convex genus 0) needs --surface ellipsoid".into(),
             ));

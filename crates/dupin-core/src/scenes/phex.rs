@@ -81,6 +81,7 @@ impl SceneSpec {
     fn config(self) -> PhexConfig {
         PhexConfig {
             surface: self.surface.to_string(),
+            nurbs: None,
             params: Vec::new(),
             twist: 0.0,
             method: self.method,
