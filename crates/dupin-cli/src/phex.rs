@@ -1,13 +1,14 @@
 //! `dupin phex`: P-Hex meshes from a scene or a library surface (P-Hex paper, sections 5-7).
 
+use crate::common::read_mesh_file;
 use crate::common::{CliError, write_report, write_text};
 use clap::Args;
 use dupin_core::Stepper;
 use dupin_core::mesh::write_obj;
 use dupin_core::phex::{PhexConfig, PhexGoals, PhexPipeline, TriangulationMethod};
 use dupin_core::scenes::{PHEX_SCENES, phex_scene};
-use dupin_core::surface::NurbsSurface;
 use dupin_core::surface::parse_assignment;
+use dupin_core::surface::{MeshFitOptions, MeshSurface, NurbsSurface, fit_mesh_surface};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -20,7 +21,8 @@ pub struct PhexArgs {
     /// Library surface name (see `dupin surface-info --list`).
     #[arg(long, conflicts_with = "input")]
     pub surface: Option<String>,
-    /// A design to panel: a NURBS surface as JSON (docs/nurbs-json.md); --size is then in the
+    /// A design to panel: a NURBS surface as JSON (docs/nurbs-json.md), or a triangle mesh of a
+    /// smooth disk-like surface (OBJ, STL, glTF/GLB) that is fitted first; --size is in the
     /// file's unit.
     #[arg(long, conflicts_with = "scene")]
     pub input: Option<PathBuf>,
@@ -76,6 +78,7 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
     let method = args.method;
     // A scene made to show invalid faces (Fig. 11's hyperboloid) has them by design.
     let mut expect_valid = true;
+    let mut fitted = None;
     let mut config = match (&args.scene, &args.surface) {
         _ if args.input.is_some() => {
             if !args.set.is_empty() {
@@ -84,7 +87,8 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
                 ));
             }
             let path = args.input.as_deref().unwrap_or(Path::new(""));
-            let surface = read_design_surface(path)?;
+            let (surface, mesh) = read_design_surface(path)?;
+            fitted = mesh;
             let label = path.display().to_string();
             PhexConfig::for_nurbs(&label, surface, None)
         }
@@ -188,6 +192,19 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
     if let Some(u) = unit {
         report["unit"] = json!(u.name());
     }
+    if let Some(f) = &fitted {
+        // How far the fitted surface is from the mesh, and the panels from the mesh itself.
+        let far = r
+            .mesh
+            .positions
+            .iter()
+            .filter_map(|p| f.mesh.closest_point(p).ok())
+            .map(|c| c.distance)
+            .fold(0.0, f64::max);
+        report["fit_max_distance"] = json!(f.max_distance);
+        report["fit_mean_distance"] = json!(f.mean_distance);
+        report["max_input_distance"] = json!(far);
+    }
     write_report(args.report.as_deref(), &report)?;
     println!(
         "phex {label}: {} faces, max_planarity {:.3e}, {} invalid faces, {} iterations, {:.3} s{}",
@@ -206,9 +223,17 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
     }
 }
 
+/// The input mesh a fitted surface stands for, to measure the panels against.
+struct FittedMesh {
+    mesh: MeshSurface,
+    max_distance: f64,
+    mean_distance: f64,
+}
+
 /// Reads the surface of a design file: a NURBS surface as JSON (told by the `.json` name or a
-/// first `{`). Errors name the file.
-fn read_design_surface(path: &Path) -> Result<NurbsSurface, CliError> {
+/// first `{`), or a triangle mesh (OBJ, STL, glTF/GLB) fitted by a smooth surface. Errors name
+/// the file.
+fn read_design_surface(path: &Path) -> Result<(NurbsSurface, Option<FittedMesh>), CliError> {
     let name = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|source| CliError::Io {
         path: name.clone(),
@@ -221,17 +246,23 @@ fn read_design_surface(path: &Path) -> Result<NurbsSurface, CliError> {
             .iter()
             .find(|b| !b.is_ascii_whitespace())
             .is_some_and(|&b| b == b'{');
-    if !is_json {
-        return Err(CliError::Input(format!(
-            "{name}: phex --input reads a NURBS surface as JSON (docs/nurbs-json.md); a mesh \
-             (OBJ, STL, glTF) is panelled with dupin planarize --input"
-        )));
+    if is_json {
+        let text = String::from_utf8(bytes).map_err(|e| {
+            CliError::Input(format!(
+                "{name}: not UTF-8 text (byte {})",
+                e.utf8_error().valid_up_to()
+            ))
+        })?;
+        let surface = NurbsSurface::from_json(&text).map_err(|e| CliError::input(&name, e))?;
+        return Ok((surface, None));
     }
-    let text = String::from_utf8(bytes).map_err(|e| {
-        CliError::Input(format!(
-            "{name}: not UTF-8 text (byte {})",
-            e.utf8_error().valid_up_to()
-        ))
-    })?;
-    NurbsSurface::from_json(&text).map_err(|e| CliError::input(&name, e))
+    let mesh = read_mesh_file(path)?;
+    let fit = fit_mesh_surface(&mesh, &MeshFitOptions::default())
+        .map_err(|e| CliError::input(&name, e))?;
+    let fitted = FittedMesh {
+        mesh: MeshSurface::from_mesh(mesh),
+        max_distance: fit.max_distance,
+        mean_distance: fit.mean_distance,
+    };
+    Ok((fit.surface, Some(fitted)))
 }

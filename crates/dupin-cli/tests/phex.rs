@@ -188,7 +188,7 @@ fn input_panels_a_nurbs_design_in_its_unit() {
     assert!(run.stdout().contains("dome-design.json"));
     let out = tmp("dome-bad.obj");
     let out = out.to_str().unwrap();
-    // Malformed JSON names the file and the line; a mesh is sent to planarize.
+    // Malformed JSON names the file and the line; panels are sent to planarize.
     let broken = tmp("broken.json");
     std::fs::write(&broken, "{\n  \"degree_u\": 3,\n  \"degree_v\": x\n}").unwrap();
     let (_, err) = refused(&["phex", "--input", broken.to_str().unwrap(), "--out", out]);
@@ -197,9 +197,10 @@ fn input_panels_a_nurbs_design_in_its_unit() {
         "{err}"
     );
     let mesh = tmp("mesh.obj");
-    std::fs::write(&mesh, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    std::fs::write(&mesh, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n").unwrap();
     let (_, err) = refused(&["phex", "--input", mesh.to_str().unwrap(), "--out", out]);
-    assert!(err.contains("dupin planarize"), "{err}");
+    assert!(err.contains("mesh.obj: face 1 has 4 corners"), "{err}");
+    assert!(err.contains("planarised"), "{err}");
     refused(&["phex", "--input", path, "--set", "R=2", "--out", out]);
     refused(&[
         "phex",
@@ -214,4 +215,46 @@ fn input_panels_a_nurbs_design_in_its_unit() {
     for p in [design, broken, mesh] {
         let _ = std::fs::remove_file(p);
     }
+}
+
+/// The same dome as a triangle mesh with no UVs (an exporter's OBJ): fitted, then panelled; the
+/// report gives the fit's distances and the panels' distance to the mesh.
+#[test]
+fn input_fits_and_panels_a_triangle_mesh() {
+    let n = 30;
+    let mut obj = String::from("# dome, metres\n");
+    for i in 0..=n {
+        for j in 0..=n {
+            let (x, y) = (
+                12.0 * i as f64 / n as f64 - 6.0,
+                12.0 * j as f64 / n as f64 - 6.0,
+            );
+            obj += &format!("v {x} {y} {}\n", 3.0 - (x * x + y * y) / 24.0);
+        }
+    }
+    let id = |i: usize, j: usize| i * (n + 1) + j + 1;
+    for i in 0..n {
+        for j in 0..n {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            obj += &format!("f {a} {b} {c}\nf {a} {c} {d}\n");
+        }
+    }
+    let design = tmp("dome-mesh.obj");
+    std::fs::write(&design, obj).unwrap();
+    let run = run_reported(
+        "dome-mesh",
+        &["phex", "--input", design.to_str().unwrap(), "--size", "0.5"],
+    );
+    let r = run.ok();
+    assert_eq!(r["invalid_faces"], 0, "{r}");
+    assert!(r["max_planarity"].as_f64().unwrap() <= 1e-10);
+    // A 30 x 30 grid of a paraboloid: the fit is within a few millimetres of its vertices.
+    assert!(r["fit_max_distance"].as_f64().unwrap() < 5e-3, "{r}");
+    assert!(r["fit_mean_distance"].as_f64().unwrap() <= r["fit_max_distance"].as_f64().unwrap());
+    let diagonal = r["bbox_diagonal"].as_f64().unwrap();
+    assert!(
+        r["max_input_distance"].as_f64().unwrap() <= 0.005 * diagonal,
+        "{r}"
+    );
+    let _ = std::fs::remove_file(design);
 }

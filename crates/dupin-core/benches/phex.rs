@@ -164,5 +164,68 @@ fn bench_dupin_start(
     });
 }
 
-criterion_group!(benches, bench);
+/// The import path: evaluating the NURBS roof (position and derivatives to second order) with
+/// our evaluator and with curvo's, side by side, and the whole P-Hex pipeline on it at about 10k
+/// panels (method 2: its parameter lines are conjugate).
+fn bench_nurbs(c: &mut Criterion) {
+    use curvo::prelude::{KnotVector, NurbsSurface3D};
+    use dupin_core::scenes::benchmark_meshes::nurbs_roof;
+    use dupin_core::surface::NurbsSurface;
+    let def = nurbs_roof();
+    let ours = NurbsSurface::try_from(def.clone()).unwrap();
+    let points = def
+        .control_points
+        .iter()
+        .map(|row| {
+            row.iter()
+                .map(|p| nalgebra::Point4::new(p[0], p[1], p[2], 1.0))
+                .collect()
+        })
+        .collect();
+    let theirs = NurbsSurface3D::new(
+        def.degree_u,
+        def.degree_v,
+        KnotVector::new(def.knots_u.clone()),
+        KnotVector::new(def.knots_v.clone()),
+        points,
+    );
+    let d = ours.domain();
+    let params: Vec<(f64, f64)> = (0..1000)
+        .map(|k| {
+            let (a, b) = ((k % 37) as f64 / 37.0, (k % 41) as f64 / 41.0);
+            (d.u.0 + a * (d.u.1 - d.u.0), d.v.0 + b * (d.v.1 - d.v.0))
+        })
+        .collect();
+    let mut g = c.benchmark_group("nurbs_roof");
+    g.bench_function("derivatives_1000_ours", |b| {
+        b.iter(|| {
+            params
+                .iter()
+                .map(|&(u, v)| ours.derivatives(u, v).puv.x)
+                .sum::<f64>()
+        })
+    });
+    g.bench_function("derivatives_1000_curvo", |b| {
+        b.iter(|| {
+            params
+                .iter()
+                .map(|&(u, v)| theirs.rational_derivatives(u, v, 2)[1][1].x)
+                .sum::<f64>()
+        })
+    });
+    let mut cfg = PhexConfig::for_nurbs("roof", ours.clone(), Some(0.22));
+    cfg.method = TriangulationMethod::Prescribed;
+    let r = phex_run(cfg.clone()).unwrap();
+    eprintln!(
+        "phex nurbs roof: {} faces, max_planarity {:.2e}, {} invalid, iterations {}",
+        r.report.faces, r.report.max_planarity, r.report.invalid_faces, r.report.iterations
+    );
+    g.sample_size(10);
+    g.bench_function("phex_pipeline_10k", |b| {
+        b.iter(|| black_box(phex_run(cfg.clone()).unwrap()))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench, bench_nurbs);
 criterion_main!(benches);

@@ -6,6 +6,7 @@
 
 use curvo::prelude::{KnotVector, NurbsSurface3D};
 use dupin_core::Vec3;
+use dupin_core::scenes::benchmark_meshes::nurbs_roof;
 use dupin_core::surface::{NurbsDefinition, NurbsSurface, Surface};
 use nalgebra::{Point3, Point4, Vector3};
 use rand::{RngExt, SeedableRng};
@@ -199,55 +200,11 @@ fn the_json_form_reads_back_bit_for_bit_in_both_knot_conventions() {
     }
 }
 
-/// A bicubic B-spline roof 20 m x 15 m whose control heights are f(x) + g(y): the surface is
-/// then exactly translational, (X(s), Y(t), F(s) + G(t)), so its parameter lines are conjugate
-/// (method 2 applies), and F = 2 sin(x / 5), G = 0.06 y^2 give K > 0 for x < 0, K < 0 for x > 0
-/// and a parabolic line between (the imported stand-in of the paper's Fig. 22).
-fn translational_roof() -> NurbsDefinition {
-    let p = 3;
-    let knots = |n: usize| {
-        let spans = n - p;
-        let mut k = vec![0.0; p + 1];
-        k.extend((1..spans).map(|i| i as f64));
-        k.extend(vec![spans as f64; p + 1]);
-        k
-    };
-    let greville = |k: &[f64], n: usize| -> Vec<f64> {
-        (0..n)
-            .map(|i| k[i + 1..i + p + 1].iter().sum::<f64>() / p as f64 / (n - p) as f64)
-            .collect()
-    };
-    let (nu, nv) = (12, 9);
-    let (ku, kv) = (knots(nu), knots(nv));
-    let control_points = greville(&ku, nu)
-        .iter()
-        .map(|a| {
-            let x = -10.0 + 20.0 * a;
-            greville(&kv, nv)
-                .iter()
-                .map(|b| {
-                    let y = -7.5 + 15.0 * b;
-                    [x, y, 2.0 * (x / 5.0).sin() + 0.06 * y * y]
-                })
-                .collect()
-        })
-        .collect();
-    NurbsDefinition {
-        degree_u: p,
-        degree_v: p,
-        knots_u: ku,
-        knots_v: kv,
-        control_points,
-        weights: None,
-        unit: Some("m".into()),
-    }
-}
-
 #[test]
 fn phex_panels_an_imported_roof_with_both_curvature_signs() {
     use dupin_core::Stepper;
     use dupin_core::phex::{PhexConfig, PhexPipeline, TriangulationMethod};
-    let roof = NurbsSurface::try_from(translational_roof()).unwrap();
+    let roof = NurbsSurface::try_from(nurbs_roof()).unwrap();
     let d = roof.domain();
     // Both signs of K: the paper's case of a parabolic curve crossing every layer.
     let k = |a: f64| {

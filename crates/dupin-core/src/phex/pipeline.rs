@@ -87,13 +87,18 @@ impl PhexConfig {
         }
     }
 
-    /// A configuration for an imported NURBS surface named `label`: its whole domain, method 1
-    /// (progressive conjugation, section 5.2: a design's parameter lines are seldom conjugate,
-    /// which method 2 needs), lower bound b = 0.3.
+    /// A configuration for an imported NURBS surface named `label`: its whole domain, method 2
+    /// along the parameter lines with the tangent-duality start (section 6: every hexagon lies
+    /// in a tangent plane, so the faces start planar), lower bound b = 0.3. Method 2 asks for
+    /// conjugate parameter lines; where a design's lines are far from conjugate the hexagons
+    /// come out non-simple and the report counts them as invalid (then try
+    /// `field_angle = Some(0.0)`, the principal directions, or method 1). Measured: on a
+    /// translational roof (conjugate lines) and on the mean-value fit of a dome mesh, method 2
+    /// gave no invalid face where method 1 gave 60 of 404 and 64 of 339.
     pub fn for_nurbs(label: &str, surface: NurbsSurface, size: Option<f64>) -> PhexConfig {
         PhexConfig {
             nurbs: Some(Arc::new(surface)),
-            ..PhexConfig::for_surface(label, &[], TriangulationMethod::Progressive, size)
+            ..PhexConfig::for_surface(label, &[], TriangulationMethod::Prescribed, size)
         }
     }
 

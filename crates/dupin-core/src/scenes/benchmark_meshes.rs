@@ -1,10 +1,11 @@
 //! Test and benchmark meshes for PQ perturbation: a skew quad grid on z = xy, a regular torus
-//! quad mesh, a noisy vase, a regular torus triangulation and its centroid dual.
+//! quad mesh, a noisy vase, a regular torus triangulation and its centroid dual; and a NURBS
+//! roof for the import path.
 
 use crate::Vec3;
 use crate::conical::principal_quad_mesh;
 use crate::mesh::PolyMesh;
-use crate::surface::{Surface, SurfaceOfRevolution, Torus};
+use crate::surface::{NurbsDefinition, Surface, SurfaceOfRevolution, Torus};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -125,6 +126,51 @@ pub fn torus_centroid_dual(nu: usize, nv: usize, major: f64, minor: f64) -> Poly
         }
     }
     PolyMesh::new(p, faces).expect("dual indices are valid")
+}
+
+/// An imported design for tests and benchmarks: a bicubic B-spline roof 20 m x 15 m (12 x 9
+/// control points, in metres) whose control heights are f(x) + g(y): the surface is
+/// then exactly translational, (X(s), Y(t), F(s) + G(t)), so its parameter lines are conjugate
+/// (method 2 applies), and F = 2 sin(x / 5), G = 0.06 y^2 give K > 0 for x < 0, K < 0 for x > 0
+/// and a parabolic line between (the imported stand-in of the paper's Fig. 22).
+pub fn nurbs_roof() -> NurbsDefinition {
+    let p = 3;
+    let knots = |n: usize| {
+        let spans = n - p;
+        let mut k = vec![0.0; p + 1];
+        k.extend((1..spans).map(|i| i as f64));
+        k.extend(vec![spans as f64; p + 1]);
+        k
+    };
+    let greville = |k: &[f64], n: usize| -> Vec<f64> {
+        (0..n)
+            .map(|i| k[i + 1..i + p + 1].iter().sum::<f64>() / p as f64 / (n - p) as f64)
+            .collect()
+    };
+    let (nu, nv) = (12, 9);
+    let (ku, kv) = (knots(nu), knots(nv));
+    let control_points = greville(&ku, nu)
+        .iter()
+        .map(|a| {
+            let x = -10.0 + 20.0 * a;
+            greville(&kv, nv)
+                .iter()
+                .map(|b| {
+                    let y = -7.5 + 15.0 * b;
+                    [x, y, 2.0 * (x / 5.0).sin() + 0.06 * y * y]
+                })
+                .collect()
+        })
+        .collect();
+    NurbsDefinition {
+        degree_u: p,
+        degree_v: p,
+        knots_u: ku,
+        knots_v: kv,
+        control_points,
+        weights: None,
+        unit: Some("m".into()),
+    }
 }
 
 #[cfg(test)]

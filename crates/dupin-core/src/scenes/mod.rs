@@ -6,7 +6,7 @@
 //! |---|---|---|
 //! | P-Hex (Figs. 1, 11, 15, 18-22, sec. 3) | `cyclide-architecture`, `sphere-radial`, ... | `phex.rs` |
 //! | conical (Figs. 1, 7-9, 14, 16, 17) | `pq-catmull-clark`, `conical-station`, ... | `pq.rs` |
-//! | conical (benchmarks) | skew grid on z = xy, torus quads, triangulation and centroid dual, noisy vase | `benchmark_meshes.rs` |
+//! | conical (benchmarks), import | skew grid on z = xy, torus quads, triangulation and centroid dual, noisy vase; a NURBS roof | `benchmark_meshes.rs` |
 
 pub mod benchmark_meshes;
 mod phex;

@@ -7,6 +7,7 @@ mod bspline_patch;
 mod closest_point;
 mod curvature;
 mod library;
+mod mesh_fit;
 mod mesh_surface;
 mod nurbs;
 mod registry;
@@ -21,6 +22,7 @@ pub use library::{
     Catenoid, Cylinder, DupinCyclide, Ellipsoid, Enneper, FREEFORM, FreeformSurface,
     HyperbolicParaboloid, Hyperboloid, Sphere, SurfaceOfRevolution, Torus, TwistedSurface, Vase,
 };
+pub use mesh_fit::{MAX_FIT_TRIANGLES, MeshFit, MeshFitError, MeshFitOptions, fit_mesh_surface};
 pub use mesh_surface::{MeshClosestPoint, MeshSurface, MeshSurfaceError, VertexCurvature};
 pub use nurbs::{
     MAX_NURBS_CONTROL_POINTS, MAX_NURBS_DEGREE, MAX_NURBS_JSON_BYTES, NurbsDefinition, NurbsError,

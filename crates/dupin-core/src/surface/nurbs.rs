@@ -473,12 +473,26 @@ fn find_span(knots: &[f64], count: usize, p: usize, t: f64) -> usize {
     p + inside.partition_point(|&k| k <= t)
 }
 
+/// The knot span of `t` and the cubic basis functions non-zero there, `N[span - 3 + r]`
+/// (r = 0..=3): what a least-squares fit sums per data point.
+pub(super) fn basis_values(knots: &[f64], count: usize, p: usize, t: f64) -> (usize, [f64; 4]) {
+    debug_assert_eq!(p, 3);
+    let span = find_span(knots, count, p, t);
+    (span, basis_derivatives::<4>(knots, span, p, t)[0])
+}
+
 /// A2.3: the non-zero basis functions `N[i - p + r]` (r = 0..=p) at `t` and their first and
-/// second derivatives, `ders[k][r]`.
-fn basis_derivatives(knots: &[f64], span: usize, p: usize, t: f64) -> [[f64; P1]; 3] {
-    let mut ndu = [[0.0; P1]; P1];
-    let mut left = [0.0; P1];
-    let mut right = [0.0; P1];
+/// second derivatives, `ders[k][r]`, for `p < N` (arrays of N: the cubic path's are a ninth of
+/// the general one's, which callgrind showed zeroing took 6% of a P-Hex run).
+fn basis_derivatives<const N: usize>(
+    knots: &[f64],
+    span: usize,
+    p: usize,
+    t: f64,
+) -> [[f64; N]; 3] {
+    let mut ndu = [[0.0; N]; N];
+    let mut left = [0.0; N];
+    let mut right = [0.0; N];
     ndu[0][0] = 1.0;
     for j in 1..=p {
         left[j] = t - knots[span + 1 - j];
@@ -492,12 +506,12 @@ fn basis_derivatives(knots: &[f64], span: usize, p: usize, t: f64) -> [[f64; P1]
         }
         ndu[j][j] = saved;
     }
-    let mut ders = [[0.0; P1]; 3];
+    let mut ders = [[0.0; N]; 3];
     for j in 0..=p {
         ders[0][j] = ndu[j][p];
     }
     let nd = p.min(2);
-    let mut a = [[0.0; P1]; 2];
+    let mut a = [[0.0; N]; 2];
     for r in 0..=p {
         let (mut s1, mut s2) = (0, 1);
         a[0][0] = 1.0;
@@ -550,16 +564,28 @@ impl Surface for NurbsSurface {
         }
     }
 
+    fn derivatives(&self, u: f64, v: f64) -> SurfaceDerivatives {
+        if self.degree[0].max(self.degree[1]) <= 3 {
+            self.derivatives_up_to::<4>(u, v)
+        } else {
+            self.derivatives_up_to::<P1>(u, v)
+        }
+    }
+}
+
+impl NurbsSurface {
     /// A4.4 for derivatives up to second order: the homogeneous derivatives `A(k, l)` and
     /// `w(k, l)`, then `S(k, l) = (A(k, l) - sum of binomial(k, i) binomial(l, j) w(i, j)
-    /// S(k - i, l - j) over (i, j) != (0, 0)) / w`.
-    fn derivatives(&self, u: f64, v: f64) -> SurfaceDerivatives {
+    /// S(k - i, l - j) over (i, j) != (0, 0)) / w`; both degrees below `N`.
+    // r and s index the basis rows of all three orders and the net at once.
+    #[allow(clippy::needless_range_loop)]
+    fn derivatives_up_to<const N: usize>(&self, u: f64, v: f64) -> SurfaceDerivatives {
         let [p, q] = self.degree;
         let [nu, nv] = self.count;
         let su = find_span(&self.knots[0], nu, p, u);
         let sv = find_span(&self.knots[1], nv, q, v);
-        let bu = basis_derivatives(&self.knots[0], su, p, u);
-        let bv = basis_derivatives(&self.knots[1], sv, q, v);
+        let bu = basis_derivatives::<N>(&self.knots[0], su, p, u);
+        let bv = basis_derivatives::<N>(&self.knots[1], sv, q, v);
         // h[k][l]: the homogeneous derivative d^(k+l)/du^k dv^l, k + l <= 2.
         let mut h = [[[0.0f64; 4]; 3]; 3];
         for r in 0..=p {

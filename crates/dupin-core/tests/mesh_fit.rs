@@ -1,0 +1,141 @@
+//! A triangle mesh of a smooth design, with no UVs, fitted by a smooth surface
+//! (`surface/mesh_fit.rs`) and panelled by P-Hex: the fit is close to the mesh, the map is one to
+//! one, and the panels are planar, valid and close to the input mesh.
+
+use dupin_core::Vec3;
+use dupin_core::mesh::PolyMesh;
+use dupin_core::surface::{MeshFitError, MeshFitOptions, MeshSurface, fit_mesh_surface};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// A dome 12 m x 12 m, z = 3 - (x² + y²) / 24 (K > 0), as an irregular triangulation of
+/// `2 n²` triangles: a grid with jittered interior vertices and randomly chosen diagonals, the
+/// vertex order shuffled (an exporter's order is not a grid's).
+fn dome_mesh(n: usize, seed: u64) -> PolyMesh {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let h = 12.0 / n as f64;
+    let mut order: Vec<usize> = (0..(n + 1) * (n + 1)).collect();
+    for k in (1..order.len()).rev() {
+        order.swap(k, rng.random_range(0..=k));
+    }
+    let mut positions = vec![Vec3::zeros(); order.len()];
+    for i in 0..=n {
+        for j in 0..=n {
+            let jitter = |rng: &mut ChaCha8Rng, edge: bool| {
+                if edge {
+                    0.0
+                } else {
+                    rng.random_range(-0.3..0.3) * h
+                }
+            };
+            let x = -6.0 + i as f64 * h + jitter(&mut rng, i == 0 || i == n);
+            let y = -6.0 + j as f64 * h + jitter(&mut rng, j == 0 || j == n);
+            positions[order[i * (n + 1) + j]] = Vec3::new(x, y, 3.0 - (x * x + y * y) / 24.0);
+        }
+    }
+    let id = |i: usize, j: usize| order[i * (n + 1) + j] as u32;
+    let mut faces = vec![];
+    for i in 0..n {
+        for j in 0..n {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            if rng.random::<bool>() {
+                faces.extend([[a, b, c], [a, c, d]]);
+            } else {
+                faces.extend([[a, b, d], [b, c, d]]);
+            }
+        }
+    }
+    PolyMesh::new(positions, faces).unwrap()
+}
+
+#[test]
+fn a_dome_mesh_is_fitted_within_a_millimetre_and_the_map_is_one_to_one() {
+    let mesh = dome_mesh(104, 1);
+    assert!(mesh.num_faces() >= 20_000);
+    let fit = fit_mesh_surface(&mesh, &MeshFitOptions::default()).unwrap();
+    eprintln!(
+        "fit: {:?} control points, max {:.3e} m, mean {:.3e} m",
+        fit.surface.control_net_size(),
+        fit.max_distance,
+        fit.mean_distance
+    );
+    assert!(fit.max_distance < 1e-3, "{}", fit.max_distance);
+    // One to one: every triangle keeps its orientation in the parameter square.
+    for f in mesh.faces() {
+        let [a, b, c] = [0, 1, 2].map(|k| fit.uv[f[k] as usize]);
+        let area = (b - a).perp(&(c - a));
+        assert!(area > 0.0, "a flipped triangle {f:?}");
+    }
+    // The four corners of the square are the four corners of the dome.
+    for v in fit.corners {
+        let p = mesh.positions[v];
+        assert!(
+            (p.x.abs() - 6.0).abs() < 1e-12 && (p.y.abs() - 6.0).abs() < 1e-12,
+            "{p:?}"
+        );
+    }
+}
+
+#[test]
+fn phex_panels_the_fitted_dome_close_to_the_mesh() {
+    use dupin_core::Stepper;
+    use dupin_core::phex::{PhexConfig, PhexPipeline};
+    let mesh = dome_mesh(104, 2);
+    let fit = fit_mesh_surface(&mesh, &MeshFitOptions::default()).unwrap();
+    let config = PhexConfig::for_nurbs("dome", fit.surface, Some(0.3));
+    let r = PhexPipeline::new(config).and_then(Stepper::finish).unwrap();
+    let rep = &r.report;
+    eprintln!(
+        "{} faces, {} invalid, planarity {:e}",
+        rep.faces, rep.invalid_faces, rep.max_planarity
+    );
+    assert!(rep.faces > 300);
+    assert_eq!(rep.invalid_faces, 0);
+    assert!(rep.max_planarity <= 1e-10);
+    let input = MeshSurface::from_mesh(mesh.clone());
+    let diagonal = mesh.bbox_diagonal();
+    let far = r
+        .mesh
+        .positions
+        .iter()
+        .map(|p| input.closest_point(p).unwrap().distance)
+        .fold(0.0, f64::max);
+    eprintln!("max distance to the input mesh {far:.3e} of a {diagonal:.2} m diagonal");
+    assert!(far <= 0.005 * diagonal, "{far}");
+}
+
+#[test]
+fn what_is_not_a_triangulated_disk_is_refused() {
+    let quads = PolyMesh::quad_grid(
+        (0..9)
+            .map(|k| Vec3::new((k % 3) as f64, (k / 3) as f64, 0.0))
+            .collect(),
+        2,
+        2,
+    )
+    .unwrap();
+    let e = fit_mesh_surface(&quads, &MeshFitOptions::default()).unwrap_err();
+    assert!(
+        matches!(e, MeshFitError::NotTriangles { face: 0, size: 4 }),
+        "{e}"
+    );
+    // A closed tetrahedron: no boundary.
+    let p = vec![Vec3::zeros(), Vec3::x(), Vec3::y(), Vec3::z()];
+    let tet = PolyMesh::new(p, vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]]).unwrap();
+    let e = fit_mesh_surface(&tet, &MeshFitOptions::default()).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("0 boundary loops and Euler characteristic 2"),
+        "{e}"
+    );
+    let dome = dome_mesh(6, 3);
+    for options in [
+        MeshFitOptions::default().with_fairness(-1.0),
+        MeshFitOptions::default().with_control_points(3, 10),
+    ] {
+        assert!(matches!(
+            fit_mesh_surface(&dome, &options),
+            Err(MeshFitError::BadOption(_))
+        ));
+    }
+}
