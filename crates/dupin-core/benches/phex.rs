@@ -225,6 +225,22 @@ fn bench_nurbs(c: &mut Criterion) {
         b.iter(|| black_box(phex_run(cfg.clone()).unwrap()))
     });
     g.finish();
+    // A design exported as a mesh: parametrisation and fit of 100k triangles, then P-Hex.
+    let mesh = dupin_core::scenes::benchmark_meshes::dome_triangle_mesh(224, 1);
+    let options = dupin_core::surface::MeshFitOptions::default();
+    let fit = dupin_core::surface::fit_mesh_surface(&mesh, &options).unwrap();
+    eprintln!(
+        "mesh fit: {} triangles, {:?} control points, max distance {:.2e} m",
+        mesh.num_faces(),
+        fit.surface.control_net_size(),
+        fit.max_distance
+    );
+    let mut g = c.benchmark_group("mesh_fit");
+    g.sample_size(10);
+    g.bench_function("fit_100k_triangles", |b| {
+        b.iter(|| black_box(dupin_core::surface::fit_mesh_surface(&mesh, &options).unwrap()))
+    });
+    g.finish();
 }
 
 criterion_group!(benches, bench, bench_nurbs);

@@ -4,53 +4,12 @@
 
 use dupin_core::Vec3;
 use dupin_core::mesh::PolyMesh;
+use dupin_core::scenes::benchmark_meshes::dome_triangle_mesh;
 use dupin_core::surface::{MeshFitError, MeshFitOptions, MeshSurface, fit_mesh_surface};
-use rand::{RngExt, SeedableRng};
-use rand_chacha::ChaCha8Rng;
-
-/// A dome 12 m x 12 m, z = 3 - (x² + y²) / 24 (K > 0), as an irregular triangulation of
-/// `2 n²` triangles: a grid with jittered interior vertices and randomly chosen diagonals, the
-/// vertex order shuffled (an exporter's order is not a grid's).
-fn dome_mesh(n: usize, seed: u64) -> PolyMesh {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let h = 12.0 / n as f64;
-    let mut order: Vec<usize> = (0..(n + 1) * (n + 1)).collect();
-    for k in (1..order.len()).rev() {
-        order.swap(k, rng.random_range(0..=k));
-    }
-    let mut positions = vec![Vec3::zeros(); order.len()];
-    for i in 0..=n {
-        for j in 0..=n {
-            let jitter = |rng: &mut ChaCha8Rng, edge: bool| {
-                if edge {
-                    0.0
-                } else {
-                    rng.random_range(-0.3..0.3) * h
-                }
-            };
-            let x = -6.0 + i as f64 * h + jitter(&mut rng, i == 0 || i == n);
-            let y = -6.0 + j as f64 * h + jitter(&mut rng, j == 0 || j == n);
-            positions[order[i * (n + 1) + j]] = Vec3::new(x, y, 3.0 - (x * x + y * y) / 24.0);
-        }
-    }
-    let id = |i: usize, j: usize| order[i * (n + 1) + j] as u32;
-    let mut faces = vec![];
-    for i in 0..n {
-        for j in 0..n {
-            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-            if rng.random::<bool>() {
-                faces.extend([[a, b, c], [a, c, d]]);
-            } else {
-                faces.extend([[a, b, d], [b, c, d]]);
-            }
-        }
-    }
-    PolyMesh::new(positions, faces).unwrap()
-}
 
 #[test]
 fn a_dome_mesh_is_fitted_within_a_millimetre_and_the_map_is_one_to_one() {
-    let mesh = dome_mesh(104, 1);
+    let mesh = dome_triangle_mesh(104, 1);
     assert!(mesh.num_faces() >= 20_000);
     let fit = fit_mesh_surface(&mesh, &MeshFitOptions::default()).unwrap();
     eprintln!(
@@ -80,7 +39,7 @@ fn a_dome_mesh_is_fitted_within_a_millimetre_and_the_map_is_one_to_one() {
 fn phex_panels_the_fitted_dome_close_to_the_mesh() {
     use dupin_core::Stepper;
     use dupin_core::phex::{PhexConfig, PhexPipeline};
-    let mesh = dome_mesh(104, 2);
+    let mesh = dome_triangle_mesh(104, 2);
     let fit = fit_mesh_surface(&mesh, &MeshFitOptions::default()).unwrap();
     let config = PhexConfig::for_nurbs("dome", fit.surface, Some(0.3));
     let r = PhexPipeline::new(config).and_then(Stepper::finish).unwrap();
@@ -128,7 +87,7 @@ fn what_is_not_a_triangulated_disk_is_refused() {
             .contains("0 boundary loops and Euler characteristic 2"),
         "{e}"
     );
-    let dome = dome_mesh(6, 3);
+    let dome = dome_triangle_mesh(6, 3);
     for options in [
         MeshFitOptions::default().with_fairness(-1.0),
         MeshFitOptions::default().with_control_points(3, 10),

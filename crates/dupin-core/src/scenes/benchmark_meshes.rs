@@ -1,6 +1,6 @@
 //! Test and benchmark meshes for PQ perturbation: a skew quad grid on z = xy, a regular torus
 //! quad mesh, a noisy vase, a regular torus triangulation and its centroid dual; and a NURBS
-//! roof for the import path.
+//! roof and a triangulated dome for the import path.
 
 use crate::Vec3;
 use crate::conical::principal_quad_mesh;
@@ -171,6 +171,46 @@ pub fn nurbs_roof() -> NurbsDefinition {
         weights: None,
         unit: Some("m".into()),
     }
+}
+
+/// A triangle mesh with no UVs for the surface fit's tests and benchmarks: a dome 12 m x 12 m, z = 3 - (x² + y²) / 24 (K > 0), as an irregular triangulation of
+/// `2 n²` triangles: a grid with jittered interior vertices and randomly chosen diagonals, the
+/// vertex order shuffled (an exporter's order is not a grid's).
+pub fn dome_triangle_mesh(n: usize, seed: u64) -> PolyMesh {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let h = 12.0 / n as f64;
+    let mut order: Vec<usize> = (0..(n + 1) * (n + 1)).collect();
+    for k in (1..order.len()).rev() {
+        order.swap(k, rng.random_range(0..=k));
+    }
+    let mut positions = vec![Vec3::zeros(); order.len()];
+    for i in 0..=n {
+        for j in 0..=n {
+            let jitter = |rng: &mut ChaCha8Rng, edge: bool| {
+                if edge {
+                    0.0
+                } else {
+                    rng.random_range(-0.3..0.3) * h
+                }
+            };
+            let x = -6.0 + i as f64 * h + jitter(&mut rng, i == 0 || i == n);
+            let y = -6.0 + j as f64 * h + jitter(&mut rng, j == 0 || j == n);
+            positions[order[i * (n + 1) + j]] = Vec3::new(x, y, 3.0 - (x * x + y * y) / 24.0);
+        }
+    }
+    let id = |i: usize, j: usize| order[i * (n + 1) + j] as u32;
+    let mut faces = vec![];
+    for i in 0..n {
+        for j in 0..n {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            if rng.random::<bool>() {
+                faces.extend([[a, b, c], [a, c, d]]);
+            } else {
+                faces.extend([[a, b, d], [b, c, d]]);
+            }
+        }
+    }
+    PolyMesh::new(positions, faces).unwrap()
 }
 
 #[cfg(test)]
