@@ -22,7 +22,9 @@ use dupin_core::phex::{
     DupinIndicatrix, Initialisation, PhexConfig, PhexPipeline, TriangulationMethod, ideal_triangle,
 };
 use dupin_core::scenes::{phex_scene, pq_scene_spec};
-use dupin_core::surface::{surface_by_name, surface_catalog};
+use dupin_core::surface::{
+    MeshFitOptions, NurbsSurface, Surface, fit_mesh_surface, surface_by_name, surface_catalog,
+};
 
 /// A fuzz target: takes any bytes, panics only on a bug.
 pub type Target = fn(&[u8]);
@@ -36,6 +38,8 @@ pub const TARGETS: &[(&str, Target)] = &[
     ("session_config", session_config),
     ("dupin_lesson", dupin_lesson),
     ("planarize", planarize),
+    ("nurbs_json", nurbs_json),
+    ("mesh_fit", mesh_fit),
 ];
 
 /// OBJ text (`dupin planarize --input`, the page's file input): whatever parses writes back and
@@ -327,4 +331,51 @@ pub fn planarize(data: &[u8]) {
         "reported planarity {} but the mesh has {recomputed}",
         result.max_planarity
     );
+}
+
+/// A NURBS surface as JSON (`dupin phex --input design.json`): whatever is accepted writes back
+/// to JSON that reads to the same surface, bit for bit, and evaluates (corners, middle, a point
+/// outside the domain) and projects a point without panicking.
+pub fn nurbs_json(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    let Ok(s) = NurbsSurface::from_json(text) else {
+        return;
+    };
+    let back = NurbsSurface::from_json(&s.to_json()).expect("a written surface reads back");
+    assert_eq!(back, s, "the JSON round trip changed the surface");
+    let d = s.domain();
+    let mid = ((d.u.0 + d.u.1) / 2.0, (d.v.0 + d.v.1) / 2.0);
+    for (u, v) in [(d.u.0, d.v.0), (d.u.1, d.v.1), mid, (d.u.1 + 1.0, d.v.0 - 1.0)] {
+        let _ = s.derivatives(u, v);
+    }
+    let p = s.position(mid.0, mid.1);
+    let _ = s.closest_point(&(p + dupin_core::Vec3::new(0.1, 0.2, 0.3)), None);
+}
+
+/// A triangle mesh fitted by a surface (`dupin phex --input mesh.obj`, up to 2 000 triangles
+/// here): an accepted fit has finite parameters inside the unit square, with the boundary on
+/// it, and a finite distance.
+pub fn mesh_fit(data: &[u8]) {
+    let options = ImportOptions::default().with_max_triangles(2_000);
+    let Ok(imported) = read_mesh("design.obj", data, &options) else {
+        return;
+    };
+    let fit = match fit_mesh_surface(&imported.mesh, &MeshFitOptions::default()) {
+        Ok(f) => f,
+        Err(_) => return,
+    };
+    let tol = 1e-9;
+    for t in &fit.uv {
+        assert!(
+            t.x.is_finite() && t.y.is_finite(),
+            "a parameter is not finite"
+        );
+        assert!(
+            (-tol..=1.0 + tol).contains(&t.x) && (-tol..=1.0 + tol).contains(&t.y),
+            "a parameter {t:?} is outside the square"
+        );
+    }
+    assert!(!fit.max_distance.is_nan() && fit.mean_distance <= fit.max_distance + tol);
 }

@@ -45,7 +45,7 @@ const LIMITS: &[&str] = &["-timeout=10", "-rss_limit_mb=2048", "-malloc_limit_mb
 /// Largest input the fuzzer makes, per target: text formats need room for a few dozen lines.
 fn max_len(target: &str) -> u32 {
     match target {
-        "obj" | "mesh_file" | "planarize" => 8192,
+        "obj" | "mesh_file" | "planarize" | "nurbs_json" | "mesh_fit" => 8192,
         "point_set" => 2048,
         _ => 512,
     }
