@@ -3,6 +3,11 @@
 // parameters, the free mode's run settings, the step count, colour mode, panel edge for mm
 // figures, the offset and support layers (conical scenes), camera and backend.
 export const FREE = 'free';
+// A design the user opened (file input or drop): its bytes stay in the page, the hash records
+// only `scene=imported` and how it is read.
+export const IMPORTED = 'imported';
+export const IMPORT_UNITS = ['mm', 'cm', 'm', 'in', 'ft'];
+export const IMPORT_MODES = ['planar', 'conical', 'circular'];
 
 // Names, defaults and bounds come from Rust (`pageSchema()`, lists start with the default),
 // handed over once the wasm module has loaded.
@@ -14,6 +19,7 @@ export function defaults() {
   return {
     scene: 'torus',
     params: {},
+    imported: { name: null, as: null, unit: null, size: null, mode: 'planar' },
     free: { surface: 'torus', method: SCHEMA.methods[0].name, init: SCHEMA.initialisations[0].name, size: null, bound: null, lambda: null, mu: null },
     steps: 1,
     color: SCHEMA.colorModes[0],
@@ -31,7 +37,13 @@ export function readHash(hash, { scenes, catalog, torusParams }) {
   const h = new URLSearchParams(hash.replace(/^#/, ''));
   const c = defaults();
   const name = h.get('scene');
-  if (name === FREE || scenes.includes(name) || name === 'torus') c.scene = name;
+  if (name === FREE || name === IMPORTED || scenes.includes(name) || name === 'torus') c.scene = name;
+  if (c.scene === IMPORTED) {
+    if (['surface', 'panels'].includes(h.get('as'))) c.imported.as = h.get('as');
+    if (IMPORT_UNITS.includes(h.get('unit'))) c.imported.unit = h.get('unit');
+    if (IMPORT_MODES.includes(h.get('mode'))) c.imported.mode = h.get('mode');
+    if (h.has('size')) c.imported.size = num(h.get('size'));
+  }
   if (c.scene === 'torus') {
     for (const [k, spec] of Object.entries(torusParams)) c.params[k] = h.has(k) ? num(h.get(k)) : spec.value;
   }
@@ -70,6 +82,12 @@ export function writeHash(c) {
     if (c.free.init !== d.free.init) h.set('init', c.free.init);
     for (const k of ['size', 'bound', 'lambda', 'mu']) if (c.free[k] !== null) h.set(k, String(c.free[k]));
   }
+  if (c.scene === IMPORTED) {
+    if (c.imported.as) h.set('as', c.imported.as);
+    if (c.imported.unit) h.set('unit', c.imported.unit);
+    if (c.imported.mode !== d.imported.mode) h.set('mode', c.imported.mode);
+    if (c.imported.size !== null) h.set('size', String(c.imported.size));
+  }
   if (c.scene !== 'torus') h.set('steps', String(c.steps));
   if (c.color !== d.color) h.set('color', c.color);
   if (c.panelEdge !== 1.5) h.set('edge', String(c.panelEdge));
@@ -84,6 +102,14 @@ export function writeHash(c) {
 /** The `Session` config of a stepped scene or free configuration (null for the torus preview). */
 export function sessionConfig(c) {
   if (c.scene === 'torus') return null;
+  if (c.scene === IMPORTED) {
+    const i = c.imported;
+    const out = { mode: i.mode };
+    if (i.as) out.importAs = i.as;
+    if (i.unit) out.unit = i.unit;
+    if (i.size !== null) out.size = i.size;
+    return out;
+  }
   if (c.scene !== FREE) return { scene: c.scene };
   const out = { surface: c.free.surface, params: { ...c.params }, method: c.free.method, init: c.free.init };
   for (const k of ['size', 'bound', 'lambda', 'mu']) if (c.free[k] !== null) out[k] = c.free[k];

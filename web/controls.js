@@ -1,7 +1,7 @@
 // Configuration controls: the scene picker and the parameter fields (torus preview, or the free
 // mode's surface, parameters with slider + numeric field, method, size, b, lambda, mu). Every
 // field has an inline message slot; `showFieldError` puts the core's error text there.
-import { FREE, schema } from './config.js';
+import { FREE, IMPORTED, IMPORT_MODES, IMPORT_UNITS, schema } from './config.js';
 
 const el = (tag, props = {}, ...children) => {
   const e = Object.assign(document.createElement(tag), props);
@@ -9,13 +9,25 @@ const el = (tag, props = {}, ...children) => {
   return e;
 };
 
-/** Fills the scene picker: torus preview, every contract scene, the free mode. */
-export function fillScenePicker(select, scenes) {
+/** Fills the scene picker: torus preview, every contract scene, the free mode, and the
+ * opened design (`imported: NAME`) when there is one. */
+export function fillScenePicker(select, scenes, importedName = null) {
   select.replaceChildren(
     new Option('Torus (surface preview)', 'torus'),
     ...scenes.map((n) => new Option(n, n)),
     new Option('free: surface, method, size, b, λ, μ', FREE),
   );
+  if (importedName) select.append(new Option(`imported: ${importedName}`, IMPORTED));
+}
+
+/** A select of `choices` ([value, label]) with a test id, calling `onPick(value)`. */
+function choice(id, choices, value, onPick, title = '') {
+  const s = el('select', { title });
+  s.dataset.testid = id;
+  s.append(...choices.map(([v, label]) => new Option(label, v)));
+  s.value = value;
+  s.addEventListener('change', () => onPick(s.value));
+  return s;
 }
 
 // One labelled field: a numeric input (optionally with a slider) and its message slot.
@@ -80,6 +92,25 @@ export function buildFields(box, c, { catalog, torusParams, defaults, onChange }
     }
     return;
   }
+  const labelled = (text, e) => el('label', { className: 'field' }, el('span', { className: 'field-label', textContent: text }), e);
+  if (c.scene === IMPORTED) {
+    const i = c.imported;
+    box.append(
+      labelled('read as', choice('import-as', [['', 'guess'], ['surface', 'surface (P-Hex)'], ['panels', 'panels (planarise)']], i.as ?? '',
+        (v) => onChange((n) => { n.imported.as = v || null; }, 'import-as'),
+        'a NURBS surface or a triangle mesh of a smooth surface is panelled by P-Hex; quads, hexagons or any polygons are planarised')),
+      labelled('unit', choice('import-unit', [['', 'file / m'], ...IMPORT_UNITS.map((u) => [u, u])], i.unit ?? '',
+        (v) => onChange((n) => { n.imported.unit = v || null; }, 'import-unit'),
+        'length unit of the file\'s coordinates (a NURBS JSON may state its own; otherwise metres)')),
+      labelled('panels', choice('import-mode', IMPORT_MODES.map((m) => [m, m]), i.mode,
+        (v) => onChange((n) => { n.imported.mode = v; }, 'import-mode'), 'planarisation mode of a panel mesh')),
+      numberField({
+        id: 'import-size', label: 'panel size', value: i.size ?? '', title: 'P-Hex: target edge length of the base curve, in the file\'s unit (empty: 1/48 of its length)',
+        onCommit: (v, id) => onChange((n) => { n.imported.size = v; }, id),
+      }),
+    );
+    return;
+  }
   if (c.scene !== FREE) return;
   const surface = catalog.find((s) => s.name === c.free.surface);
   const pick = el('select', { title: surface?.parametrisation ?? '' });
@@ -100,7 +131,6 @@ export function buildFields(box, c, { catalog, torusParams, defaults, onChange }
   init.append(...schema().initialisations.map((m) => new Option(m.label, m.name)));
   init.value = c.free.init;
   init.addEventListener('change', () => onChange((n) => { n.free.init = init.value; }, 'free-init'));
-  const labelled = (text, e) => el('label', { className: 'field' }, el('span', { className: 'field-label', textContent: text }), e);
   box.append(labelled('surface', pick), labelled('method', method), labelled('init', init));
   for (const p of surface?.params ?? []) {
     box.append(numberField({

@@ -4,7 +4,7 @@
 //   config.js (configuration <-> hash), controls.js (picker and fields), metrics.js (panel,
 //   histogram, legend), solver.js (worker client). Other tabs plug in through `window.dupin`.
 import init, { MeshData, Viewer, colorLegend, freeDefaults, pageSchema, sceneNames, surfaceCatalog, torusMesh } from './pkg/dupin_web.js';
-import { FREE, defaults, readHash, sessionConfig, useSchema, writeHash } from './config.js';
+import { FREE, IMPORTED, defaults, readHash, sessionConfig, useSchema, writeHash } from './config.js';
 import { buildFields, clearFieldErrors, fillScenePicker, showFieldError } from './controls.js';
 import { drawHistogram, drawLegend, showMetrics } from './metrics.js';
 import { Solver } from './solver.js';
@@ -38,6 +38,7 @@ let pickedPoint = null;   // 3D point of the vertex clicked for the teaching ins
 const marker = document.createElement('div');
 const stepLog = [];      // per-step { phase, faces, ms } for benchmarks (window.dupin.stepLog)
 let settled = false;      // something was shown or reported (the first frame may count as ready)
+let opened = null;        // the design the user opened: { name, bytes } (never leaves the page)
 
 function showStatus(text, isError = false) {
   statusEl.textContent = text;
@@ -78,7 +79,7 @@ function updateButtons() {
 
 // ---- loading a configuration -----------------------------------------------------------------
 /** Shows configuration `next`; `field` names the input that changed (its errors go there). */
-function load(next, { reframe = true, field = null } = {}) {
+function load(next, { reframe = true, field = null, rebuild = false } = {}) {
   setMarker(null);
   if (next.scene === 'torus') {
     try {
@@ -103,12 +104,45 @@ function load(next, { reframe = true, field = null } = {}) {
     updateButtons();
     return;
   }
+  if (next.scene === IMPORTED && !opened) {
+    // A link or reload of an imported design: the file stays on the user's machine.
+    solver.post('pause');
+    solver.gen += 1;
+    running = false; playing = false; done = true;
+    config = next;
+    settled = true;
+    showStatus(`${viewer.backend} · this page showed an imported design; its file is not here (files never leave your browser): open it again with “Open design” or drop it on the page`, true);
+    updateButtons();
+    return;
+  }
   lastFaces = 0;
   lastPhase = '';
   userMoved = !!pendingCamera;
-  candidate = { config: next, field, reframe };
-  solver.load(sessionConfig(next), { steps: next.steps, mode: next.color, field, layers: next.layers });
+  candidate = { config: next, field, reframe, rebuild };
+  const file = next.scene === IMPORTED ? opened : null;
+  solver.load(sessionConfig(next), { steps: next.steps, mode: next.color, field, layers: next.layers, file });
 }
+
+/** Opens a design file (file input or drop): shown as `imported: NAME` once the worker has read
+ * it; a file it cannot read leaves the current run on screen and says why. */
+async function openDesign(file) {
+  if (!file) return;
+  let bytes;
+  try {
+    bytes = new Uint8Array(await file.arrayBuffer());
+  } catch (e) {
+    showStatus(`${viewer.backend} · ${file.name}: the browser could not read the file (${e.message ?? e})`, true);
+    return;
+  }
+  previousOpened = opened;
+  opened = { name: file.name, bytes };
+  const next = defaults();
+  Object.assign(next, { scene: IMPORTED, color: config.color, panelEdge: config.panelEdge, layers: config.layers, backend: config.backend });
+  next.imported.name = file.name;
+  showStatus(`${viewer.backend} · reading ${file.name}…`);
+  load(next, { reframe: true, field: 'import-file', rebuild: true });
+}
+let previousOpened = null;
 let candidate = null; // configuration sent to the worker, not yet confirmed
 
 function onState(s) {
@@ -128,6 +162,11 @@ function applyState(s) {
   const t0main = performance.now();
   if (candidate) {
     config = candidate.config;
+    if (candidate.rebuild) {
+      fillScenePicker($('scene-select'), ctx.scenes, opened?.name);
+      $('scene-select').value = config.scene;
+      rebuildFields();
+    }
     if (candidate.field) showFieldError(fieldsBox, candidate.field, '');
     candidate = null;
     running = true;
@@ -149,6 +188,7 @@ function applyState(s) {
   lastPhase = m.phase;
   lastMetrics = m;
   if (m.phase === 'warning') showStatus(`${viewer.backend} · NOT done: ${m.reason}`, true);
+  else if (m.design && s.steps <= 1) showStatus(`${viewer.backend} · ${designLine(m.design)}`);
   const entry = { phase: m.phase, layer: m.layer, iteration: m.iteration, faces: m.faces, maxPlanarity: m.maxPlanarity, steps: s.steps, ms: m.ms, timing: m.timing, mainMs: performance.now() - t0main, panelMs: null, at: performance.now() };
   stepLog.push(entry);
   if (stepLog.length > 5000) stepLog.shift();
@@ -299,8 +339,16 @@ function stop() {
   restartSolver(`stopped; back at step ${config.steps}`, false);
 }
 
+/** `imported: NAME · surface · 20.00 × 15.00 × 3.40 m (fit within 0.1 mm)`. */
+function designLine(d) {
+  const dims = d.dimensionsM.map((x) => x.toFixed(2)).join(' × ');
+  const fit = d.fitMaxDistanceM === undefined ? '' : ` · surface fitted within ${(d.fitMaxDistanceM * 1000).toFixed(2)} mm`;
+  return `imported: ${d.name} · ${d.importAs} · ${dims} m (unit ${d.unit})${fit}`;
+}
+
 function onError(e) {
   playing = false;
+  if (e.load && candidate?.field === 'import-file') opened = previousOpened; // the old run stays
   if (e.load) {
     const field = candidate?.field ?? e.field;
     candidate = null;
@@ -523,10 +571,19 @@ async function main() {
   initTeach();
   initHexd2d();
   initPresent(() => mesh);
+  $('import-file').addEventListener('change', (e) => { openDesign(e.target.files[0]); e.target.value = ''; });
+  // Drop a design anywhere on the page.
+  document.addEventListener('dragover', (e) => { if (e.dataTransfer?.types.includes('Files')) e.preventDefault(); });
+  document.addEventListener('drop', (e) => {
+    if (!e.dataTransfer?.files.length) return;
+    e.preventDefault();
+    openDesign(e.dataTransfer.files[0]);
+  });
   $('scene-select').addEventListener('change', (e) => {
     const next = defaults();
     Object.assign(next, { scene: e.target.value, color: config.color, panelEdge: config.panelEdge, layers: config.layers, backend: config.backend });
     if (next.scene === 'torus') for (const [k, s] of Object.entries(TORUS)) next.params[k] = s.value;
+    if (next.scene === IMPORTED) next.imported.name = opened?.name ?? null;
     if (next.scene === FREE) {
       const s = ctx.catalog.find((x) => x.name === next.free.surface) ?? ctx.catalog[0];
       next.free.surface = s.name;

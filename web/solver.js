@@ -51,10 +51,11 @@ export class Solver {
 
   /** Starts `config` (a Session config) and replays `steps` steps; `field` names the input
    * that caused the load (bad configurations report back to it); `layers` are the offset and
-   * support layers to draw where the run has them. */
-  load(config, { steps = 1, mode, field = null, layers = null } = {}) {
+   * support layers to draw where the run has them; `file` ({ name, bytes }) opens a design
+   * with `config` as its import options (Session.fromFile). */
+  load(config, { steps = 1, mode, field = null, layers = null, file = null } = {}) {
     this.gen += 1;
-    this.worker.postMessage({ type: 'load', gen: this.gen, config, steps, mode, field, layers });
+    this.worker.postMessage({ type: 'load', gen: this.gen, config, steps, mode, field, layers, file });
     return this.gen;
   }
 

@@ -1,7 +1,7 @@
 // The solver thread: a module worker that owns the `Session` (state and geometry in Rust) so
 // the page's thread only draws. Protocol (all messages carry the load generation `gen`; stale
 // ones are dropped on both sides):
-//   in:  load {config, steps, mode, layers} | step | play | pause | ack | mode {mode}
+//   in:  load {config, steps, mode, layers, file?} (file {name, bytes}: Session.fromFile) | step | play | pause | ack | mode {mode}
 //        | layers {layers} (offset/support, Session.setLayers) | export {kind, panelEdge}
 //        | pick {origin, direction} (a view ray)
 //        | fault {kind} (debugFault: a deliberate trap or out-of-memory, for recovery tests)
@@ -76,7 +76,7 @@ const handlers = {
   load(msg) {
     let next;
     try {
-      next = new Session(msg.config);
+      next = msg.file ? Session.fromFile(msg.file.name, msg.file.bytes, msg.config) : new Session(msg.config);
     } catch (e) {
       if (e instanceof WebAssembly.RuntimeError) { fail(e); return; }
       postMessage({ type: 'error', gen: msg.gen, active: gen, message: e?.message ?? String(e), field: msg.field ?? null, load: true });

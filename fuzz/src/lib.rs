@@ -347,7 +347,12 @@ pub fn nurbs_json(data: &[u8]) {
     assert_eq!(back, s, "the JSON round trip changed the surface");
     let d = s.domain();
     let mid = ((d.u.0 + d.u.1) / 2.0, (d.v.0 + d.v.1) / 2.0);
-    for (u, v) in [(d.u.0, d.v.0), (d.u.1, d.v.1), mid, (d.u.1 + 1.0, d.v.0 - 1.0)] {
+    for (u, v) in [
+        (d.u.0, d.v.0),
+        (d.u.1, d.v.1),
+        mid,
+        (d.u.1 + 1.0, d.v.0 - 1.0),
+    ] {
         let _ = s.derivatives(u, v);
     }
     let p = s.position(mid.0, mid.1);

@@ -6,6 +6,7 @@
 //! Errors cross the boundary as JS `Error`s carrying the Rust message.
 
 mod hexd2d;
+mod import;
 mod js;
 mod mesh_data;
 mod pick;

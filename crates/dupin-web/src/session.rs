@@ -24,9 +24,12 @@ use wasm_bindgen::prelude::*;
 
 /// `new Session(config)`: `{ scene }` or `{ surface, params, method, size, bound, lambda, mu,
 /// init }`.
-#[derive(Deserialize, Serialize, Clone)]
+#[derive(Deserialize, Serialize, Clone, Default)]
 #[serde(deny_unknown_fields)]
 struct SessionConfig {
+    /// The opened file's name (`Session.fromFile` only; not a key of `new Session`).
+    #[serde(skip_deserializing, skip_serializing_if = "Option::is_none")]
+    imported: Option<String>,
     scene: Option<String>,
     surface: Option<String>,
     #[serde(default)]
@@ -77,7 +80,11 @@ const SESSION_CONFIG_KEYS: &[&str] = &[
 
 /// serde_wasm_bindgen reads a JS object's known fields only (`deny_unknown_fields` never
 /// fires), so a misspelt key would be silently ignored: refuse it with a readable message.
-fn refuse_unknown_keys(value: &JsValue, what: &str, allowed: &[&str]) -> Result<(), JsError> {
+pub(crate) fn refuse_unknown_keys(
+    value: &JsValue,
+    what: &str,
+    allowed: &[&str],
+) -> Result<(), JsError> {
     if !value.is_object() {
         return Ok(()); // serde reports the wrong type itself.
     }
@@ -133,6 +140,9 @@ struct Metrics {
     /// Strip scenes: quads whose singular-curve point lies on the strip.
     #[serde(skip_serializing_if = "Option::is_none")]
     singular_points_inside: Option<usize>,
+    /// An opened design: what it is and how large.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    design: Option<crate::import::DesignInfo>,
 }
 
 /// The extra layers `Session.mesh` can draw with the panels: `{ offset, support, distance }`
@@ -167,7 +177,7 @@ struct LayerInfo {
     beam_planarity: f64,
 }
 
-enum Run {
+pub(crate) enum Run {
     /// A P-Hex run and what it is asked for (a finished run that misses it is a `warning`).
     Phex(Box<PhexPipeline>, PhexGoals),
     /// A PQ scene, one perturbation iteration or one subdivision a step; the first step shows
@@ -189,6 +199,8 @@ pub struct Session {
     per_face: Option<Vec<f64>>,
     /// Extra layers drawn with the panels (`setLayers`).
     layers: LayerConfig,
+    /// The opened design (`Session.fromFile`), shown with the metrics.
+    design: Option<crate::import::DesignInfo>,
 }
 
 /// Every scene a `Session` accepts: the P-Hex scenes, then the PQ scenes.
@@ -375,6 +387,28 @@ impl Session {
             config: cfg,
             per_face: None,
             layers: LayerConfig::default(),
+            design: None,
+        })
+    }
+
+    /// Opens a design file: `name` (its extension tells the format), its `bytes` and
+    /// `{ importAs, unit, size, method, mode, fixBoundary }` (all optional). A NURBS surface as
+    /// JSON (docs/nurbs-json.md) or a triangle mesh (fitted by a smooth surface) is panelled by
+    /// P-Hex; a panel mesh (OBJ, STL, glTF/GLB) is planarised keeping the design. The metrics
+    /// then carry `design: { name, importAs, unit, dimensionsM, fitMaxDistanceM }`. Throws an
+    /// `Error` naming the file and what is wrong with it.
+    #[wasm_bindgen(js_name = fromFile)]
+    pub fn from_file(name: &str, bytes: &[u8], config: JsValue) -> Result<Session, JsError> {
+        let (run, design) = crate::import::import_run(name, bytes, config)?;
+        Ok(Session {
+            run,
+            config: SessionConfig {
+                imported: Some(name.to_string()),
+                ..SessionConfig::default()
+            },
+            per_face: None,
+            layers: LayerConfig::default(),
+            design: Some(design),
         })
     }
 
@@ -761,6 +795,7 @@ impl Session {
                     circular_residual: None,
                     max_determinant: None,
                     singular_points_inside: None,
+                    design: self.design.clone(),
                 }
             }
             Run::Pq { stepper, started } => {
@@ -807,6 +842,7 @@ impl Session {
                     circular_residual,
                     max_determinant,
                     singular_points_inside,
+                    design: self.design.clone(),
                 }
             }
         }

@@ -1,0 +1,96 @@
+// A user's own design in the page: a NURBS surface opened with the file input is panelled by
+// P-Hex, a panel mesh dropped on the page is planarised, a broken file is refused with its name
+// and line while the previous run stays, and a link to an imported design opened without the
+// file says so. The files are made here, never downloaded.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { byId, exportText, metrics, openPage, parseObj, waitDone } from './harness.mjs';
+
+/** A bicubic NURBS dome 12 m x 12 m whose control heights are f(x) + g(y) (conjugate lines). */
+function domeJson() {
+  const knots = [0, 0, 0, 0, 1, 2, 3, 3, 3, 3];
+  const points = [];
+  for (let i = 0; i < 6; i++) {
+    const row = [];
+    for (let j = 0; j < 6; j++) {
+      const [x, y] = [2.4 * i - 6, 2.4 * j - 6];
+      row.push([x, y, 3 - (x * x + y * y) / 24]);
+    }
+    points.push(row);
+  }
+  return JSON.stringify({ degree_u: 3, degree_v: 3, knots_u: knots, knots_v: knots, control_points: points, unit: 'm' });
+}
+
+/** A 10 x 10 quad grid over 20 m with seeded +-1 mm noise in z: panels that are nearly planar. */
+function noisyGridObj() {
+  let seed = 7;
+  const rnd = () => { seed = (seed * 1103515245 + 12345) % 2147483648; return seed / 2147483648; };
+  const n = 10;
+  let obj = '';
+  for (let i = 0; i <= n; i++) for (let j = 0; j <= n; j++) obj += `v ${2 * i} ${2 * j} ${(rnd() - 0.5) * 0.002}\n`;
+  const id = (i, j) => i * (n + 1) + j + 1;
+  for (let i = 0; i < n; i++) for (let j = 0; j < n; j++) obj += `f ${id(i, j)} ${id(i + 1, j)} ${id(i + 1, j + 1)} ${id(i, j + 1)}\n`;
+  return obj;
+}
+
+async function play(page) {
+  await byId(page, 'play').click();
+  await page.waitForFunction(() => ['done', 'warning'].includes(document.querySelector('[data-testid=metrics]').dataset.phase), null, { timeout: 180_000 });
+}
+
+test('open a NURBS design, panel it, export; drop a panel mesh and planarise it; refuse a broken file', async () => {
+  const { browser, page, errors } = await openPage();
+  try {
+    await byId(page, 'import-file').setInputFiles({ name: 'dome.json', mimeType: 'application/json', buffer: Buffer.from(domeJson()) });
+    await page.waitForFunction(() => document.querySelector('[data-testid=scene-select]').value === 'imported', null, { timeout: 60_000 });
+    const option = await byId(page, 'scene-select').locator('option[value=imported]').textContent();
+    assert.equal(option, 'imported: dome.json');
+    const status = await byId(page, 'status').textContent();
+    assert.match(status, /imported: dome\.json · surface · 12\.00 × 12\.00 × [0-9.]+ m \(unit m\)/);
+    assert.match(page.url(), /scene=imported/);
+    await play(page);
+    let m = await metrics(page);
+    assert.equal(m.phase, 'done', await byId(page, 'status').textContent());
+    assert.equal(m.invalidFaces, '0');
+    assert.ok(Number(m.maxPlanarity) <= 1e-10, m.maxPlanarity);
+    assert.equal(parseObj(await exportText(page, 'export-obj')).faces, Number(m.faces));
+
+    // A panel mesh dropped anywhere on the page: planarised, keeping the design.
+    await page.evaluate((text) => {
+      const dt = new DataTransfer();
+      dt.items.add(new File([text], 'grid.obj'));
+      document.dispatchEvent(new DragEvent('drop', { dataTransfer: dt, bubbles: true, cancelable: true }));
+    }, noisyGridObj());
+    await page.waitForFunction(() => document.querySelector('[data-testid=status]').textContent.includes('grid.obj · panels'), null, { timeout: 60_000 });
+    assert.equal(await byId(page, 'scene-select').locator('option[value=imported]').textContent(), 'imported: grid.obj');
+    await play(page);
+    m = await metrics(page);
+    assert.equal(m.phase, 'done', await byId(page, 'status').textContent());
+    assert.ok(Number(m.maxPlanarity) <= 1e-9, m.maxPlanarity);
+
+    // A broken file: its name and line in the status, the planarised grid stays.
+    await byId(page, 'import-file').setInputFiles({ name: 'broken.json', mimeType: 'application/json', buffer: Buffer.from('{\n "degree_u": 3,\n "degree_v": x }') });
+    await page.waitForFunction(() => document.querySelector('[data-testid=status]').textContent.includes('broken.json'), null, { timeout: 60_000 });
+    assert.match(await byId(page, 'status').textContent(), /broken\.json: not a NURBS surface .*line 3/);
+    assert.equal((await metrics(page)).faces, m.faces);
+    assert.equal(await byId(page, 'scene-select').locator('option[value=imported]').textContent(), 'imported: grid.obj');
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
+
+test('a link to an imported design opened without the file says so and the page stays usable', async () => {
+  const { browser, page, errors } = await openPage({ hash: '#scene=imported&as=panels' });
+  try {
+    await page.waitForFunction(() => document.querySelector('[data-testid=status]').textContent.includes('open it again'), null, { timeout: 60_000 });
+    assert.equal(await byId(page, 'play').isDisabled(), true);
+    await byId(page, 'scene-select').selectOption('sphere-radial');
+    await page.waitForFunction(() => document.querySelector('[data-testid=metrics]').dataset.steps === '1', null, { timeout: 60_000 });
+    assert.equal(await byId(page, 'play').isDisabled(), false);
+    assert.doesNotMatch(await byId(page, 'status').textContent(), /open it again/);
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
