@@ -4,7 +4,6 @@
 //! perturbation makes planar (planar, conical or circular), keeping the design. The file never
 //! leaves the page: the bytes come from the browser and stay in the worker.
 
-use crate::js::err;
 use crate::session::Run;
 use dupin_core::conical::{MeshRule, PqMode, PqOptions, PqSceneStepper};
 use dupin_core::fabrication::LengthUnit;
@@ -68,19 +67,26 @@ pub(crate) fn import_run(
         serde_wasm_bindgen::from_value(config)
             .map_err(|e| JsError::new(&format!("bad import config: {e}")))?
     };
-    let named = |e: &dyn std::fmt::Display| JsError::new(&format!("{name}: {e}"));
+    import_design(name, bytes, &cfg).map_err(|e| JsError::new(&e))
+}
+
+/// [`import_run`] after its options are read (plain Rust, tested natively).
+fn import_design(
+    name: &str,
+    bytes: &[u8],
+    cfg: &ImportConfig,
+) -> Result<(Run, DesignInfo), String> {
+    let named = |e: &dyn std::fmt::Display| format!("{name}: {e}");
     let wanted = match cfg.import_as.as_deref() {
         None => None,
         Some("surface") => Some(true),
         Some("panels") => Some(false),
         Some(other) => {
-            return Err(JsError::new(&format!(
-                "importAs `{other}`: use `surface` or `panels`"
-            )));
+            return Err(format!("importAs `{other}`: use `surface` or `panels`"));
         }
     };
     let mut unit: Option<LengthUnit> = match cfg.unit.as_deref() {
-        Some(u) => Some(u.parse().map_err(err)?),
+        Some(u) => Some(u.parse().map_err(|e| format!("{e}"))?),
         None => None,
     };
     let is_json = name.to_ascii_lowercase().ends_with(".json")
@@ -142,12 +148,15 @@ pub(crate) fn import_run(
         (Some(surface), _) => {
             let mut config = PhexConfig::for_nurbs(name, surface, cfg.size);
             if let Some(m) = &cfg.method {
-                config.method = m.parse::<TriangulationMethod>().map_err(err)?;
+                config.method = m
+                    .parse::<TriangulationMethod>()
+                    .map_err(|e| format!("{e}"))?;
             }
             let goals = PhexGoals::of(&config, true);
-            Run::Phex(Box::new(PhexPipeline::new(config).map_err(err)?), goals)
+            let pipeline = PhexPipeline::new(config).map_err(|e| named(&e))?;
+            Run::Phex(Box::new(pipeline), goals)
         }
-        (None, Some(mesh)) => panels_run(&mesh, &cfg)?,
+        (None, Some(mesh)) => panels_run(&mesh, cfg).map_err(|e| named(&e))?,
         (None, None) => unreachable!("a file gives a surface or a mesh"),
     };
     Ok((run, info))
@@ -155,13 +164,13 @@ pub(crate) fn import_run(
 
 /// The planarisation of an opened panel mesh, stepped like a PQ scene with no subdivision: the
 /// design kept (fairness on the move, `keep_design`), as `dupin planarize` does.
-fn panels_run(mesh: &PolyMesh, cfg: &ImportConfig) -> Result<Run, JsError> {
+fn panels_run(mesh: &PolyMesh, cfg: &ImportConfig) -> Result<Run, String> {
     let mode: PqMode = cfg
         .mode
         .as_deref()
         .unwrap_or("planar")
         .parse()
-        .map_err(err)?;
+        .map_err(|e| format!("{e}"))?;
     let options = PqOptions {
         mode,
         keep_design: true,
@@ -169,8 +178,8 @@ fn panels_run(mesh: &PolyMesh, cfg: &ImportConfig) -> Result<Run, JsError> {
         max_factor_bytes: PAGE_MAX_FACTOR_BYTES,
         ..PqOptions::default()
     };
-    let stepper =
-        PqSceneStepper::for_mesh(mesh, MeshRule::CatmullClark, 0, options).map_err(err)?;
+    let stepper = PqSceneStepper::for_mesh(mesh, MeshRule::CatmullClark, 0, options)
+        .map_err(|e| format!("{e}"))?;
     Ok(Run::Pq {
         stepper: Box::new(stepper),
         started: false,
@@ -188,4 +197,113 @@ fn bbox(points: &[dupin_core::Vec3]) -> [f64; 3] {
         }
     }
     [0, 1, 2].map(|k| if hi[k] >= lo[k] { hi[k] - lo[k] } else { 0.0 })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use dupin_core::Stepper;
+
+    fn refused(name: &str, bytes: &[u8], cfg: &ImportConfig) -> String {
+        match import_design(name, bytes, cfg) {
+            Ok(_) => panic!("{name} was accepted"),
+            Err(e) => e,
+        }
+    }
+
+    fn run_to_end(run: &mut Run) -> (f64, usize) {
+        match run {
+            Run::Phex(p, _) => {
+                while !p.is_done() {
+                    p.step().unwrap();
+                }
+                let m = p.metrics();
+                (m.max_planarity, m.invalid_faces)
+            }
+            Run::Pq { stepper, .. } => {
+                while !stepper.is_done() {
+                    stepper.step().unwrap();
+                }
+                (stepper.metrics().measures.max_planarity, 0)
+            }
+        }
+    }
+
+    fn grid_obj(n: usize, triangles: bool) -> String {
+        let mut obj = String::new();
+        for i in 0..=n {
+            for j in 0..=n {
+                let (x, y) = (i as f64, j as f64);
+                let z = 0.05 * (x * x + y * y) + if (i * 7 + j * 3) % 5 == 0 { 1e-3 } else { 0.0 };
+                obj += &format!("v {x} {y} {z}\n");
+            }
+        }
+        let id = |i: usize, j: usize| i * (n + 1) + j + 1;
+        for i in 0..n {
+            for j in 0..n {
+                let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+                if triangles {
+                    obj += &format!("f {a} {b} {c}\nf {a} {c} {d}\n");
+                } else {
+                    obj += &format!("f {a} {b} {c} {d}\n");
+                }
+            }
+        }
+        obj
+    }
+
+    #[test]
+    fn quads_are_panels_and_triangles_a_surface_unless_told() {
+        let cfg = ImportConfig {
+            unit: Some("ft".into()),
+            ..ImportConfig::default()
+        };
+        let (mut run, info) =
+            import_design("grid.obj", grid_obj(6, false).as_bytes(), &cfg).unwrap();
+        assert_eq!((info.import_as, info.unit), ("panels", "ft"));
+        // 6 ft across: 1.8288 m.
+        assert!((info.dimensions_m[0] - 6.0 * 0.3048).abs() < 1e-12);
+        let (planarity, _) = run_to_end(&mut run);
+        assert!(planarity <= 1e-9, "{planarity}");
+
+        let (run, info) = import_design(
+            "dome.obj",
+            grid_obj(12, true).as_bytes(),
+            &ImportConfig::default(),
+        )
+        .unwrap();
+        assert_eq!((info.import_as, info.unit), ("surface", "m"));
+        assert!(info.fit_max_distance_m.unwrap() < 0.01, "{info:?}");
+        assert!(matches!(run, Run::Phex(..)));
+
+        let as_panels = ImportConfig {
+            import_as: Some("panels".into()),
+            ..ImportConfig::default()
+        };
+        let (run, _) = import_design("dome.obj", grid_obj(4, true).as_bytes(), &as_panels).unwrap();
+        assert!(matches!(run, Run::Pq { .. }));
+    }
+
+    #[test]
+    fn a_nurbs_design_states_its_unit_and_errors_name_the_file() {
+        let json = r#"{"degree_u": 1, "degree_v": 1, "knots_u": [0, 0, 1, 1],
+            "knots_v": [0, 0, 1, 1], "unit": "mm",
+            "control_points": [[[0, 0, 0], [0, 2000, 0]], [[3000, 0, 0], [3000, 2000, 500]]]}"#;
+        let (_, info) =
+            import_design("roof.json", json.as_bytes(), &ImportConfig::default()).unwrap();
+        assert_eq!((info.import_as, info.unit), ("surface", "mm"));
+        assert!(
+            (info.dimensions_m[0] - 3.0).abs() < 1e-12
+                && (info.dimensions_m[2] - 0.5).abs() < 1e-12
+        );
+        let e = refused("roof.json", b"{ \"degree_u\": }", &ImportConfig::default());
+        assert!(e.starts_with("roof.json: not a NURBS surface"), "{e}");
+        let e = refused("x.obj", b"v 0 0 0\nf 1 2 3\n", &ImportConfig::default());
+        assert!(e.starts_with("x.obj: "), "{e}");
+        let as_what = ImportConfig {
+            import_as: Some("roof".into()),
+            ..ImportConfig::default()
+        };
+        assert!(refused("a.obj", b"", &as_what).contains("use `surface` or `panels`"));
+    }
 }

@@ -921,6 +921,7 @@ mod tests {
             config: serde_json::from_str(r#"{"surface": "torus"}"#).unwrap(),
             per_face: None,
             layers: LayerConfig::default(),
+            design: None,
         }
     }
 
@@ -979,6 +980,7 @@ mod tests {
             config: serde_json::from_str(&format!(r#"{{"scene": "{scene}"}}"#)).unwrap(),
             per_face: None,
             layers: LayerConfig::default(),
+            design: None,
         }
     }
 

@@ -34,7 +34,8 @@ pub const MAX_FIT_TRIANGLES: usize = 2_000_000;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MeshFitOptions {
     /// Control points along u and v; `None`: chosen from the vertex count (about one per eight
-    /// vertices) and the aspect ratio of the boundary, 4 to 96 along each direction.
+    /// vertices, at least 8 x 8 in all) and the aspect ratio of the boundary, 4 to 96 along each
+    /// direction.
     pub control_points: Option<(usize, usize)>,
     /// Weight of the thin-plate term, relative to the data term per control point (>= 0).
     pub fairness: f64,
@@ -425,7 +426,7 @@ fn net_size(mesh: &PolyMesh, boundary: &[u32], corners: &[usize; 4]) -> (usize, 
         len
     };
     let (lu, lv) = (side(0) + side(2), side(1) + side(3));
-    let total = (mesh.num_vertices() as f64 / 8.0).max(16.0);
+    let total = (mesh.num_vertices() as f64 / 8.0).max(64.0);
     let ratio = (lu / lv).clamp(0.05, 20.0);
     let nu = (total * ratio).sqrt().round() as usize;
     let nv = (total / ratio).sqrt().round() as usize;
