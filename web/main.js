@@ -74,7 +74,7 @@ function updateButtons() {
   setProp($('reset'), 'disabled', !running);
   setProp($('stop'), 'disabled', !running || done);
   setProp($('play'), 'textContent', playing ? 'Pause' : 'Play');
-  for (const id of ['export-json', 'export-svg']) setProp($(id), 'disabled', !running);
+  for (const id of ['export-json', 'export-svg', 'export-dxf', 'export-csv', 'export-glb']) setProp($(id), 'disabled', !running);
 }
 
 // ---- loading a configuration -----------------------------------------------------------------
@@ -367,9 +367,10 @@ function download(name, data, type) {
   setTimeout(() => URL.revokeObjectURL(url), 1000);
 }
 
-const EXPORT_TYPES = { obj: 'text/plain', json: 'application/json', svg: 'image/svg+xml' };
+const EXPORT_TYPES = { obj: 'text/plain', json: 'application/json', svg: 'image/svg+xml', dxf: 'application/dxf', csv: 'text/csv', glb: 'model/gltf-binary' };
 function onExport(m) {
-  const name = config.scene === FREE ? `free-${config.free.surface}` : config.scene;
+  const name = config.scene === FREE ? `free-${config.free.surface}`
+    : config.scene === IMPORTED ? (opened?.name ?? 'design').replace(/\.[^.]*$/, '') : config.scene;
   download(`${name}.${m.kind}`, m.text, EXPORT_TYPES[m.kind]);
 }
 
@@ -631,6 +632,7 @@ async function main() {
   });
   $('export-json').addEventListener('click', () => solver.post('export', { kind: 'json' }));
   $('export-svg').addEventListener('click', () => solver.post('export', { kind: 'svg', panelEdge: config.panelEdge }));
+  for (const kind of ['dxf', 'csv', 'glb']) $(`export-${kind}`).addEventListener('click', () => solver.post('export', { kind, panelEdge: config.panelEdge }));
   $('screenshot').addEventListener('click', async () => {
     try { download(`${config.scene}@2x.png`, await snapshotPng(2)); } catch (e) { showStatus(`${viewer.backend} · ${e.message ?? e}`, true); }
   });

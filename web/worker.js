@@ -2,7 +2,7 @@
 // the page's thread only draws. Protocol (all messages carry the load generation `gen`; stale
 // ones are dropped on both sides):
 //   in:  load {config, steps, mode, layers, file?} (file {name, bytes}: Session.fromFile) | step | play | pause | ack | mode {mode}
-//        | layers {layers} (offset/support, Session.setLayers) | export {kind, panelEdge}
+//        | layers {layers} (offset/support, Session.setLayers) | export {kind, panelEdge} (obj, json, svg, dxf, csv, glb)
 //        | pick {origin, direction} (a view ray)
 //        | fault {kind} (debugFault: a deliberate trap or out-of-memory, for recovery tests)
 //   out: ready | state {metrics, steps, done, mesh: typed arrays (transferred), layers:
@@ -139,9 +139,15 @@ const handlers = {
   export(msg) {
     if (!session) return;
     try {
-      const text = msg.kind === 'obj' ? session.exportObj()
-        : msg.kind === 'json' ? session.exportJson()
-          : session.exportSvg(msg.panelEdge);
+      const exports = {
+        obj: () => session.exportObj(),
+        json: () => session.exportJson(),
+        svg: () => session.exportSvg(msg.panelEdge),
+        dxf: () => session.exportDxf(msg.panelEdge),
+        csv: () => session.exportCsv(msg.panelEdge),
+        glb: () => session.exportGlb(msg.panelEdge), // bytes
+      };
+      const text = exports[msg.kind]();
       postMessage({ type: 'export', gen, kind: msg.kind, text });
     } catch (e) { fail(e, `export-${msg.kind}`); }
   },

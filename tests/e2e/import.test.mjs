@@ -54,6 +54,20 @@ test('open a NURBS design, panel it, export; drop a panel mesh and planarise it;
     assert.equal(m.invalidFaces, '0');
     assert.ok(Number(m.maxPlanarity) <= 1e-10, m.maxPlanarity);
     assert.equal(parseObj(await exportText(page, 'export-obj')).faces, Number(m.faces));
+    // The fabrication pack, in the design's metres: DXF in millimetres with one closed polyline
+    // a panel, a CSV row a panel, a GLB with its magic and version.
+    const dxf = await exportText(page, 'export-dxf');
+    assert.match(dxf, /\$INSUNITS\s+70\s+4/);
+    const onPanels = dxf.split(/^LWPOLYLINE$/m).slice(1).filter((e) => /\n\s*8\nPANELS\n/.test(e.slice(0, 200)));
+    assert.equal(onPanels.length, Number(m.faces));
+    const csv = (await exportText(page, 'export-csv')).trim().split('\n');
+    assert.equal(csv.length, Number(m.faces) + 1);
+    const [download] = await Promise.all([page.waitForEvent('download'), byId(page, 'export-glb').click()]);
+    assert.equal(download.suggestedFilename(), 'dome.glb');
+    const glb = (await import('node:fs')).readFileSync(await download.path());
+    assert.equal(glb.toString('latin1', 0, 4), 'glTF');
+    assert.equal(glb.readUInt32LE(4), 2);
+    assert.equal(glb.readUInt32LE(8), glb.length);
 
     // A panel mesh dropped anywhere on the page: planarised, keeping the design.
     await page.evaluate((text) => {
@@ -70,7 +84,7 @@ test('open a NURBS design, panel it, export; drop a panel mesh and planarise it;
 
     // A broken file: its name and line in the status, the planarised grid stays.
     await byId(page, 'import-file').setInputFiles({ name: 'broken.json', mimeType: 'application/json', buffer: Buffer.from('{\n "degree_u": 3,\n "degree_v": x }') });
-    await page.waitForFunction(() => document.querySelector('[data-testid=status]').textContent.includes('broken.json'), null, { timeout: 60_000 });
+    await page.waitForFunction(() => document.querySelector('[data-testid=status]').textContent.includes('broken.json: '), null, { timeout: 60_000 });
     assert.match(await byId(page, 'status').textContent(), /broken\.json: not a NURBS surface .*line 3/);
     assert.equal((await metrics(page)).faces, m.faces);
     assert.equal(await byId(page, 'scene-select').locator('option[value=imported]').textContent(), 'imported: grid.obj');

@@ -48,10 +48,14 @@ const PAGE_MAX_FACTOR_BYTES: usize = 1 << 30;
 pub(crate) struct DesignInfo {
     name: String,
     import_as: &'static str,
-    unit: &'static str,
+    pub(crate) unit: &'static str,
     dimensions_m: [f64; 3],
     #[serde(skip_serializing_if = "Option::is_none")]
     fit_max_distance_m: Option<f64>,
+    /// A panel mesh's vertices as opened: the design the schedule's deviations are measured
+    /// from (the planarisation keeps the vertex order).
+    #[serde(skip)]
+    pub(crate) positions: Option<Vec<dupin_core::Vec3>>,
 }
 
 /// The run and design information of an opened file. Errors name the file.
@@ -143,6 +147,10 @@ fn import_design(
         unit: unit.name(),
         dimensions_m: extent.map(|e| e * unit.to_m()),
         fit_max_distance_m: fit_distance.map(|d| d * unit.to_m()),
+        positions: match (&surface, &mesh) {
+            (None, Some(m)) => Some(m.positions.clone()),
+            _ => None,
+        },
     };
     let run = match (surface, mesh) {
         (Some(surface), _) => {

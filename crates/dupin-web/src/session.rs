@@ -6,7 +6,10 @@ use dupin_core::Stepper;
 use dupin_core::conical::{
     PqMode, PqSceneMeasures, PqSceneStepInfo, PqSceneStepper, pq_scene_shortfall, support_structure,
 };
-use dupin_core::fabrication::{SheetOptions, panel_schedule, panel_schedule_svg};
+use dupin_core::fabrication::{
+    DxfOptions, GlbLayer, LengthUnit, SheetOptions, panel_csv, panel_dxf, panel_schedule,
+    panel_schedule_svg, panels_glb,
+};
 use dupin_core::mesh::{
     ColorMode, NOT_HEX, PLANARITY_HIST_HI, PLANARITY_HIST_LO, PLANARITY_LEGEND_LOG10, PolyMesh,
     REGULARITY_LEGEND, convexity_color, face_planarities, max_planarity, mean_planarity,
@@ -544,6 +547,65 @@ impl Session {
             1.0
         };
         Ok(panel_schedule_svg(&sched, scale))
+    }
+
+    /// The current panels in real units for fabrication files: an opened design in its own
+    /// unit; a scene scaled so its mean edge is `panel_edge_m` metres (the page's panel edge).
+    fn fabrication_mesh(&self, panel_edge_m: f64) -> Result<(PolyMesh, LengthUnit), JsError> {
+        let mut mesh = self.current_mesh().unwrap_or_default();
+        if let Some(d) = &self.design {
+            return Ok((mesh, d.unit.parse().unwrap_or_default()));
+        }
+        if !(panel_edge_m.is_finite() && panel_edge_m > 0.0) {
+            return Err(JsError::new(&format!(
+                "panel edge must be a positive length in metres, got {panel_edge_m}"
+            )));
+        }
+        let mean_edge = mesh.mean_edge();
+        if mean_edge > 0.0 {
+            let scale = panel_edge_m / mean_edge;
+            for p in &mut mesh.positions {
+                *p *= scale;
+            }
+        }
+        Ok((mesh, LengthUnit::Metre))
+    }
+
+    /// The cutting file (DXF, `$INSUNITS` millimetres): every panel flattened into its plane
+    /// as a closed polyline on layer `PANELS`, its number on `LABELS`, edge lengths on
+    /// `DIMENSIONS`, packed without overlap on 2500 x 1250 mm sheets. Real sizes: an opened
+    /// design's own unit, a scene scaled to a mean edge of `panel_edge_m` metres.
+    #[wasm_bindgen(js_name = exportDxf)]
+    pub fn export_dxf(&self, panel_edge_m: f64) -> Result<String, JsError> {
+        let (mesh, unit) = self.fabrication_mesh(panel_edge_m)?;
+        panel_dxf(&mesh, &DxfOptions::default().with_unit(unit)).map_err(err)
+    }
+
+    /// The panel schedule as CSV: number, corners, area (m²), perimeter, planarity (mm), the
+    /// deviation from an opened panel design (mm), edge lengths. Units as [`Session::export_dxf`].
+    #[wasm_bindgen(js_name = exportCsv)]
+    pub fn export_csv(&self, panel_edge_m: f64) -> Result<String, JsError> {
+        let (mesh, unit) = self.fabrication_mesh(panel_edge_m)?;
+        let design = self
+            .design
+            .as_ref()
+            .and_then(|d| d.positions.as_deref())
+            .filter(|p| p.len() == mesh.num_vertices());
+        Ok(panel_csv(&mesh, unit, design))
+    }
+
+    /// The panels as binary glTF 2.0, written in metres (readable by three.js, model-viewer and
+    /// Rhino). Units as [`Session::export_dxf`].
+    #[wasm_bindgen(js_name = exportGlb)]
+    pub fn export_glb(&self, panel_edge_m: f64) -> Result<Vec<u8>, JsError> {
+        let (mesh, unit) = self.fabrication_mesh(panel_edge_m)?;
+        Ok(panels_glb(
+            &[GlbLayer {
+                name: "panels",
+                mesh: &mesh,
+            }],
+            unit,
+        ))
     }
 
     /// The P-Hex triangulation vertex under a click: `origin` and `direction` (3 numbers each)
