@@ -20,6 +20,14 @@ export function fillScenePicker(select, scenes, importedName = null) {
   if (importedName) select.append(new Option(`imported: ${importedName}`, IMPORTED));
 }
 
+/** A labelled checkbox with a test id, calling `onToggle(checked)`. */
+function checkbox(id, label, checked, title, onToggle) {
+  const c = el('input', { type: 'checkbox', checked });
+  c.dataset.testid = id;
+  c.addEventListener('change', () => onToggle(c.checked));
+  return el('label', { className: 'field', title }, c, ` ${label}`);
+}
+
 /** A select of `choices` ([value, label]) with a test id, calling `onPick(value)`. */
 function choice(id, choices, value, onPick, title = '') {
   const s = el('select', { title });
@@ -104,6 +112,8 @@ export function buildFields(box, c, { catalog, torusParams, defaults, onChange }
         'length unit of the file\'s coordinates (a NURBS JSON may state its own; otherwise metres)')),
       labelled('panels', choice('import-mode', IMPORT_MODES.map((m) => [m, m]), i.mode,
         (v) => onChange((n) => { n.imported.mode = v; }, 'import-mode'), 'planarisation mode of a panel mesh')),
+      checkbox('import-fix-boundary', 'fix boundary', i.fixBoundary, 'panels: keep every boundary vertex exactly where the file puts it',
+        (v) => onChange((n) => { n.imported.fixBoundary = v; }, 'import-fix-boundary')),
       numberField({
         id: 'import-size', label: 'panel size', value: i.size ?? '', title: 'P-Hex: target edge length of the base curve, in the file\'s unit (empty: 1/48 of its length)',
         onCommit: (v, id) => onChange((n) => { n.imported.size = v; }, id),

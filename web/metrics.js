@@ -40,6 +40,7 @@ export function showMetrics(dl, m, { panelEdge }) {
     invalidFaces: m.invalidFaces ?? 0,
     steps: m.steps ?? 0,
     // PQ scenes: level and the scene's residuals (absent attributes for other runs).
+    maxDeviationMm: m.deviationMm?.[0], meanDeviationMm: m.deviationMm?.[1],
     level: m.level, levels: m.levels, conicalResidual: m.conicalResidual, circularResidual: m.circularResidual, maxDeterminant: m.maxDeterminant, singularPointsInside: m.singularPointsInside,
   };
   for (const [k, v] of Object.entries(data)) setData(dl, k, v);
@@ -56,6 +57,7 @@ export function showMetrics(dl, m, { panelEdge }) {
   if (m.circularResidual !== undefined) rows.push(['circular residual', exp(m.circularResidual)]);
   if (m.maxDeterminant !== undefined) rows.push(['max determinant', exp(m.maxDeterminant)]);
   if (m.singularPointsInside !== undefined) rows.push(['singular points on strip', m.singularPointsInside]);
+  if (m.deviationMm) rows.push(['moved from design', `max ${m.deviationMm[0].toFixed(3)} mm · mean ${m.deviationMm[1].toFixed(3)} mm`]);
   const keys = rows.map(([k]) => k).join('|');
   let panel = panels.get(dl);
   if (panel?.keys !== keys || dl.children.length !== 2 * rows.length) {

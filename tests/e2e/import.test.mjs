@@ -81,6 +81,16 @@ test('open a NURBS design, panel it, export; drop a panel mesh and planarise it;
     m = await metrics(page);
     assert.equal(m.phase, 'done', await byId(page, 'status').textContent());
     assert.ok(Number(m.maxPlanarity) <= 1e-9, m.maxPlanarity);
+    // The design is kept: +-1 mm of noise moves the vertices by about that, never 2 mm.
+    assert.ok(Number(m.maxDeviationMm) > 0.1 && Number(m.maxDeviationMm) <= 2, m.maxDeviationMm);
+    assert.match(await byId(page, 'metrics').textContent(), /moved from design/);
+    // Fix the boundary: the run restarts with it and still ends planar.
+    await byId(page, 'import-fix-boundary').check();
+    await page.waitForFunction(() => document.querySelector('[data-testid=metrics]').dataset.steps === '1', null, { timeout: 60_000 });
+    assert.match(page.url(), /fix=1/);
+    await play(page);
+    m = await metrics(page);
+    assert.equal(m.phase, 'done', await byId(page, 'status').textContent());
 
     // A broken file: its name and line in the status, the planarised grid stays.
     await byId(page, 'import-file').setInputFiles({ name: 'broken.json', mimeType: 'application/json', buffer: Buffer.from('{\n "degree_u": 3,\n "degree_v": x }') });

@@ -58,6 +58,25 @@ pub(crate) struct DesignInfo {
     pub(crate) positions: Option<Vec<dupin_core::Vec3>>,
 }
 
+impl DesignInfo {
+    /// How far `mesh`'s vertices are from the opened panel design's, largest and mean, in
+    /// millimetres; `None` for a surface or a mesh of another vertex count.
+    pub(crate) fn deviation_mm(&self, mesh: &PolyMesh) -> Option<[f64; 2]> {
+        let design = self.positions.as_ref()?;
+        if design.len() != mesh.num_vertices() || design.is_empty() {
+            return None;
+        }
+        let mm = self.unit.parse::<LengthUnit>().unwrap_or_default().to_mm();
+        let (mut max, mut sum) = (0.0f64, 0.0);
+        for (p, q) in mesh.positions.iter().zip(design) {
+            let d = (p - q).norm() * mm;
+            max = max.max(d);
+            sum += d;
+        }
+        Some([max, sum / design.len() as f64])
+    }
+}
+
 /// The run and design information of an opened file. Errors name the file.
 pub(crate) fn import_run(
     name: &str,
@@ -273,6 +292,15 @@ mod tests {
         assert!((info.dimensions_m[0] - 6.0 * 0.3048).abs() < 1e-12);
         let (planarity, _) = run_to_end(&mut run);
         assert!(planarity <= 1e-9, "{planarity}");
+        // The bumps are 1 mm in feet (0.3048 mm): the design moves by about that, not more.
+        let Run::Pq { stepper, .. } = &run else {
+            panic!("a panels run")
+        };
+        let [max, mean] = info.deviation_mm(stepper.mesh()).unwrap();
+        assert!(
+            max > 0.01 && max < 2.0 * 0.3048 && mean <= max,
+            "{max} {mean}"
+        );
 
         let (run, info) = import_design(
             "dome.obj",

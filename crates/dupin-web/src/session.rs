@@ -146,6 +146,10 @@ struct Metrics {
     /// An opened design: what it is and how large.
     #[serde(skip_serializing_if = "Option::is_none")]
     design: Option<crate::import::DesignInfo>,
+    /// An opened panel design: how far the vertices are from where the file put them, largest
+    /// and mean, in millimetres.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    deviation_mm: Option<[f64; 2]>,
 }
 
 /// The extra layers `Session.mesh` can draw with the panels: `{ offset, support, distance }`
@@ -858,6 +862,7 @@ impl Session {
                     max_determinant: None,
                     singular_points_inside: None,
                     design: self.design.clone(),
+                    deviation_mm: None,
                 }
             }
             Run::Pq { stepper, started } => {
@@ -905,6 +910,7 @@ impl Session {
                     max_determinant,
                     singular_points_inside,
                     design: self.design.clone(),
+                    deviation_mm: self.design.as_ref().and_then(|d| d.deviation_mm(&mesh)),
                 }
             }
         }
