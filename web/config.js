@@ -19,7 +19,7 @@ export function defaults() {
   return {
     scene: 'torus',
     params: {},
-    imported: { name: null, as: null, unit: null, size: null, mode: 'planar', fixBoundary: false },
+    imported: { name: null, as: null, unit: null, size: null, method: 'prescribed', mode: 'planar', fixBoundary: false },
     free: { surface: 'torus', method: SCHEMA.methods[0].name, init: SCHEMA.initialisations[0].name, size: null, bound: null, lambda: null, mu: null },
     steps: 1,
     color: SCHEMA.colorModes[0],
@@ -44,6 +44,7 @@ export function readHash(hash, { scenes, catalog, torusParams }) {
     if (IMPORT_MODES.includes(h.get('mode'))) c.imported.mode = h.get('mode');
     if (h.has('size')) c.imported.size = num(h.get('size'));
     c.imported.fixBoundary = h.get('fix') === '1';
+    if (SCHEMA.methods.some((m) => m.name === h.get('method'))) c.imported.method = h.get('method');
   }
   if (c.scene === 'torus') {
     for (const [k, spec] of Object.entries(torusParams)) c.params[k] = h.has(k) ? num(h.get(k)) : spec.value;
@@ -89,6 +90,7 @@ export function writeHash(c) {
     if (c.imported.mode !== d.imported.mode) h.set('mode', c.imported.mode);
     if (c.imported.size !== null) h.set('size', String(c.imported.size));
     if (c.imported.fixBoundary) h.set('fix', '1');
+    if (c.imported.method !== d.imported.method) h.set('method', c.imported.method);
   }
   if (c.scene !== 'torus') h.set('steps', String(c.steps));
   if (c.color !== d.color) h.set('color', c.color);
@@ -106,7 +108,7 @@ export function sessionConfig(c) {
   if (c.scene === 'torus') return null;
   if (c.scene === IMPORTED) {
     const i = c.imported;
-    const out = { mode: i.mode, fixBoundary: i.fixBoundary };
+    const out = { mode: i.mode, fixBoundary: i.fixBoundary, method: i.method };
     if (i.as) out.importAs = i.as;
     if (i.unit) out.unit = i.unit;
     if (i.size !== null) out.size = i.size;

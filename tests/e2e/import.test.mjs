@@ -54,6 +54,7 @@ test('open a NURBS design, panel it, export; drop a panel mesh and planarise it;
     assert.equal(m.invalidFaces, '0');
     assert.ok(Number(m.maxPlanarity) <= 1e-10, m.maxPlanarity);
     assert.equal(parseObj(await exportText(page, 'export-obj')).faces, Number(m.faces));
+    assert.equal(await byId(page, 'import-method').inputValue(), 'prescribed');
     // The fabrication pack, in the design's metres: DXF in millimetres with one closed polyline
     // a panel, a CSV row a panel, a GLB with its magic and version.
     const dxf = await exportText(page, 'export-dxf');
