@@ -227,3 +227,24 @@ fn phex_panels_an_imported_roof_with_both_curvature_signs() {
         rep.bbox_diagonal
     );
 }
+
+/// Method 1 on the roof: the layer front runs into a side of the domain, where apexes beyond it
+/// are clamped onto one boundary point. That used to end in "apex projection failed: the query
+/// point or start parameters are not finite"; the layers now stop there and the run finishes
+/// (method 1 is not the method for this roof: the result has invalid faces, reported as such).
+#[test]
+fn method_1_stops_its_layers_at_a_side_of_the_domain() {
+    use dupin_core::Stepper;
+    use dupin_core::phex::{PhexConfig, PhexPipeline, TriangulationMethod};
+    let roof = NurbsSurface::try_from(nurbs_roof()).unwrap();
+    let mut config = PhexConfig::for_nurbs("roof", roof, Some(1.0));
+    config.method = TriangulationMethod::Progressive;
+    let r = PhexPipeline::new(config).and_then(Stepper::finish).unwrap();
+    assert!(r.report.faces > 50, "{} faces", r.report.faces);
+    assert!(
+        r.mesh
+            .positions
+            .iter()
+            .all(|p| p.iter().all(|c| c.is_finite()))
+    );
+}

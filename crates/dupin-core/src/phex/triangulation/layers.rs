@@ -485,6 +485,17 @@ impl<'a> Builder<'a> {
             {
                 break;
             }
+            // A front pressed against a side of the domain: apexes beyond it are clamped onto
+            // one boundary point, so two neighbours coincide and the next layer would have no
+            // direction. The layers stop there, as at the end of the across range.
+            let collapsed = next.windows(2).any(|w| {
+                let (a, b) = (s.position(w[0].x, w[0].y), s.position(w[1].x, w[1].y));
+                let d = (b - a).norm();
+                d == 0.0 || d.is_nan()
+            });
+            if collapsed {
+                break;
+            }
             prev_ratio = Some(ratios.iter().sum::<f64>() / ratios.len() as f64);
             let step = next
                 .iter()
