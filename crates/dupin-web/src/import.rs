@@ -4,7 +4,6 @@
 //! perturbation makes planar (planar, conical or circular), keeping the design. The file never
 //! leaves the page: the bytes come from the browser and stay in the worker.
 
-use crate::session::Run;
 use dupin_core::conical::{MeshRule, PqMode, PqOptions, PqSceneStepper};
 use dupin_core::fabrication::LengthUnit;
 use dupin_core::mesh::PolyMesh;
@@ -77,13 +76,21 @@ impl DesignInfo {
     }
 }
 
+/// What an opened file runs: P-Hex on its surface, or the planarisation of its panels.
+pub(crate) enum Imported {
+    /// P-Hex on the design's surface and what the run is asked for.
+    Phex(Box<PhexPipeline>, PhexGoals),
+    /// The panels' perturbation, stepped like a PQ scene with no subdivision.
+    Panels(Box<PqSceneStepper>),
+}
+
 /// The run and design information of an opened file. Errors name the file.
 pub(crate) fn import_run(
     name: &str,
     bytes: &[u8],
     config: JsValue,
-) -> Result<(Run, DesignInfo), JsError> {
-    crate::session::refuse_unknown_keys(&config, "import config", IMPORT_CONFIG_KEYS)?;
+) -> Result<(Imported, DesignInfo), JsError> {
+    crate::js::refuse_unknown_keys(&config, "import config", IMPORT_CONFIG_KEYS)?;
     let cfg: ImportConfig = if config.is_undefined() || config.is_null() {
         ImportConfig::default()
     } else {
@@ -98,7 +105,7 @@ fn import_design(
     name: &str,
     bytes: &[u8],
     cfg: &ImportConfig,
-) -> Result<(Run, DesignInfo), String> {
+) -> Result<(Imported, DesignInfo), String> {
     let named = |e: &dyn std::fmt::Display| format!("{name}: {e}");
     let wanted = match cfg.import_as.as_deref() {
         None => None,
@@ -181,7 +188,7 @@ fn import_design(
             }
             let goals = PhexGoals::of(&config, true);
             let pipeline = PhexPipeline::new(config).map_err(|e| named(&e))?;
-            Run::Phex(Box::new(pipeline), goals)
+            Imported::Phex(Box::new(pipeline), goals)
         }
         (None, Some(mesh)) => panels_run(&mesh, cfg).map_err(|e| named(&e))?,
         (None, None) => unreachable!("a file gives a surface or a mesh"),
@@ -191,7 +198,7 @@ fn import_design(
 
 /// The planarisation of an opened panel mesh, stepped like a PQ scene with no subdivision: the
 /// design kept (fairness on the move, `keep_design`), as `dupin planarize` does.
-fn panels_run(mesh: &PolyMesh, cfg: &ImportConfig) -> Result<Run, String> {
+fn panels_run(mesh: &PolyMesh, cfg: &ImportConfig) -> Result<Imported, String> {
     let mode: PqMode = cfg
         .mode
         .as_deref()
@@ -207,10 +214,7 @@ fn panels_run(mesh: &PolyMesh, cfg: &ImportConfig) -> Result<Run, String> {
     };
     let stepper = PqSceneStepper::for_mesh(mesh, MeshRule::CatmullClark, 0, options)
         .map_err(|e| format!("{e}"))?;
-    Ok(Run::Pq {
-        stepper: Box::new(stepper),
-        started: false,
-    })
+    Ok(Imported::Panels(Box::new(stepper)))
 }
 
 /// Extent of points along x, y and z.
@@ -238,16 +242,16 @@ mod tests {
         }
     }
 
-    fn run_to_end(run: &mut Run) -> (f64, usize) {
+    fn run_to_end(run: &mut Imported) -> (f64, usize) {
         match run {
-            Run::Phex(p, _) => {
+            Imported::Phex(p, _) => {
                 while !p.is_done() {
                     p.step().unwrap();
                 }
                 let m = p.metrics();
                 (m.max_planarity, m.invalid_faces)
             }
-            Run::Pq { stepper, .. } => {
+            Imported::Panels(stepper) => {
                 while !stepper.is_done() {
                     stepper.step().unwrap();
                 }
@@ -293,7 +297,7 @@ mod tests {
         let (planarity, _) = run_to_end(&mut run);
         assert!(planarity <= 1e-9, "{planarity}");
         // The bumps are 1 mm in feet (0.3048 mm): the design moves by about that, not more.
-        let Run::Pq { stepper, .. } = &run else {
+        let Imported::Panels(stepper) = &run else {
             panic!("a panels run")
         };
         let [max, mean] = info.deviation_mm(stepper.mesh()).unwrap();
@@ -310,14 +314,14 @@ mod tests {
         .unwrap();
         assert_eq!((info.import_as, info.unit), ("surface", "m"));
         assert!(info.fit_max_distance_m.unwrap() < 0.01, "{info:?}");
-        assert!(matches!(run, Run::Phex(..)));
+        assert!(matches!(run, Imported::Phex(..)));
 
         let as_panels = ImportConfig {
             import_as: Some("panels".into()),
             ..ImportConfig::default()
         };
         let (run, _) = import_design("dome.obj", grid_obj(4, true).as_bytes(), &as_panels).unwrap();
-        assert!(matches!(run, Run::Pq { .. }));
+        assert!(matches!(run, Imported::Panels(..)));
     }
 
     #[test]

@@ -36,3 +36,27 @@ pub(crate) fn number_arg(value: f64, what: &str) -> Result<f64, JsError> {
         Err(err(format!("{what} must be a finite number, got {value}")))
     }
 }
+
+/// serde_wasm_bindgen reads a JS object's known fields only (`deny_unknown_fields` never
+/// fires), so a misspelt key would be silently ignored: refuse it with a readable message.
+pub(crate) fn refuse_unknown_keys(
+    value: &JsValue,
+    what: &str,
+    allowed: &[&str],
+) -> Result<(), JsError> {
+    if !value.is_object() {
+        return Ok(()); // serde reports the wrong type itself.
+    }
+    let keys = js_sys::Object::keys(&js_sys::Object::from(value.clone()));
+    match keys
+        .iter()
+        .filter_map(|k| k.as_string())
+        .find(|k| !allowed.contains(&k.as_str()))
+    {
+        Some(k) => Err(JsError::new(&format!(
+            "bad {what}: unknown field `{k}`, expected one of `{}`",
+            allowed.join("`, `")
+        ))),
+        None => Ok(()),
+    }
+}

@@ -1,6 +1,7 @@
 //! `Session`: the contract's step-by-step JS API over the core's P-Hex pipeline and PQ scenes.
 
-use crate::js::{err, to_js};
+use crate::import::Imported;
+use crate::js::{err, refuse_unknown_keys, to_js};
 use crate::mesh_data::MeshData;
 use dupin_core::Stepper;
 use dupin_core::conical::{
@@ -81,30 +82,6 @@ const SESSION_CONFIG_KEYS: &[&str] = &[
     "scene", "surface", "params", "method", "size", "bound", "lambda", "mu", "init",
 ];
 
-/// serde_wasm_bindgen reads a JS object's known fields only (`deny_unknown_fields` never
-/// fires), so a misspelt key would be silently ignored: refuse it with a readable message.
-pub(crate) fn refuse_unknown_keys(
-    value: &JsValue,
-    what: &str,
-    allowed: &[&str],
-) -> Result<(), JsError> {
-    if !value.is_object() {
-        return Ok(()); // serde reports the wrong type itself.
-    }
-    let keys = js_sys::Object::keys(&js_sys::Object::from(value.clone()));
-    match keys
-        .iter()
-        .filter_map(|k| k.as_string())
-        .find(|k| !allowed.contains(&k.as_str()))
-    {
-        Some(k) => Err(JsError::new(&format!(
-            "bad {what}: unknown field `{k}`, expected one of `{}`",
-            allowed.join("`, `")
-        ))),
-        None => Ok(()),
-    }
-}
-
 /// What `step()` and `metrics()` return.
 #[derive(Serialize, Clone)]
 #[serde(rename_all = "camelCase")]
@@ -184,7 +161,7 @@ struct LayerInfo {
     beam_planarity: f64,
 }
 
-pub(crate) enum Run {
+enum Run {
     /// A P-Hex run and what it is asked for (a finished run that misses it is a `warning`).
     Phex(Box<PhexPipeline>, PhexGoals),
     /// A PQ scene, one perturbation iteration or one subdivision a step; the first step shows
@@ -406,7 +383,14 @@ impl Session {
     /// `Error` naming the file and what is wrong with it.
     #[wasm_bindgen(js_name = fromFile)]
     pub fn from_file(name: &str, bytes: &[u8], config: JsValue) -> Result<Session, JsError> {
-        let (run, design) = crate::import::import_run(name, bytes, config)?;
+        let (imported, design) = crate::import::import_run(name, bytes, config)?;
+        let run = match imported {
+            Imported::Phex(p, goals) => Run::Phex(p, goals),
+            Imported::Panels(stepper) => Run::Pq {
+                stepper,
+                started: false,
+            },
+        };
         Ok(Session {
             run,
             config: SessionConfig {
