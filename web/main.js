@@ -339,7 +339,7 @@ function stop() {
   restartSolver(`stopped; back at step ${config.steps}`, false);
 }
 
-/** `imported: NAME · surface · 20.00 × 15.00 × 3.40 m (fit within 0.1 mm)`. */
+/** `imported: NAME · surface · 20.00 × 15.00 × 3.40 m (unit m) · surface fitted within 0.11 mm`. */
 function designLine(d) {
   const dims = d.dimensionsM.map((x) => x.toFixed(2)).join(' × ');
   const fit = d.fitMaxDistanceM === undefined ? '' : ` · surface fitted within ${(d.fitMaxDistanceM * 1000).toFixed(2)} mm`;
