@@ -19,7 +19,8 @@ export function defaults() {
   return {
     scene: 'torus',
     params: {},
-    imported: { name: null, as: null, unit: null, size: null, method: 'prescribed', mode: 'planar', fixBoundary: false },
+    // `read`: how the worker read the opened file ({ as, unit }), shown until the user picks.
+    imported: { name: null, as: null, unit: null, method: 'prescribed', init: SCHEMA.initialisations[0].name, size: null, bound: null, lambda: null, mu: null, mode: 'planar', fixBoundary: false, read: null },
     free: { surface: 'torus', method: SCHEMA.methods[0].name, init: SCHEMA.initialisations[0].name, size: null, bound: null, lambda: null, mu: null },
     steps: 1,
     color: SCHEMA.colorModes[0],
@@ -42,9 +43,8 @@ export function readHash(hash, { scenes, catalog, torusParams }) {
     if (['surface', 'panels'].includes(h.get('as'))) c.imported.as = h.get('as');
     if (IMPORT_UNITS.includes(h.get('unit'))) c.imported.unit = h.get('unit');
     if (IMPORT_MODES.includes(h.get('mode'))) c.imported.mode = h.get('mode');
-    if (h.has('size')) c.imported.size = num(h.get('size'));
     c.imported.fixBoundary = h.get('fix') === '1';
-    if (SCHEMA.methods.some((m) => m.name === h.get('method'))) c.imported.method = h.get('method');
+    readRunSettings(h, c.imported);
   }
   if (c.scene === 'torus') {
     for (const [k, spec] of Object.entries(torusParams)) c.params[k] = h.has(k) ? num(h.get(k)) : spec.value;
@@ -53,9 +53,7 @@ export function readHash(hash, { scenes, catalog, torusParams }) {
     const surface = catalog.find((s) => s.name === h.get('surface')) ?? catalog.find((s) => s.name === 'torus') ?? catalog[0];
     c.free.surface = surface.name;
     for (const p of surface.params) c.params[p.key] = h.has(`p.${p.key}`) ? num(h.get(`p.${p.key}`)) : p.default;
-    if (SCHEMA.methods.some((m) => m.name === h.get('method'))) c.free.method = h.get('method');
-    if (SCHEMA.initialisations.some((m) => m.name === h.get('init'))) c.free.init = h.get('init');
-    for (const k of ['size', 'bound', 'lambda', 'mu']) if (h.has(k)) c.free[k] = num(h.get(k));
+    readRunSettings(h, c.free);
   }
   // The torus preview does not step (writeHash leaves its steps out).
   const steps = Number(h.get('steps'));
@@ -73,6 +71,25 @@ export function readHash(hash, { scenes, catalog, torusParams }) {
   return c;
 }
 
+// The P-Hex run settings of the free mode, which an opened surface shares: method,
+// initialisation, size, b, λ, μ (hash keys `method`, `init`, `size`, `bound`, `lambda`, `mu`).
+const RUN_NUMBERS = ['size', 'bound', 'lambda', 'mu'];
+function readRunSettings(h, into) {
+  if (SCHEMA.methods.some((m) => m.name === h.get('method'))) into.method = h.get('method');
+  if (SCHEMA.initialisations.some((m) => m.name === h.get('init'))) into.init = h.get('init');
+  for (const k of RUN_NUMBERS) if (h.has(k)) into[k] = num(h.get(k));
+}
+function writeRunSettings(h, from, d) {
+  if (from.method !== d.method) h.set('method', from.method);
+  if (from.init !== d.init) h.set('init', from.init);
+  for (const k of RUN_NUMBERS) if (from[k] !== null) h.set(k, String(from[k]));
+}
+function runSettings(from) {
+  const out = { method: from.method, init: from.init };
+  for (const k of RUN_NUMBERS) if (from[k] !== null) out[k] = from[k];
+  return out;
+}
+
 export function writeHash(c) {
   const d = defaults();
   const h = new URLSearchParams({ scene: c.scene });
@@ -80,17 +97,15 @@ export function writeHash(c) {
   if (c.scene === FREE) {
     h.set('surface', c.free.surface);
     for (const [k, v] of Object.entries(c.params)) h.set(`p.${k}`, String(v));
-    h.set('method', c.free.method);
-    if (c.free.init !== d.free.init) h.set('init', c.free.init);
-    for (const k of ['size', 'bound', 'lambda', 'mu']) if (c.free[k] !== null) h.set(k, String(c.free[k]));
+    h.set('method', c.free.method); // a free link always names its method
+    writeRunSettings(h, c.free, d.free);
   }
   if (c.scene === IMPORTED) {
     if (c.imported.as) h.set('as', c.imported.as);
     if (c.imported.unit) h.set('unit', c.imported.unit);
     if (c.imported.mode !== d.imported.mode) h.set('mode', c.imported.mode);
-    if (c.imported.size !== null) h.set('size', String(c.imported.size));
     if (c.imported.fixBoundary) h.set('fix', '1');
-    if (c.imported.method !== d.imported.method) h.set('method', c.imported.method);
+    writeRunSettings(h, c.imported, d.imported);
   }
   if (c.scene !== 'torus') h.set('steps', String(c.steps));
   if (c.color !== d.color) h.set('color', c.color);
@@ -108,14 +123,11 @@ export function sessionConfig(c) {
   if (c.scene === 'torus') return null;
   if (c.scene === IMPORTED) {
     const i = c.imported;
-    const out = { mode: i.mode, fixBoundary: i.fixBoundary, method: i.method };
+    const out = { mode: i.mode, fixBoundary: i.fixBoundary, ...runSettings(i) };
     if (i.as) out.importAs = i.as;
     if (i.unit) out.unit = i.unit;
-    if (i.size !== null) out.size = i.size;
     return out;
   }
   if (c.scene !== FREE) return { scene: c.scene };
-  const out = { surface: c.free.surface, params: { ...c.params }, method: c.free.method, init: c.free.init };
-  for (const k of ['size', 'bound', 'lambda', 'mu']) if (c.free[k] !== null) out[k] = c.free[k];
-  return out;
+  return { surface: c.free.surface, params: { ...c.params }, ...runSettings(c.free) };
 }

@@ -9,6 +9,8 @@ const el = (tag, props = {}, ...children) => {
   return e;
 };
 
+const labelled = (text, e) => el('label', { className: 'field' }, el('span', { className: 'field-label', textContent: text }), e);
+
 /** Fills the scene picker: torus preview, every contract scene, the free mode, and the
  * opened design (`imported: NAME`) when there is one. */
 export function fillScenePicker(select, scenes, importedName = null) {
@@ -100,28 +102,29 @@ export function buildFields(box, c, { catalog, torusParams, defaults, onChange }
     }
     return;
   }
-  const labelled = (text, e) => el('label', { className: 'field' }, el('span', { className: 'field-label', textContent: text }), e);
   if (c.scene === IMPORTED) {
     const i = c.imported;
+    // The selects show how the file is read (the worker's guess) until the user picks.
+    const as = i.as ?? i.read?.as ?? 'surface';
     box.append(
-      labelled('read as', choice('import-as', [['', 'guess'], ['surface', 'surface (P-Hex)'], ['panels', 'panels (planarise)']], i.as ?? '',
-        (v) => onChange((n) => { n.imported.as = v || null; }, 'import-as'),
+      labelled('read as', choice('import-as', [['surface', 'surface (P-Hex)'], ['panels', 'panels (planarise)']], as,
+        (v) => onChange((n) => { n.imported.as = v; }, 'import-as', true),
         'a NURBS surface or a triangle mesh of a smooth surface is panelled by P-Hex; quads, hexagons or any polygons are planarised')),
-      labelled('unit', choice('import-unit', [['', 'file / m'], ...IMPORT_UNITS.map((u) => [u, u])], i.unit ?? '',
-        (v) => onChange((n) => { n.imported.unit = v || null; }, 'import-unit'),
-        'length unit of the file\'s coordinates (a NURBS JSON may state its own; otherwise metres)')),
-      labelled('method', choice('import-method', [['prescribed', 'method 2: parameter lines'], ['progressive', 'method 1: progressive']], i.method,
-        (v) => onChange((n) => { n.imported.method = v; }, 'import-method'),
-        'P-Hex triangulation of section 5.2: method 2 along the parameter lines (they should be conjugate), or method 1 from a base curve')),
-      labelled('panels', choice('import-mode', IMPORT_MODES.map((m) => [m, m]), i.mode,
-        (v) => onChange((n) => { n.imported.mode = v; }, 'import-mode'), 'planarisation mode of a panel mesh')),
-      checkbox('import-fix-boundary', 'fix boundary', i.fixBoundary, 'panels: keep every boundary vertex exactly where the file puts it',
-        (v) => onChange((n) => { n.imported.fixBoundary = v; }, 'import-fix-boundary')),
-      numberField({
-        id: 'import-size', label: 'panel size', value: i.size ?? '', title: 'P-Hex: target edge length of the base curve, in the file\'s unit (empty: 1/48 of its length)',
-        onCommit: (v, id) => onChange((n) => { n.imported.size = v; }, id),
-      }),
+      labelled('unit', choice('import-unit', IMPORT_UNITS.map((u) => [u, u]), i.unit ?? i.read?.unit ?? 'm',
+        (v) => onChange((n) => { n.imported.unit = v; }, 'import-unit'),
+        'length unit of the file\'s coordinates (a .3dm or a NURBS JSON states its own; otherwise metres)')),
     );
+    if (as === 'surface') {
+      // The free mode's P-Hex fields, on the opened surface (sizes in the file's unit).
+      runFields(box, i, (apply, id) => onChange((n) => apply(n.imported), id), defaults, 'in the file\'s unit');
+    } else {
+      box.append(
+        labelled('panels', choice('import-mode', IMPORT_MODES.map((m) => [m, m]), i.mode,
+          (v) => onChange((n) => { n.imported.mode = v; }, 'import-mode'), 'planarisation mode of a panel mesh')),
+        checkbox('import-fix-boundary', 'fix boundary', i.fixBoundary, 'keep every boundary vertex exactly where the file puts it',
+          (v) => onChange((n) => { n.imported.fixBoundary = v; }, 'import-fix-boundary')),
+      );
+    }
     return;
   }
   if (c.scene !== FREE) return;
@@ -134,34 +137,44 @@ export function buildFields(box, c, { catalog, torusParams, defaults, onChange }
     n.free.surface = pick.value;
     n.params = Object.fromEntries(catalog.find((s) => s.name === pick.value).params.map((p) => [p.key, p.default]));
   }, 'free-surface', true));
-  const method = el('select');
-  method.dataset.testid = 'free-method';
-  method.append(...schema().methods.map((m) => new Option(m.label, m.name)));
-  method.value = c.free.method;
-  method.addEventListener('change', () => onChange((n) => { n.free.method = method.value; }, 'free-method'));
-  const init = el('select', { title: 'hexagon initialisation: tangent duality (sec. 4.1, starts planar) or Dupin duality (sec. 6, the optimisation makes it planar)' });
-  init.dataset.testid = 'free-init';
-  init.append(...schema().initialisations.map((m) => new Option(m.label, m.name)));
-  init.value = c.free.init;
-  init.addEventListener('change', () => onChange((n) => { n.free.init = init.value; }, 'free-init'));
-  box.append(labelled('surface', pick), labelled('method', method), labelled('init', init));
-  for (const p of surface?.params ?? []) {
-    box.append(numberField({
-      id: `param-${p.key}`, label: p.key, value: c.params[p.key], min: p.min, max: p.max,
-      step: p.integer ? 1 : 'any', slider: true, title: `${p.doc} [${p.min}, ${p.max}]`,
-      onCommit: (v, id) => onChange((n) => { n.params[p.key] = v ?? NaN; }, id),
-    }));
-  }
+  box.append(labelled('surface', pick));
+  const run = (apply, id) => onChange((n) => apply(n.free), id);
+  runFields(box, c.free, run, defaults, null, () => {
+    for (const p of surface?.params ?? []) {
+      box.append(numberField({
+        id: `param-${p.key}`, label: p.key, value: c.params[p.key], min: p.min, max: p.max,
+        step: p.integer ? 1 : 'any', slider: true, title: `${p.doc} [${p.min}, ${p.max}]`,
+        onCommit: (v, id) => onChange((n) => { n.params[p.key] = v ?? NaN; }, id),
+      }));
+    }
+  });
+}
+
+/**
+ * The free mode's P-Hex run fields (`free-method`, `free-init`, then `between()`'s fields, then
+ * `free-size`, `free-bound`, `free-lambda`, `free-mu`) for the settings object `s`;
+ * `onChange(apply, id)` with `apply(settings)` changing a copy. `unit` (or null) is said in the
+ * size's tooltip.
+ */
+function runFields(box, s, onChange, defaults, unit, between = () => {}) {
+  const method = choice('free-method', schema().methods.map((m) => [m.name, m.label]), s.method,
+    (v) => onChange((t) => { t.method = v; }, 'free-method'),
+    'P-Hex triangulation of section 5.2: progressive (method 1, from a base curve) or prescribed (method 2, along the parameter lines, which should be conjugate)');
+  const init = choice('free-init', schema().initialisations.map((m) => [m.name, m.label]), s.init,
+    (v) => onChange((t) => { t.init = v; }, 'free-init'),
+    'hexagon initialisation: tangent duality (sec. 4.1, starts planar) or Dupin duality (sec. 6, the optimisation makes it planar)');
+  box.append(labelled('method', method), labelled('init', init));
+  between();
   const run = [
-    ['size', 'panel size', 'target edge length of the base curve (empty: 1/48 of its length)'],
+    ['size', 'panel size', `target edge length of the base curve${unit ? `, ${unit}` : ''} (empty: 1/48 of its length)`],
     ['bound', 'b', `parabolic lower bound b of section 5.3 (default ${defaults.bound})`],
     ['lambda', 'λ', `fairness weight of section 7 (default ${defaults.lambda})`],
     ['mu', 'μ', `surface-distance weight of section 7 (default ${defaults.mu})`],
   ];
   for (const [k, label, title] of run) {
     box.append(numberField({
-      id: `free-${k}`, label, value: c.free[k] ?? (k === 'size' ? '' : defaults[k]), title,
-      onCommit: (v, id) => onChange((n) => { n.free[k] = v; }, id),
+      id: `free-${k}`, label, value: s[k] ?? (k === 'size' ? '' : defaults[k]), title,
+      onCommit: (v, id) => onChange((t) => { t[k] = v; }, id),
     }));
   }
 }

@@ -11,6 +11,7 @@ import { Solver } from './solver.js';
 import { initTeach, showPick } from './teach.js';
 import { initHexd2d } from './hexd2d.js';
 import { initPresent } from './present.js';
+import { read3dm, write3dm } from './rhino.js';
 
 const $ = (id) => document.querySelector(`[data-testid="${id}"]`);
 const statusEl = $('status');
@@ -74,7 +75,7 @@ function updateButtons() {
   setProp($('reset'), 'disabled', !running);
   setProp($('stop'), 'disabled', !running || done);
   setProp($('play'), 'textContent', playing ? 'Pause' : 'Play');
-  for (const id of ['export-json', 'export-svg', 'export-dxf', 'export-csv', 'export-glb']) setProp($(id), 'disabled', !running);
+  for (const id of ['export-json', 'export-svg', 'export-dxf', 'export-csv', 'export-glb', 'export-3dm']) setProp($(id), 'disabled', !running);
 }
 
 // ---- loading a configuration -----------------------------------------------------------------
@@ -119,8 +120,11 @@ function load(next, { reframe = true, field = null, rebuild = false } = {}) {
   lastPhase = '';
   userMoved = !!pendingCamera;
   candidate = { config: next, field, reframe, rebuild };
-  const file = next.scene === IMPORTED ? opened : null;
-  solver.load(sessionConfig(next), { steps: next.steps, mode: next.color, field, layers: next.layers, file });
+  const file = next.scene === IMPORTED ? { name: opened.name, bytes: opened.bytes } : null;
+  const cfg = sessionConfig(next);
+  // A .3dm's own unit, unless the user picked one.
+  if (file && opened.unit && !cfg.unit) cfg.unit = opened.unit;
+  solver.load(cfg, { steps: next.steps, mode: next.color, field, layers: next.layers, file });
 }
 
 /** Opens a design file (file input or drop): shown as `imported: NAME` once the worker has read
@@ -134,8 +138,23 @@ async function openDesign(file) {
     showStatus(`${viewer.backend} · ${file.name}: the browser could not read the file (${e.message ?? e})`, true);
     return;
   }
+  let unit = null;
+  let note = '';
+  if (/\.3dm$/i.test(file.name)) {
+    // Rhino's format, read by rhino3dm into the NURBS JSON or OBJ the solver reads.
+    showStatus(`${viewer.backend} · reading ${file.name} with rhino3dm…`);
+    try {
+      const design = await read3dm(bytes, file.name);
+      bytes = new TextEncoder().encode(design.text);
+      unit = design.unit;
+      note = [`${design.kind}: ${design.name}`, design.note].filter(Boolean).join('; ');
+    } catch (e) {
+      showStatus(`${viewer.backend} · ${file.name}: ${e.message ?? e}`, true);
+      return;
+    }
+  }
   previousOpened = opened;
-  opened = { name: file.name, bytes };
+  opened = { name: file.name, bytes, unit, note };
   const next = defaults();
   Object.assign(next, { scene: IMPORTED, color: config.color, panelEdge: config.panelEdge, layers: config.layers, backend: config.backend });
   next.imported.name = file.name;
@@ -162,6 +181,13 @@ function applyState(s) {
   const t0main = performance.now();
   if (candidate) {
     config = candidate.config;
+    const design = s.metrics.design;
+    if (config.scene === IMPORTED && design) {
+      const read = { as: design.importAs, unit: design.unit };
+      // The import selects show what the worker made of the file.
+      if (read.as !== config.imported.read?.as || read.unit !== config.imported.read?.unit) candidate.rebuild = true;
+      config.imported.read = read;
+    }
     if (candidate.rebuild) {
       fillScenePicker($('scene-select'), ctx.scenes, opened?.name);
       $('scene-select').value = config.scene;
@@ -343,7 +369,8 @@ function stop() {
 function designLine(d) {
   const dims = d.dimensionsM.map((x) => x.toFixed(2)).join(' × ');
   const fit = d.fitMaxDistanceM === undefined ? '' : ` · surface fitted within ${(d.fitMaxDistanceM * 1000).toFixed(2)} mm`;
-  return `imported: ${d.name} · ${d.importAs} · ${dims} m (unit ${d.unit})${fit}`;
+  const note = opened?.note ? ` · ${opened.note}` : '';
+  return `imported: ${d.name} · ${d.importAs} · ${dims} m (unit ${d.unit})${fit}${note}`;
 }
 
 function onError(e) {
@@ -369,9 +396,22 @@ function download(name, data, type) {
 
 const EXPORT_TYPES = { obj: 'text/plain', json: 'application/json', svg: 'image/svg+xml', dxf: 'application/dxf', csv: 'text/csv', glb: 'model/gltf-binary' };
 function onExport(m) {
-  const name = config.scene === FREE ? `free-${config.free.surface}`
+  if (m.kind === '3dm') {
+    // The panels from the solver, written by rhino3dm in its worker.
+    const name = exportName();
+    write3dm(m.text).then(({ bytes, degenerate }) => {
+      download(`${name}.3dm`, bytes, 'application/octet-stream');
+      if (degenerate) showStatus(`${viewer.backend} · ${name}.3dm: ${degenerate} degenerate panel(s) written as outlines only`, true);
+    })
+      .catch((e) => showStatus(`${viewer.backend} · 3dm export failed: ${e.message ?? e}`, true));
+    return;
+  }
+  download(`${exportName()}.${m.kind}`, m.text, EXPORT_TYPES[m.kind]);
+}
+
+function exportName() {
+  return config.scene === FREE ? `free-${config.free.surface}`
     : config.scene === IMPORTED ? (opened?.name ?? 'design').replace(/\.[^.]*$/, '') : config.scene;
-  download(`${name}.${m.kind}`, m.text, EXPORT_TYPES[m.kind]);
 }
 
 /** Renders the view at `scale` x the canvas size on the GPU and returns a PNG blob. */
@@ -632,7 +672,7 @@ async function main() {
   });
   $('export-json').addEventListener('click', () => solver.post('export', { kind: 'json' }));
   $('export-svg').addEventListener('click', () => solver.post('export', { kind: 'svg', panelEdge: config.panelEdge }));
-  for (const kind of ['dxf', 'csv', 'glb']) $(`export-${kind}`).addEventListener('click', () => solver.post('export', { kind, panelEdge: config.panelEdge }));
+  for (const kind of ['dxf', 'csv', 'glb', '3dm']) $(`export-${kind}`).addEventListener('click', () => solver.post('export', { kind, panelEdge: config.panelEdge }));
   $('screenshot').addEventListener('click', async () => {
     try { download(`${config.scene}@2x.png`, await snapshotPng(2)); } catch (e) { showStatus(`${viewer.backend} · ${e.message ?? e}`, true); }
   });

@@ -2,7 +2,7 @@
 // the page's thread only draws. Protocol (all messages carry the load generation `gen`; stale
 // ones are dropped on both sides):
 //   in:  load {config, steps, mode, layers, file?} (file {name, bytes}: Session.fromFile) | step | play | pause | ack | mode {mode}
-//        | layers {layers} (offset/support, Session.setLayers) | export {kind, panelEdge} (obj, json, svg, dxf, csv, glb)
+//        | layers {layers} (offset/support, Session.setLayers) | export {kind, panelEdge} (obj, json, svg, dxf, csv, glb, 3dm)
 //        | pick {origin, direction} (a view ray)
 //        | fault {kind} (debugFault: a deliberate trap or out-of-memory, for recovery tests)
 //   out: ready | state {metrics, steps, done, mesh: typed arrays (transferred), layers:
@@ -146,6 +146,7 @@ const handlers = {
         dxf: () => session.exportDxf(msg.panelEdge),
         csv: () => session.exportCsv(msg.panelEdge),
         glb: () => session.exportGlb(msg.panelEdge), // bytes
+        '3dm': () => session.exportPanels(msg.panelEdge), // panels for rhino.js to write
       };
       const text = exports[msg.kind]();
       postMessage({ type: 'export', gen, kind: msg.kind, text });

@@ -54,7 +54,12 @@ test('open a NURBS design, panel it, export; drop a panel mesh and planarise it;
     assert.equal(m.invalidFaces, '0');
     assert.ok(Number(m.maxPlanarity) <= 1e-10, m.maxPlanarity);
     assert.equal(parseObj(await exportText(page, 'export-obj')).faces, Number(m.faces));
-    assert.equal(await byId(page, 'import-method').inputValue(), 'prescribed');
+    // The selects show how the file was read; the free mode's fields drive the opened surface.
+    assert.equal(await byId(page, 'import-as').inputValue(), 'surface');
+    assert.deepEqual(await byId(page, 'import-as').locator('option').evaluateAll((o) => o.map((x) => x.value)), ['surface', 'panels']);
+    assert.equal(await byId(page, 'import-unit').inputValue(), 'm');
+    assert.deepEqual(await byId(page, 'import-unit').locator('option').evaluateAll((o) => o.map((x) => x.value)), ['mm', 'cm', 'm', 'in', 'ft']);
+    assert.equal(await byId(page, 'free-method').inputValue(), 'prescribed');
     // The fabrication pack, in the design's metres: DXF in millimetres with one closed polyline
     // a panel, a CSV row a panel, a GLB with its magic and version.
     const dxf = await exportText(page, 'export-dxf');
@@ -69,6 +74,16 @@ test('open a NURBS design, panel it, export; drop a panel mesh and planarise it;
     assert.equal(glb.toString('latin1', 0, 4), 'glTF');
     assert.equal(glb.readUInt32LE(4), 2);
     assert.equal(glb.readUInt32LE(8), glb.length);
+
+    // A larger panel size (free-size, in the file's metres) gives fewer panels.
+    await byId(page, 'free-size').fill('1.2');
+    await byId(page, 'free-size').press('Enter');
+    await page.waitForFunction(() => document.querySelector('[data-testid=metrics]').dataset.steps === '1', null, { timeout: 60_000 });
+    assert.match(page.url(), /size=1\.2/);
+    await play(page);
+    const coarse = await metrics(page);
+    assert.equal(coarse.phase, 'done', await byId(page, 'status').textContent());
+    assert.ok(Number(coarse.faces) < Number(m.faces) / 2, `${coarse.faces} vs ${m.faces}`);
 
     // A panel mesh dropped anywhere on the page: planarised, keeping the design.
     await page.evaluate((text) => {
@@ -85,6 +100,7 @@ test('open a NURBS design, panel it, export; drop a panel mesh and planarise it;
     // The design is kept: +-1 mm of noise moves the vertices by about that, never 2 mm.
     assert.ok(Number(m.maxDeviationMm) > 0.1 && Number(m.maxDeviationMm) <= 2, m.maxDeviationMm);
     assert.match(await byId(page, 'metrics').textContent(), /moved from design/);
+    assert.equal(await byId(page, 'import-as').inputValue(), 'panels');
     // Fix the boundary: the run restarts with it and still ends planar.
     await byId(page, 'import-fix-boundary').check();
     await page.waitForFunction(() => document.querySelector('[data-testid=metrics]').dataset.steps === '1', null, { timeout: 60_000 });

@@ -44,6 +44,21 @@ const CSP: &str = "default-src 'self'; script-src 'self' 'wasm-unsafe-eval'; wor
                    connect-src 'self' data: blob:; img-src 'self' data: blob:; style-src 'self'; \
                    object-src 'none'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'";
 
+/// The .3dm worker's own policy: rhino3dm's bindings (embind) build functions from strings, so
+/// this worker alone may evaluate them; it loads rhino3dm's script and wasm from the origin and
+/// nothing else.
+const RHINO_WORKER_CSP: &str = "default-src 'none'; script-src 'self' 'unsafe-eval' \
+                                'wasm-unsafe-eval'; connect-src 'self'";
+
+/// The page's policy for `path`, a request path.
+fn csp_for(path: &str) -> &'static str {
+    if path == "/rhino-worker.js" {
+        RHINO_WORKER_CSP
+    } else {
+        CSP
+    }
+}
+
 fn handle(mut stream: TcpStream, dir: &Path) -> std::io::Result<()> {
     let mut reader = BufReader::new(stream.try_clone()?);
     let mut request = String::new();
@@ -70,9 +85,10 @@ fn handle(mut stream: TcpStream, dir: &Path) -> std::io::Result<()> {
     write!(
         stream,
         "HTTP/1.1 {status}\r\nContent-Type: {mime}\r\nContent-Length: {}\r\n\
-         Content-Security-Policy: {CSP}\r\nX-Content-Type-Options: nosniff\r\n\
+         Content-Security-Policy: {}\r\nX-Content-Type-Options: nosniff\r\n\
          Cache-Control: no-store\r\nConnection: close\r\n\r\n",
-        body.len()
+        body.len(),
+        csp_for(path),
     )?;
     if method != "HEAD" {
         stream.write_all(&body)?;
@@ -91,5 +107,18 @@ fn mime(path: &Path) -> &'static str {
         Some("svg") => "image/svg+xml",
         Some("ts") => "text/plain; charset=utf-8",
         _ => "application/octet-stream",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_the_rhino_worker_may_evaluate_strings() {
+        assert!(csp_for("/rhino-worker.js").contains("'unsafe-eval'"));
+        for path in ["/", "/index.html", "/worker.js", "/main.js", "/rhino.js"] {
+            assert!(!csp_for(path).contains("'unsafe-eval'"), "{path}");
+        }
     }
 }

@@ -46,6 +46,15 @@ pub fn ensure(browser: bool) -> Result<Vec<String>> {
         installed.push(format!("wasm-pack {WASM_PACK_VERSION}"));
     }
 
+    // rhino3dm, which the page loads from web/vendor when a .3dm is opened or written.
+    let vendor = root().join("web/vendor");
+    if !vendor.join("node_modules/rhino3dm/rhino3dm.wasm").exists() {
+        run(Command::new("npm")
+            .args(["ci", "--no-audit", "--no-fund"])
+            .current_dir(&vendor))?;
+        installed.push("npm: rhino3dm (web/vendor)".into());
+    }
+
     if browser {
         let missing = !Path::new("/usr/bin/chromium").exists()
             || !Path::new("/usr/bin/chromedriver").exists()
@@ -68,11 +77,15 @@ pub fn ensure(browser: bool) -> Result<Vec<String>> {
             installed.push(format!("apt: {}", APT_PACKAGES.join(", ")));
         }
         let e2e = root().join("tests/e2e");
-        if !e2e.join("node_modules/playwright-core").exists() {
+        let packages = ["playwright-core", "dxf-parser", "gltf-validator"];
+        if packages
+            .iter()
+            .any(|p| !e2e.join("node_modules").join(p).exists())
+        {
             run(Command::new("npm")
                 .args(["ci", "--no-audit", "--no-fund"])
                 .current_dir(&e2e))?;
-            installed.push("npm: playwright-core (tests/e2e)".into());
+            installed.push(format!("npm: {} (tests/e2e)", packages.join(", ")));
         }
     }
     Ok(installed)

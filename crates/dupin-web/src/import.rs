@@ -8,13 +8,13 @@ use dupin_core::conical::{MeshRule, PqMode, PqOptions, PqSceneStepper};
 use dupin_core::fabrication::LengthUnit;
 use dupin_core::mesh::PolyMesh;
 use dupin_core::mesh::io::{ImportOptions, read_mesh};
-use dupin_core::phex::{PhexConfig, PhexGoals, PhexPipeline, TriangulationMethod};
+use dupin_core::phex::{LayerRule, PhexConfig, PhexGoals, PhexPipeline, TriangulationMethod};
 use dupin_core::surface::{MeshFitOptions, NurbsSurface, Surface, fit_mesh_surface};
 use serde::{Deserialize, Serialize};
 use wasm_bindgen::prelude::*;
 
-/// The options of `Session.fromFile`: `{ importAs, unit, size, method, mode, fixBoundary }`, all
-/// optional.
+/// The options of `Session.fromFile`: `{ importAs, unit, size, method, init, bound, lambda, mu,
+/// mode, fixBoundary }`, all optional: the surface settings are the free mode's.
 #[derive(Deserialize, Default)]
 #[serde(deny_unknown_fields, rename_all = "camelCase")]
 struct ImportConfig {
@@ -27,6 +27,14 @@ struct ImportConfig {
     size: Option<f64>,
     /// Surface: `prescribed` (default: method 2 along the parameter lines) or `progressive`.
     method: Option<String>,
+    /// Surface: hexagon initialisation, as in the free mode.
+    init: Option<String>,
+    /// Surface: parabolic lower bound b (section 5.3).
+    bound: Option<f64>,
+    /// Surface: initial fairness weight (section 7).
+    lambda: Option<f64>,
+    /// Surface: initial surface-distance weight (section 7).
+    mu: Option<f64>,
     /// Panels: `planar` (default), `conical` or `circular`.
     mode: Option<String>,
     /// Panels: keep the boundary vertices where they are.
@@ -34,8 +42,44 @@ struct ImportConfig {
 }
 
 /// The keys of [`ImportConfig`] as JS spells them, for the unknown-key check.
-pub(crate) const IMPORT_CONFIG_KEYS: &[&str] =
-    &["importAs", "unit", "size", "method", "mode", "fixBoundary"];
+pub(crate) const IMPORT_CONFIG_KEYS: &[&str] = &[
+    "importAs",
+    "unit",
+    "size",
+    "method",
+    "init",
+    "bound",
+    "lambda",
+    "mu",
+    "mode",
+    "fixBoundary",
+];
+
+/// The free mode's P-Hex run settings, shared by a library surface and an opened one: the
+/// parabolic lower bound b (section 5.3), the initial fairness and surface-distance weights
+/// (section 7) and the hexagon initialisation (`tangent-duality`, section 4.1, by default, or
+/// `dupin-duality`, section 6). Absent values keep `config`'s.
+pub(crate) fn apply_phex_settings(
+    config: &mut PhexConfig,
+    bound: Option<f64>,
+    lambda: Option<f64>,
+    mu: Option<f64>,
+    init: Option<&str>,
+) -> Result<(), String> {
+    if let Some(b) = bound {
+        config.rule = LayerRule::Ideal { bound: b };
+    }
+    if let Some(l) = lambda {
+        config.lambda = l;
+    }
+    if let Some(m) = mu {
+        config.mu = m;
+    }
+    if let Some(i) = init {
+        config.initialisation = i.parse().map_err(|e| format!("{e}"))?;
+    }
+    Ok(())
+}
 
 /// The page's largest panel factorisation (1 GB: a browser tab must survive it).
 const PAGE_MAX_FACTOR_BYTES: usize = 1 << 30;
@@ -119,11 +163,17 @@ fn import_design(
         Some(u) => Some(u.parse().map_err(|e| format!("{e}"))?),
         None => None,
     };
-    let is_json = name.to_ascii_lowercase().ends_with(".json")
-        || bytes
+    // A NURBS surface is `.json`, or JSON text under a name no mesh format claims (a .3dm the
+    // page converted, a file without extension); a `.gltf` is JSON too but a mesh.
+    let ext = name.rsplit_once('.').map(|(_, e)| e.to_ascii_lowercase());
+    let is_json = match ext.as_deref() {
+        Some("json") => true,
+        Some("obj" | "stl" | "gltf" | "glb") => false,
+        _ => bytes
             .iter()
             .find(|b| !b.is_ascii_whitespace())
-            .is_some_and(|&b| b == b'{');
+            .is_some_and(|&b| b == b'{'),
+    };
     let (surface, mesh, fit_distance) = if is_json {
         if wanted == Some(false) {
             return Err(named(
@@ -186,6 +236,13 @@ fn import_design(
                     .parse::<TriangulationMethod>()
                     .map_err(|e| format!("{e}"))?;
             }
+            apply_phex_settings(
+                &mut config,
+                cfg.bound,
+                cfg.lambda,
+                cfg.mu,
+                cfg.init.as_deref(),
+            )?;
             let goals = PhexGoals::of(&config, true);
             let pipeline = PhexPipeline::new(config).map_err(|e| named(&e))?;
             Imported::Phex(Box::new(pipeline), goals)
@@ -345,5 +402,48 @@ mod tests {
             ..ImportConfig::default()
         };
         assert!(refused("a.obj", b"", &as_what).contains("use `surface` or `panels`"));
+    }
+
+    #[test]
+    fn the_free_mode_settings_reach_an_opened_surface() {
+        let json = r#"{"degree_u": 1, "degree_v": 1, "knots_u": [0, 0, 1, 1],
+            "knots_v": [0, 0, 1, 1],
+            "control_points": [[[0, 0, 0], [0, 2, 0]], [[3, 0, 0], [3, 2, 0.5]]]}"#;
+        let cfg = ImportConfig {
+            init: Some("dupin-duality".into()),
+            bound: Some(0.2),
+            lambda: Some(0.5),
+            mu: Some(7.0),
+            ..ImportConfig::default()
+        };
+        let (run, _) = import_design("roof.json", json.as_bytes(), &cfg).unwrap();
+        let Imported::Phex(p, _) = run else {
+            panic!("a NURBS design is a surface")
+        };
+        let c = p.config();
+        assert_eq!(
+            c.initialisation,
+            dupin_core::phex::Initialisation::DupinDuality
+        );
+        assert_eq!(c.rule, LayerRule::Ideal { bound: 0.2 });
+        assert_eq!((c.lambda, c.mu), (0.5, 7.0));
+        let bad = ImportConfig {
+            init: Some("spiral".into()),
+            ..ImportConfig::default()
+        };
+        assert!(import_design("roof.json", json.as_bytes(), &bad).is_err());
+    }
+
+    #[test]
+    fn a_gltf_is_a_mesh_and_json_under_another_name_a_nurbs_surface() {
+        let gltf = r#"{"asset": {"version": "2.0"}}"#;
+        let e = refused("roof.gltf", gltf.as_bytes(), &ImportConfig::default());
+        assert!(!e.contains("NURBS"), "{e}");
+        let json = r#"{"degree_u": 1, "degree_v": 1, "knots_u": [0, 0, 1, 1],
+            "knots_v": [0, 0, 1, 1],
+            "control_points": [[[0, 0, 0], [0, 2, 0]], [[3, 0, 0], [3, 2, 0.5]]]}"#;
+        let (_, info) =
+            import_design("roof.3dm", json.as_bytes(), &ImportConfig::default()).unwrap();
+        assert_eq!(info.import_as, "surface");
     }
 }

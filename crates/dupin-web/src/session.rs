@@ -342,21 +342,14 @@ impl Session {
                 let params: Vec<(String, f64)> =
                     cfg.params.iter().map(|(k, v)| (k.clone(), *v)).collect();
                 let mut config = PhexConfig::for_surface(surface, &params, method, cfg.size);
-                if let Some(b) = cfg.bound {
-                    config.rule = LayerRule::Ideal { bound: b };
-                }
-                if let Some(l) = cfg.lambda {
-                    config.lambda = l;
-                }
-                if let Some(m) = cfg.mu {
-                    config.mu = m;
-                }
-                config.initialisation = cfg
-                    .init
-                    .as_deref()
-                    .unwrap_or("tangent-duality")
-                    .parse()
-                    .map_err(err)?;
+                crate::import::apply_phex_settings(
+                    &mut config,
+                    cfg.bound,
+                    cfg.lambda,
+                    cfg.mu,
+                    cfg.init.as_deref(),
+                )
+                .map_err(|e| JsError::new(&e))?;
                 let goals = PhexGoals::of(&config, true);
                 Run::Phex(Box::new(PhexPipeline::new(config).map_err(err)?), goals)
             }
@@ -376,7 +369,8 @@ impl Session {
     }
 
     /// Opens a design file: `name` (its extension tells the format), its `bytes` and
-    /// `{ importAs, unit, size, method, mode, fixBoundary }` (all optional). A NURBS surface as
+    /// `{ importAs, unit, size, method, init, bound, lambda, mu, mode, fixBoundary }` (all
+    /// optional; the surface settings are the free mode's). A NURBS surface as
     /// JSON (docs/nurbs-json.md) or a triangle mesh (fitted by a smooth surface) is panelled by
     /// P-Hex; a panel mesh (OBJ, STL, glTF/GLB) is planarised keeping the design. The metrics
     /// then carry `design: { name, importAs, unit, dimensionsM, fitMaxDistanceM }`. Throws an
@@ -540,23 +534,52 @@ impl Session {
     /// The current panels in real units for fabrication files: an opened design in its own
     /// unit; a scene scaled so its mean edge is `panel_edge_m` metres (the page's panel edge).
     fn fabrication_mesh(&self, panel_edge_m: f64) -> Result<(PolyMesh, LengthUnit), JsError> {
-        let mut mesh = self.current_mesh().unwrap_or_default();
-        if let Some(d) = &self.design {
-            return Ok((mesh, d.unit.parse().unwrap_or_default()));
+        let (mut layers, unit) = self.fabrication_layers(panel_edge_m, false)?;
+        Ok((layers.swap_remove(0).1, unit))
+    }
+
+    /// [`Session::fabrication_mesh`] with, when `with_layers`, the offset and support layers
+    /// on show (conical runs), named `panels`, `offset` and `beams` and scaled as the panels.
+    fn fabrication_layers(
+        &self,
+        panel_edge_m: f64,
+        with_layers: bool,
+    ) -> Result<FabricationLayers, JsError> {
+        let mesh = self.current_mesh().unwrap_or_default();
+        let (scale, unit) = match &self.design {
+            Some(d) => (1.0, d.unit.parse().unwrap_or_default()),
+            None => {
+                if !(panel_edge_m.is_finite() && panel_edge_m > 0.0) {
+                    return Err(JsError::new(&format!(
+                        "panel edge must be a positive length in metres, got {panel_edge_m}"
+                    )));
+                }
+                let mean_edge = mesh.mean_edge();
+                let scale = if mean_edge > 0.0 {
+                    panel_edge_m / mean_edge
+                } else {
+                    1.0
+                };
+                (scale, LengthUnit::Metre)
+            }
+        };
+        let extra = match with_layers {
+            true => self.layer_meshes(&mesh)?,
+            false => None,
+        };
+        let mut layers = vec![("panels", mesh)];
+        if let Some((offset, beams, _)) = extra {
+            layers.extend(offset.map(|m| ("offset", m)));
+            layers.extend(beams.map(|m| ("beams", m)));
         }
-        if !(panel_edge_m.is_finite() && panel_edge_m > 0.0) {
-            return Err(JsError::new(&format!(
-                "panel edge must be a positive length in metres, got {panel_edge_m}"
-            )));
-        }
-        let mean_edge = mesh.mean_edge();
-        if mean_edge > 0.0 {
-            let scale = panel_edge_m / mean_edge;
-            for p in &mut mesh.positions {
-                *p *= scale;
+        if scale != 1.0 {
+            for (_, m) in &mut layers {
+                for p in &mut m.positions {
+                    *p *= scale;
+                }
             }
         }
-        Ok((mesh, LengthUnit::Metre))
+        Ok((layers, unit))
     }
 
     /// The cutting file (DXF, `$INSUNITS` millimetres): every panel flattened into its plane
@@ -586,14 +609,44 @@ impl Session {
     /// Rhino). Units as [`Session::export_dxf`].
     #[wasm_bindgen(js_name = exportGlb)]
     pub fn export_glb(&self, panel_edge_m: f64) -> Result<Vec<u8>, JsError> {
-        let (mesh, unit) = self.fabrication_mesh(panel_edge_m)?;
-        Ok(panels_glb(
-            &[GlbLayer {
-                name: "panels",
-                mesh: &mesh,
-            }],
-            unit,
-        ))
+        let (layers, unit) = self.fabrication_layers(panel_edge_m, true)?;
+        let layers: Vec<GlbLayer> = layers
+            .iter()
+            .map(|(name, mesh)| GlbLayer { name, mesh })
+            .collect();
+        Ok(panels_glb(&layers, unit))
+    }
+
+    /// The panels for a .3dm (written in the page by rhino3dm): `{ unit, layers: [{ name,
+    /// positions, faces }] }` with `positions` flat `[x, y, z, ...]` in `unit`, `faces` 0-based
+    /// corner lists, and the layers `panels`, then `offset` and `beams` when they are on show.
+    /// Units as [`Session::export_dxf`].
+    #[wasm_bindgen(js_name = exportPanels)]
+    pub fn export_panels(&self, panel_edge_m: f64) -> Result<JsValue, JsError> {
+        #[derive(Serialize)]
+        struct Layer {
+            name: &'static str,
+            positions: Vec<f64>,
+            faces: Vec<Vec<u32>>,
+        }
+        #[derive(Serialize)]
+        struct Panels {
+            unit: &'static str,
+            layers: Vec<Layer>,
+        }
+        let (layers, unit) = self.fabrication_layers(panel_edge_m, true)?;
+        let panels = Panels {
+            unit: unit.name(),
+            layers: layers
+                .into_iter()
+                .map(|(name, m)| Layer {
+                    name,
+                    positions: m.positions.iter().flat_map(|p| [p.x, p.y, p.z]).collect(),
+                    faces: m.faces().map(<[u32]>::to_vec).collect(),
+                })
+                .collect(),
+        };
+        to_js(&panels)
     }
 
     /// The P-Hex triangulation vertex under a click: `origin` and `direction` (3 numbers each)
@@ -701,6 +754,9 @@ const BEAM_COLOR: [f32; 3] = [0.55, 0.56, 0.60];
 /// An offset layer, a support-structure layer and the beams' segments between each vertex and
 /// its offset (the quads' other edges are the panels' and the offset's).
 type Layers = (Option<PolyMesh>, Option<PolyMesh>, Vec<f32>);
+
+/// Named meshes in one length unit: the panels and the layers on show, for fabrication files.
+type FabricationLayers = (Vec<(&'static str, PolyMesh)>, LengthUnit);
 
 impl Session {
     /// [`Session::mesh`] for Rust callers: `None` is planarity colours.

@@ -459,6 +459,11 @@ impl PhexPipeline {
         Ok(Self::at_start(surface, config, tri, vec![n]))
     }
 
+    /// The configuration the pipeline runs.
+    pub fn config(&self) -> &PhexConfig {
+        &self.config
+    }
+
     /// The surface being meshed.
     pub fn surface(&self) -> &dyn Surface {
         self.surface.as_ref()
