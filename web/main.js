@@ -12,6 +12,7 @@ import { initTeach, showPick } from './teach.js';
 import { initHexd2d } from './hexd2d.js';
 import { initPresent } from './present.js';
 import { read3dm, write3dm } from './rhino.js';
+import { loadDesign, saveDesign } from './design-store.js';
 
 const $ = (id) => document.querySelector(`[data-testid="${id}"]`);
 const statusEl = $('status');
@@ -194,6 +195,8 @@ function applyState(s) {
       rebuildFields();
     }
     if (candidate.field) showFieldError(fieldsBox, candidate.field, '');
+    // An opened design the worker has read is kept for a reload (design-store.js).
+    if (candidate.field === 'import-file' && opened) saveDesign(opened);
     candidate = null;
     running = true;
     showStatus(notice ? `${viewer.backend} · ${notice.text}` : viewer.backend, !!notice?.isError);
@@ -677,6 +680,11 @@ async function main() {
     try { download(`${config.scene}@2x.png`, await snapshotPng(2)); } catch (e) { showStatus(`${viewer.backend} · ${e.message ?? e}`, true); }
   });
   wireInput();
+  // A link or reload of an opened design: the design kept in this browser, if any.
+  if (readHash(location.hash, { scenes: ctx.scenes, catalog: ctx.catalog, torusParams: TORUS }).scene === IMPORTED) {
+    opened = await loadDesign();
+    if (opened) fillScenePicker($('scene-select'), ctx.scenes, opened.name);
+  }
   restore(location.hash);
   requestAnimationFrame(frame);
 }

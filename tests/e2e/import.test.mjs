@@ -115,6 +115,14 @@ test('open a NURBS design, panel it, export; drop a panel mesh and planarise it;
     assert.match(await byId(page, 'status').textContent(), /broken\.json: not a NURBS surface .*line 3/);
     assert.equal((await metrics(page)).faces, m.faces);
     assert.equal(await byId(page, 'scene-select').locator('option[value=imported]').textContent(), 'imported: grid.obj');
+
+    // The design is kept in this browser (IndexedDB): a reload shows it again, as it was read.
+    await page.reload();
+    await page.waitForFunction(() => document.querySelector('[data-testid=scene-select] option[value=imported]')?.textContent === 'imported: grid.obj'
+      && document.querySelector('[data-testid=metrics]').dataset.phase === 'done', null, { timeout: 60_000 });
+    assert.equal(await byId(page, 'scene-select').inputValue(), 'imported');
+    assert.equal((await metrics(page)).faces, m.faces);
+    assert.equal(await byId(page, 'import-fix-boundary').isChecked(), true);
     assert.deepEqual(errors, []);
   } finally {
     await browser.close();
