@@ -74,7 +74,7 @@ function updateButtons() {
   setProp($('step'), 'disabled', !running || done);
   setProp($('play'), 'disabled', !running || done);
   setProp($('reset'), 'disabled', !running);
-  setProp($('stop'), 'disabled', !running || done);
+  setProp($('stop'), 'disabled', !candidate && (!running || done));
   setProp($('play'), 'textContent', playing ? 'Pause' : 'Play');
   for (const id of ['export-json', 'export-svg', 'export-dxf', 'export-csv', 'export-glb', 'export-3dm']) setProp($(id), 'disabled', !running);
 }
@@ -126,6 +126,22 @@ function load(next, { reframe = true, field = null, rebuild = false } = {}) {
   // A .3dm's own unit, unless the user picked one.
   if (file && opened.unit && !cfg.unit) cfg.unit = opened.unit;
   solver.load(cfg, { steps: next.steps, mode: next.color, field, layers: next.layers, file });
+  if (file) watchRead(candidate, opened.name);
+  updateButtons();
+}
+
+/** While the worker reads (and fits) an opened design: after 0.5 s the status counts the
+ * seconds and says that Stop cancels (the read cannot report finer progress from inside one
+ * wasm call; Stop replaces the worker and the previous run comes back). */
+function watchRead(pending, name) {
+  const t0 = performance.now();
+  const tick = () => {
+    if (candidate !== pending) return;
+    const s = (performance.now() - t0) / 1000;
+    if (s >= 0.5) showStatus(`${viewer.backend} · reading ${name}… ${s.toFixed(0)} s (Stop cancels)`);
+    setTimeout(tick, 250);
+  };
+  setTimeout(tick, 500);
 }
 
 /** Opens a design file (file input or drop): shown as `imported: NAME` once the worker has read
@@ -364,6 +380,12 @@ function onFault(message) {
 }
 
 function stop() {
+  if (candidate) {
+    // Cancel a load (a long read or fit): the previous run comes back.
+    if (candidate.field === 'import-file') opened = previousOpened;
+    restartSolver(config.scene === 'torus' ? 'cancelled' : `cancelled; back at step ${config.steps}`, false);
+    return;
+  }
   if (!running || done) return;
   restartSolver(`stopped; back at step ${config.steps}`, false);
 }

@@ -143,3 +143,30 @@ test('a link to an imported design opened without the file says so and the page 
     await browser.close();
   }
 });
+
+test('a long read says how long it has taken and Stop cancels it, back to the previous run', async () => {
+  const { browser, page, errors } = await openPage({ hash: '#scene=sphere-radial' });
+  try {
+    await page.waitForFunction(() => document.querySelector('[data-testid=metrics]').dataset.steps === '1', null, { timeout: 60_000 });
+    const before = await metrics(page);
+    // 320 000 triangles of a smooth bump: the fit takes seconds in the worker.
+    const n = 400;
+    const lines = [];
+    for (let i = 0; i <= n; i++) for (let j = 0; j <= n; j++) lines.push(`v ${i / 20} ${j / 20} ${Math.sin(i / 90) * Math.cos(j / 70)}`);
+    const id = (i, j) => i * (n + 1) + j + 1;
+    for (let i = 0; i < n; i++) for (let j = 0; j < n; j++) lines.push(`f ${id(i, j)} ${id(i + 1, j)} ${id(i + 1, j + 1)}`, `f ${id(i, j)} ${id(i + 1, j + 1)} ${id(i, j + 1)}`);
+    await byId(page, 'import-file').setInputFiles({ name: 'big.obj', mimeType: 'text/plain', buffer: Buffer.from(lines.join('\n')) });
+    await page.waitForFunction(() => document.querySelector('[data-testid=status]').textContent.includes('Stop cancels'), null, { timeout: 60_000 });
+    assert.match(await byId(page, 'status').textContent(), /reading big\.obj… \d+ s/);
+    assert.equal(await byId(page, 'stop').isDisabled(), false);
+    await byId(page, 'stop').click();
+    await page.waitForFunction(() => document.querySelector('[data-testid=status]').textContent.includes('cancelled'), null, { timeout: 60_000 });
+    await page.waitForFunction(() => document.querySelector('[data-testid=metrics]').dataset.steps === '1', null, { timeout: 60_000 });
+    assert.equal((await metrics(page)).faces, before.faces);
+    assert.equal(await byId(page, 'scene-select').inputValue(), 'sphere-radial');
+    assert.equal(await byId(page, 'scene-select').locator('option[value=imported]').count(), 0);
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
