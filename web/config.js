@@ -20,7 +20,7 @@ export function defaults() {
     scene: 'torus',
     params: {},
     // `read`: how the worker read the opened file ({ as, unit }), shown until the user picks.
-    imported: { name: null, as: null, unit: null, method: 'prescribed', init: SCHEMA.initialisations[0].name, size: null, bound: null, lambda: null, mu: null, mode: 'planar', fixBoundary: false, read: null },
+    imported: { name: null, as: null, unit: null, method: 'prescribed', init: SCHEMA.initialisations[0].name, size: null, bound: null, lambda: null, mu: null, mode: 'planar', fixBoundary: false, anchors: [], closeness: null, toleranceMm: null, read: null },
     free: { surface: 'torus', method: SCHEMA.methods[0].name, init: SCHEMA.initialisations[0].name, size: null, bound: null, lambda: null, mu: null },
     steps: 1,
     color: SCHEMA.colorModes[0],
@@ -45,6 +45,11 @@ export function readHash(hash, { scenes, catalog, torusParams }) {
     if (IMPORT_MODES.includes(h.get('mode'))) c.imported.mode = h.get('mode');
     c.imported.fixBoundary = h.get('fix') === '1';
     readRunSettings(h, c.imported);
+    // Anchors as vertex indices `anchors=3.17.40` (dots stay readable in a URL).
+    const anchors = (h.get('anchors') ?? '').split('.').filter((t) => /^\d+$/.test(t)).map(Number);
+    c.imported.anchors = [...new Set(anchors)].slice(0, 100000);
+    if (h.has('closeness')) c.imported.closeness = num(h.get('closeness'));
+    if (h.has('tol')) c.imported.toleranceMm = num(h.get('tol'));
   }
   if (c.scene === 'torus') {
     for (const [k, spec] of Object.entries(torusParams)) c.params[k] = h.has(k) ? num(h.get(k)) : spec.value;
@@ -106,6 +111,9 @@ export function writeHash(c) {
     if (c.imported.mode !== d.imported.mode) h.set('mode', c.imported.mode);
     if (c.imported.fixBoundary) h.set('fix', '1');
     writeRunSettings(h, c.imported, d.imported);
+    if (c.imported.anchors.length) h.set('anchors', c.imported.anchors.join('.'));
+    if (c.imported.closeness !== null) h.set('closeness', String(c.imported.closeness));
+    if (c.imported.toleranceMm !== null) h.set('tol', String(c.imported.toleranceMm));
   }
   if (c.scene !== 'torus') h.set('steps', String(c.steps));
   if (c.color !== d.color) h.set('color', c.color);
@@ -124,6 +132,9 @@ export function sessionConfig(c) {
   if (c.scene === IMPORTED) {
     const i = c.imported;
     const out = { mode: i.mode, fixBoundary: i.fixBoundary, ...runSettings(i) };
+    if (i.anchors.length) out.anchors = i.anchors;
+    if (i.closeness !== null) out.closeness = i.closeness;
+    if (i.toleranceMm !== null) out.toleranceMm = i.toleranceMm;
     if (i.as) out.importAs = i.as;
     if (i.unit) out.unit = i.unit;
     return out;

@@ -40,8 +40,25 @@ function choice(id, choices, value, onPick, title = '') {
   return s;
 }
 
-// One labelled field: a numeric input (optionally with a slider) and its message slot.
-function numberField({ id, label, value, min, max, step = 'any', slider = false, title = '', onCommit }) {
+/** The anchored vertices of a panel mesh: their count, how to set them, and a clear button. */
+function anchorsField(anchors, onClear) {
+  const text = el('span', { textContent: anchors.length ? `${anchors.length} anchored` : 'click a vertex to anchor it' });
+  const clear = el('button', { type: 'button', textContent: 'clear', disabled: anchors.length === 0, title: 'release every anchor' });
+  clear.dataset.testid = 'import-clear-anchors';
+  clear.addEventListener('click', onClear);
+  const msg = el('span', { className: 'field-error' });
+  msg.dataset.testid = 'import-anchors-error';
+  msg.dataset.for = 'import-anchors';
+  const box = el('span', { className: 'field', title: 'anchors stay exactly where the file puts them: click a vertex in the view to add or remove one' },
+    el('span', { className: 'field-label', textContent: 'anchors' }), text, clear, msg);
+  box.dataset.testid = 'import-anchors';
+  box.dataset.anchors = String(anchors.length);
+  return box;
+}
+
+// One labelled field: a numeric input (optionally with a slider, linear or, with `log`, over
+// decades) and its message slot.
+function numberField({ id, label, value, min, max, step = 'any', slider = false, log = false, title = '', onCommit }) {
   const input = el('input', { type: 'number', step, value: value ?? '', title });
   if (min !== undefined) input.min = min;
   if (max !== undefined) input.max = max;
@@ -52,17 +69,24 @@ function numberField({ id, label, value, min, max, step = 'any', slider = false,
   const parts = [el('span', { className: 'field-label', textContent: label })];
   let range = null;
   if (slider && Number.isFinite(min) && Number.isFinite(max)) {
-    range = el('input', { type: 'range', min, max, step: step === 'any' ? (max - min) / 200 : step, value });
+    // A log slider moves the exponent, 100 steps a decade.
+    const [lo, hi] = log ? [Math.log10(min), Math.log10(max)] : [min, max];
+    const toRange = (v) => (log ? Math.log10(v) : v);
+    const fromRange = (r) => (log ? Number((10 ** r).toPrecision(3)) : r);
+    const rangeStep = log ? 0.01 : step === 'any' ? (hi - lo) / 200 : step;
+    range = el('input', { type: 'range', min: lo, max: hi, step: rangeStep, value: toRange(value) });
     range.dataset.testid = `${id}-slider`;
-    range.addEventListener('input', () => { input.value = range.value; });
-    range.addEventListener('change', () => { input.value = range.value; commit(); });
+    range.setAttribute('aria-label', label);
+    range.addEventListener('input', () => { input.value = fromRange(Number(range.value)); });
+    range.addEventListener('change', () => { input.value = fromRange(Number(range.value)); commit(); });
+    range.sync = (v) => { range.value = toRange(v); };
     parts.push(range);
   }
   const commit = () => {
     const text = input.value.trim();
     const v = text === '' ? null : Number(text);
     if (v !== null && !Number.isFinite(v)) { setError(msg, input, `${label} must be a number`); return; }
-    if (range && v !== null) range.value = v;
+    if (range && v !== null && (!log || v > 0)) range.sync(v);
     onCommit(v, id);
   };
   input.addEventListener('change', commit);
@@ -123,6 +147,17 @@ export function buildFields(box, c, { catalog, torusParams, defaults, onChange }
           (v) => onChange((n) => { n.imported.mode = v; }, 'import-mode'), 'planarisation mode of a panel mesh')),
         checkbox('import-fix-boundary', 'fix boundary', i.fixBoundary, 'keep every boundary vertex exactly where the file puts it',
           (v) => onChange((n) => { n.imported.fixBoundary = v; }, 'import-fix-boundary')),
+        numberField({
+          id: 'import-closeness', label: 'closeness', value: i.closeness ?? 0.01, min: 1e-4, max: 1e3, slider: true, log: true,
+          title: 'how strongly the vertices stay near the design (default 0.01; larger keeps them nearer, at more iterations)',
+          onCommit: (v, id) => onChange((n) => { n.imported.closeness = v; }, id),
+        }),
+        numberField({
+          id: 'import-tolerance-mm', label: 'tolerance mm', value: i.toleranceMm ?? '', min: 0,
+          title: 'the largest distance of a panel corner from its plane, in mm (empty: planar to rounding, 1e-11 of an edge)',
+          onCommit: (v, id) => onChange((n) => { n.imported.toleranceMm = v; }, id),
+        }),
+        anchorsField(i.anchors, () => onChange((n) => { n.imported.anchors = []; }, 'import-anchors', true)),
       );
     }
     return;

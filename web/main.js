@@ -477,16 +477,37 @@ function cameraMoved() {
 // ---- picking a vertex for the teaching inset: a click (no drag) on the 3D view --------------
 // JS only turns the click into normalised device coordinates; the view ray (Viewer.pickRay) and
 // the vertex and its star (Session.pickVertex, in the worker) are computed in Rust.
+// On an opened panel mesh a click anchors (or releases) the vertex under it instead.
 function pickAt(x, y) {
-  if (!running) { showPick(null, 'Vertex picking needs a P-Hex scene or free configuration (load one, then click the mesh).'); return; }
+  const panels = config.scene === IMPORTED && (config.imported.as ?? config.imported.read?.as) === 'panels';
+  if (!running) {
+    if (!panels) showPick(null, 'Vertex picking needs a P-Hex scene or free configuration (load one, then click the mesh).');
+    return;
+  }
   const nx = (x / canvas.clientWidth) * 2 - 1, ny = 1 - (y / canvas.clientHeight) * 2;
   try {
     const r = viewer.pickRay(nx, ny);
-    solver.post('pick', { origin: Array.from(r.slice(0, 3)), direction: Array.from(r.slice(3, 6)) });
-  } catch (e) { showPick(null, e.message ?? String(e)); }
+    solver.post('pick', { origin: Array.from(r.slice(0, 3)), direction: Array.from(r.slice(3, 6)), panels });
+  } catch (e) {
+    if (panels) reportError(e.message ?? String(e), 'import-anchors');
+    else showPick(null, e.message ?? String(e));
+  }
 }
 
 function onPick(m) {
+  if (m.panels) {
+    if (m.error) { reportError(m.error, 'import-anchors'); return; }
+    if (!m.pick) return; // a click beside the mesh
+    const next = structuredClone(config);
+    const a = next.imported.anchors;
+    const k = a.indexOf(m.pick.vertex);
+    if (k >= 0) a.splice(k, 1); else a.push(m.pick.vertex);
+    a.sort((x, y) => x - y);
+    next.steps = 1;
+    // The run restarts with the new anchors; fields show the count once it is accepted.
+    load(next, { reframe: false, field: 'import-anchors', rebuild: true });
+    return;
+  }
   const pick = showPick(m.pick, m.error);
   setMarker(pick ? pick.point : null);
 }

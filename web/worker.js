@@ -3,11 +3,11 @@
 // ones are dropped on both sides):
 //   in:  load {config, steps, mode, layers, file?} (file {name, bytes}: Session.fromFile) | step | play | pause | ack | mode {mode}
 //        | layers {layers} (offset/support, Session.setLayers) | export {kind, panelEdge} (obj, json, svg, dxf, csv, glb, 3dm)
-//        | pick {origin, direction} (a view ray)
+//        | pick {origin, direction, panels} (a view ray; panels: Session.pickPanelVertex)
 //        | fault {kind} (debugFault: a deliberate trap or out-of-memory, for recovery tests)
 //   out: ready | state {metrics, steps, done, mesh: typed arrays (transferred), layers:
 //        {unavailable, info}} | error {message, field}
-//        | export {kind, text} | pick {pick | error} (Session.pickVertex's answer)
+//        | export {kind, text} | pick {panels, pick | error} (Session.pickVertex's or pickPanelVertex's answer)
 //        error {fatal: true} after a wasm trap: the module is unusable and the page restarts us
 import init, { Session, debugFault } from './pkg/dupin_web.js';
 
@@ -133,7 +133,9 @@ const handlers = {
   pick(msg) {
     if (!session) return;
     try {
-      postMessage({ type: 'pick', gen, pick: session.pickVertex(msg.origin, msg.direction) });
+      // A panel mesh picks its design vertices (anchors); P-Hex its triangulation's stars.
+      const pick = msg.panels ? session.pickPanelVertex(msg.origin, msg.direction) : session.pickVertex(msg.origin, msg.direction);
+      postMessage({ type: 'pick', gen, panels: !!msg.panels, pick });
     } catch (e) { postMessage({ type: 'pick', gen, error: e?.message ?? String(e) }); }
   },
   export(msg) {

@@ -170,3 +170,51 @@ test('a long read says how long it has taken and Stop cancels it, back to the pr
     await browser.close();
   }
 });
+
+test('panels: a click anchors a vertex, which stays exactly where the file puts it; closeness and a tolerance in mm', async () => {
+  const { browser, page, errors } = await openPage();
+  try {
+    const text = noisyGridObj();
+    const original = text.split('\n').filter((l) => l.startsWith('v ')).map((l) => l.split(' ').slice(1).map(Number));
+    await byId(page, 'import-file').setInputFiles({ name: 'grid.obj', mimeType: 'text/plain', buffer: Buffer.from(text) });
+    await page.waitForFunction(() => document.querySelector('[data-testid=status]').textContent.includes('grid.obj · panels'), null, { timeout: 60_000 });
+    assert.equal(await byId(page, 'import-anchors').getAttribute('data-anchors'), '0');
+    // Click vertex 60 (the middle of the grid) where the view draws it.
+    const at = await page.evaluate(([x, y, z]) => {
+      const q = window.dupin.viewer.project(x, y, z);
+      const r = document.querySelector('[data-testid=canvas]').getBoundingClientRect();
+      return { x: r.left + (q[0] + 1) / 2 * r.width, y: r.top + (1 - q[1]) / 2 * r.height };
+    }, original[60]);
+    await page.mouse.click(at.x, at.y);
+    await page.waitForFunction(() => document.querySelector('[data-testid=import-anchors]')?.dataset.anchors === '1'
+      && /anchors=60(&|$)/.test(location.hash), null, { timeout: 60_000 });
+    await play(page);
+    let m = await metrics(page);
+    assert.equal(m.phase, 'done', await byId(page, 'status').textContent());
+    const out = (await exportText(page, 'export-obj')).split('\n').filter((l) => l.startsWith('v ')).map((l) => l.split(/\s+/).slice(1).map(Number));
+    assert.deepEqual(out[60], original[60]);
+    assert.ok(out.some((p, i) => p[2] !== original[i][2]), 'the other vertices moved');
+
+    // A tolerance of 0.5 mm and a closeness of 10 (typed; the slider follows on a log scale).
+    await byId(page, 'import-tolerance-mm').fill('0.5');
+    await byId(page, 'import-tolerance-mm').press('Enter');
+    await page.waitForFunction(() => /tol=0\.5/.test(location.hash), null, { timeout: 60_000 });
+    await byId(page, 'import-closeness').fill('10');
+    await byId(page, 'import-closeness').press('Enter');
+    await page.waitForFunction(() => /closeness=10/.test(location.hash), null, { timeout: 60_000 });
+    assert.equal(Number(await byId(page, 'import-closeness-slider').inputValue()), 1);
+    await play(page);
+    m = await metrics(page);
+    assert.equal(m.phase, 'done', await byId(page, 'status').textContent());
+    // 0.5 mm on 2 m panels: planarity at most 2.5e-4 (the contract measure).
+    assert.ok(Number(m.maxPlanarity) <= 0.5 / 2000, m.maxPlanarity);
+    assert.match(page.url(), /anchors=60/);
+
+    await byId(page, 'import-clear-anchors').click();
+    await page.waitForFunction(() => document.querySelector('[data-testid=import-anchors]')?.dataset.anchors === '0'
+      && !/anchors=/.test(location.hash), null, { timeout: 60_000 });
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});

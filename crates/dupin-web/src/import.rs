@@ -39,6 +39,12 @@ struct ImportConfig {
     mode: Option<String>,
     /// Panels: keep the boundary vertices where they are.
     fix_boundary: Option<bool>,
+    /// Panels: vertices (0-based, in the file's order) that must not move.
+    anchors: Option<Vec<usize>>,
+    /// Panels: the closeness weight (how strongly the vertices stay near the design).
+    closeness: Option<f64>,
+    /// Panels: the largest distance of a panel corner from its plane, in millimetres.
+    tolerance_mm: Option<f64>,
 }
 
 /// The keys of [`ImportConfig`] as JS spells them, for the unknown-key check.
@@ -53,6 +59,9 @@ pub(crate) const IMPORT_CONFIG_KEYS: &[&str] = &[
     "mu",
     "mode",
     "fixBoundary",
+    "anchors",
+    "closeness",
+    "toleranceMm",
 ];
 
 /// The free mode's P-Hex run settings, shared by a library surface and an opened one: the
@@ -99,6 +108,9 @@ pub(crate) struct DesignInfo {
     /// from (the planarisation keeps the vertex order).
     #[serde(skip)]
     pub(crate) positions: Option<Vec<dupin_core::Vec3>>,
+    /// The anchored vertices of a panel mesh (drawn with the panels).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub(crate) anchors: Vec<usize>,
 }
 
 impl DesignInfo {
@@ -227,6 +239,10 @@ fn import_design(
             (None, Some(m)) => Some(m.positions.clone()),
             _ => None,
         },
+        anchors: match surface {
+            None => cfg.anchors.clone().unwrap_or_default(),
+            Some(_) => Vec::new(),
+        },
     };
     let run = match (surface, mesh) {
         (Some(surface), _) => {
@@ -247,7 +263,7 @@ fn import_design(
             let pipeline = PhexPipeline::new(config).map_err(|e| named(&e))?;
             Imported::Phex(Box::new(pipeline), goals)
         }
-        (None, Some(mesh)) => panels_run(&mesh, cfg).map_err(|e| named(&e))?,
+        (None, Some(mesh)) => panels_run(&mesh, cfg, unit).map_err(|e| named(&e))?,
         (None, None) => unreachable!("a file gives a surface or a mesh"),
     };
     Ok((run, info))
@@ -255,23 +271,70 @@ fn import_design(
 
 /// The planarisation of an opened panel mesh, stepped like a PQ scene with no subdivision: the
 /// design kept (fairness on the move, `keep_design`), as `dupin planarize` does.
-fn panels_run(mesh: &PolyMesh, cfg: &ImportConfig) -> Result<Imported, String> {
+fn panels_run(mesh: &PolyMesh, cfg: &ImportConfig, unit: LengthUnit) -> Result<Imported, String> {
     let mode: PqMode = cfg
         .mode
         .as_deref()
         .unwrap_or("planar")
         .parse()
         .map_err(|e| format!("{e}"))?;
-    let options = PqOptions {
+    let mut options = PqOptions {
         mode,
         keep_design: true,
         fix_boundary: cfg.fix_boundary.unwrap_or(false),
         max_factor_bytes: PAGE_MAX_FACTOR_BYTES,
         ..PqOptions::default()
     };
+    if let Some(anchors) = &cfg.anchors {
+        if let Some(&bad) = anchors.iter().find(|&&a| a >= mesh.num_vertices()) {
+            return Err(format!(
+                "anchor {bad} is not a vertex (the mesh has {} vertices)",
+                mesh.num_vertices()
+            ));
+        }
+        options.fixed_vertices = anchors.clone();
+    }
+    if let Some(w) = cfg.closeness {
+        if !(w.is_finite() && w >= 0.0) {
+            return Err(format!("closeness must be a number >= 0, got {w}"));
+        }
+        options.closeness = w;
+    }
+    if let Some(t) = cfg.tolerance_mm {
+        options.tolerance = relative_tolerance(mesh, t, unit)?;
+    }
     let stepper = PqSceneStepper::for_mesh(mesh, MeshRule::CatmullClark, 0, options)
         .map_err(|e| format!("{e}"))?;
     Ok(Imported::Panels(Box::new(stepper)))
+}
+
+/// The planarisation tolerance (contract planarity: a face's corner distance over its mean
+/// edge) that keeps every corner within `mm` millimetres of its face's plane: `mm` over the
+/// largest face's mean edge in mm, so the bound holds for every face. Never looser than 1e-3
+/// (a millimetre on a metre is not planar) nor tighter than 1e-13 (rounding).
+fn relative_tolerance(mesh: &PolyMesh, mm: f64, unit: LengthUnit) -> Result<f64, String> {
+    if !(mm.is_finite() && mm > 0.0) {
+        return Err(format!(
+            "tolerance must be a positive length in mm, got {mm}"
+        ));
+    }
+    let largest = mesh
+        .faces()
+        .map(|f| {
+            let n = f.len();
+            (0..n)
+                .map(|i| {
+                    (mesh.positions[f[(i + 1) % n] as usize] - mesh.positions[f[i] as usize]).norm()
+                })
+                .sum::<f64>()
+                / n as f64
+        })
+        .fold(0.0f64, f64::max)
+        * unit.to_mm();
+    if largest <= 0.0 {
+        return Err("the panels have no edge length to measure a tolerance on".into());
+    }
+    Ok((mm / largest).clamp(1e-13, 1e-3))
 }
 
 /// Extent of points along x, y and z.
@@ -445,5 +508,90 @@ mod tests {
         let (_, info) =
             import_design("roof.3dm", json.as_bytes(), &ImportConfig::default()).unwrap();
         assert_eq!(info.import_as, "surface");
+    }
+
+    /// The acceptance: an opened 10 000-quad panel mesh with 20 anchors ends with the
+    /// anchors exactly where the file put them and max planarity <= 1e-10.
+    #[test]
+    fn twenty_anchors_of_ten_thousand_quads_stay_exactly() {
+        let text = grid_obj(100, false);
+        let anchors: Vec<usize> = (0..20).map(|k| (k * 509) % (101 * 101)).collect();
+        let cfg = ImportConfig {
+            anchors: Some(anchors.clone()),
+            ..ImportConfig::default()
+        };
+        let (mut run, info) = import_design("grid.obj", text.as_bytes(), &cfg).unwrap();
+        assert_eq!(info.anchors, anchors);
+        let design = info.positions.clone().unwrap();
+        let (planarity, _) = run_to_end(&mut run);
+        assert!(planarity <= 1e-10, "{planarity}");
+        let Imported::Panels(stepper) = &run else {
+            panic!("a panels run")
+        };
+        let mesh = stepper.mesh();
+        assert_eq!(mesh.num_faces(), 10_000);
+        for &a in &anchors {
+            assert_eq!(mesh.positions[a], design[a], "anchor {a} moved");
+        }
+        // Not a test that cannot fail: the other vertices did move.
+        assert!(info.deviation_mm(mesh).unwrap()[0] > 0.0);
+
+        let bad = ImportConfig {
+            anchors: Some(vec![101 * 101]),
+            ..ImportConfig::default()
+        };
+        let e = refused("grid.obj", text.as_bytes(), &bad);
+        assert!(e.contains("anchor 10201 is not a vertex"), "{e}");
+    }
+
+    /// A tolerance in millimetres bounds every corner's distance from its panel's plane, in the
+    /// file's unit; a negative closeness is refused.
+    #[test]
+    fn a_tolerance_in_mm_bounds_every_corner_and_bad_weights_are_refused() {
+        let text = grid_obj(6, false);
+        for (unit, mm) in [("m", 0.5), ("cm", 0.05)] {
+            let cfg = ImportConfig {
+                unit: Some(unit.into()),
+                tolerance_mm: Some(mm),
+                closeness: Some(5.0),
+                ..ImportConfig::default()
+            };
+            let (mut run, _) = import_design("grid.obj", text.as_bytes(), &cfg).unwrap();
+            run_to_end(&mut run);
+            let Imported::Panels(stepper) = &run else {
+                panic!("a panels run")
+            };
+            let mesh = stepper.mesh();
+            let to_mm = unit.parse::<LengthUnit>().unwrap().to_mm();
+            let worst = dupin_core::mesh::face_planarities(mesh)
+                .iter()
+                .zip(mesh.faces())
+                .map(|(p, f)| {
+                    let n = f.len();
+                    let edge = (0..n)
+                        .map(|i| {
+                            (mesh.positions[f[(i + 1) % n] as usize]
+                                - mesh.positions[f[i] as usize])
+                                .norm()
+                        })
+                        .sum::<f64>()
+                        / n as f64;
+                    p * edge * to_mm
+                })
+                .fold(0.0f64, f64::max);
+            assert!(worst <= mm, "{unit}: {worst} mm");
+        }
+        for bad in [0.0, -1.0, f64::NAN] {
+            let cfg = ImportConfig {
+                tolerance_mm: Some(bad),
+                ..ImportConfig::default()
+            };
+            assert!(refused("grid.obj", text.as_bytes(), &cfg).contains("tolerance"));
+        }
+        let cfg = ImportConfig {
+            closeness: Some(-1.0),
+            ..ImportConfig::default()
+        };
+        assert!(refused("grid.obj", text.as_bytes(), &cfg).contains("closeness"));
     }
 }

@@ -672,6 +672,50 @@ impl Session {
         }
     }
 
+    /// The panel-mesh vertex under a click, for anchoring: `origin` and `direction` (3 numbers
+    /// each) are the view ray (`Viewer.pickRay`). Returns `null` on a miss, else `{ vertex,
+    /// point }` (the corner of the panel hit first that is nearest the hit point, 0-based in
+    /// the file's order). Throws for a P-Hex run (its vertices are the solver's, not the
+    /// design's) or a malformed ray.
+    #[wasm_bindgen(js_name = pickPanelVertex)]
+    pub fn pick_panel_vertex(
+        &self,
+        origin: Vec<f64>,
+        direction: Vec<f64>,
+    ) -> Result<JsValue, JsError> {
+        let Run::Pq { .. } = &self.run else {
+            return Err(JsError::new(
+                "anchors are for a panel mesh: a P-Hex surface has no design vertices to hold",
+            ));
+        };
+        if origin.len() != 3 || direction.len() != 3 {
+            return Err(JsError::new("a ray needs 3 origin and 3 direction numbers"));
+        }
+        let m = self.current_mesh().unwrap_or_default();
+        // Each panel as a fan of triangles from its first corner: a pick needs only the
+        // panel's surface, not a good triangulation.
+        let triangles: Vec<[u32; 3]> = m
+            .faces()
+            .flat_map(|f| (1..f.len().saturating_sub(1)).map(move |i| [f[0], f[i], f[i + 1]]))
+            .collect();
+        let v = |a: &[f64]| dupin_core::Vec3::new(a[0], a[1], a[2]);
+        let Some(pick) =
+            dupin_core::mesh::pick_vertex(&m.positions, &triangles, v(&origin), v(&direction))
+        else {
+            return Ok(JsValue::NULL);
+        };
+        #[derive(Serialize)]
+        struct PanelPick {
+            vertex: usize,
+            point: [f64; 3],
+        }
+        let p = m.positions[pick.vertex];
+        to_js(&PanelPick {
+            vertex: pick.vertex,
+            point: [p.x, p.y, p.z],
+        })
+    }
+
     /// The current mesh for the viewer: flat panels coloured by `mode` (`planarity`: blue
     /// planar, through white, to red at 1e-2 and above, log scale; `convexity`; `regularity`:
     /// the P-Hex paper's section 4.2 deviation from the affine (quasi-)regular hexagon) and
@@ -751,6 +795,24 @@ fn parse_layers(l: LayerConfig, unavailable: Option<&str>) -> Result<LayerConfig
 const OFFSET_COLOR: [f32; 3] = [0.80, 0.62, 0.30];
 const BEAM_COLOR: [f32; 3] = [0.55, 0.56, 0.60];
 
+/// Three crossed segments (a third of the mean edge each way) at every anchored vertex, drawn
+/// with the panel edges.
+fn anchor_crosses(mesh: &PolyMesh, anchors: &[usize]) -> Vec<f32> {
+    let r = mesh.mean_edge() / 3.0;
+    anchors
+        .iter()
+        .filter_map(|&a| mesh.positions.get(a))
+        .flat_map(|p| {
+            (0..3).flat_map(move |k| {
+                let mut d = dupin_core::Vec3::zeros();
+                d[k] = r;
+                let (a, b) = (p - d, p + d);
+                [a.x, a.y, a.z, b.x, b.y, b.z].map(|x| x as f32)
+            })
+        })
+        .collect()
+}
+
 /// An offset layer, a support-structure layer and the beams' segments between each vertex and
 /// its offset (the quads' other edges are the panels' and the offset's).
 type Layers = (Option<PolyMesh>, Option<PolyMesh>, Vec<f32>);
@@ -794,6 +856,9 @@ impl Session {
             }
         };
         let mut data = MeshData::panels(m.clone(), &colors);
+        if let Some(design) = &self.design {
+            data.add_lines(&anchor_crosses(&m, &design.anchors));
+        }
         if let Some((offset, beams, segments)) = self.layer_meshes(&m)? {
             if let Some(offset) = offset {
                 data.add_layer(&offset, OFFSET_COLOR, true);
