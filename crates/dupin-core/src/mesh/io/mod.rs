@@ -97,6 +97,10 @@ pub struct ImportOptions {
     pub max_triangles: usize,
 }
 
+/// The most bytes a glTF is taken to spend on a triangle (see
+/// [`ImportOptions::check_gltf_bytes`]).
+const GLTF_BYTES_PER_TRIANGLE: usize = 160;
+
 /// The default import limit: 5 million triangles (about 150 MB as a [`PolyMesh`]), what a
 /// browser tab holds with room for the computation.
 pub const MAX_IMPORT_TRIANGLES: usize = 5_000_000;
@@ -126,9 +130,28 @@ impl ImportOptions {
         Ok(())
     }
 
-    /// A file of `len` bytes holds at most one triangle per 12 bytes in any format read here.
-    pub(crate) fn check_bytes(&self, len: usize) -> Result<(), ImportError> {
-        self.check_triangles(len / 12)
+    /// A glTF of `len` bytes: refused unread when, past 64 KiB of JSON and headers, even at 160
+    /// bytes a triangle (unindexed corners with position, normal, UV and colour: 3 x 48 bytes)
+    /// it would hold more triangles than the limit. The accessors' counts are checked again as
+    /// they are read.
+    pub(crate) fn check_gltf_bytes(&self, len: usize) -> Result<(), ImportError> {
+        self.check_triangles(len.saturating_sub(1 << 16) / GLTF_BYTES_PER_TRIANGLE)
+    }
+
+    /// An OBJ text: its `f` and `v` lines counted (a byte scan, no parsing) and checked before
+    /// it is parsed, so a huge file is refused before its mesh is built. Every face counts as
+    /// one; vertices may number at most three per allowed face.
+    pub(crate) fn check_obj_text(&self, text: &[u8]) -> Result<(), ImportError> {
+        let (mut faces, mut vertices) = (0usize, 0usize);
+        for line in text.split(|&b| b == b'\n' || b == b'\r') {
+            let line = line.trim_ascii_start();
+            match line {
+                [b'f', b' ' | b'\t', ..] => faces += 1,
+                [b'v', b' ' | b'\t', ..] => vertices += 1,
+                _ => {}
+            }
+        }
+        self.check_triangles(faces.max(vertices.div_ceil(3)))
     }
 }
 
@@ -191,7 +214,7 @@ pub fn read_mesh(
         .ok_or_else(|| ImportError::UnknownFormat { name: quoted(name) })?;
     let (mesh, dropped_triangles) = match format {
         MeshFormat::Obj => {
-            options.check_bytes(bytes.len())?;
+            options.check_obj_text(bytes)?;
             let text = std::str::from_utf8(bytes).map_err(|e| ImportError::Syntax {
                 format: "OBJ",
                 message: format!(
@@ -242,5 +265,53 @@ mod tests {
         );
         let e = read_mesh("bin.obj", b"v 0 0 0\n\xff\xfe", &ImportOptions::default());
         assert!(e.unwrap_err().to_string().contains("byte 8 is not UTF-8"));
+    }
+
+    /// The limit counts faces, not bytes: long lines, comments and flat-shaded glTF corners
+    /// do not make a file within the limit look too large, and a file over it is refused
+    /// before its mesh is built.
+    #[test]
+    fn the_triangle_limit_counts_faces_not_bytes() {
+        let limited = ImportOptions::default().with_max_triangles(8);
+        let mut obj = String::from("# a long header\n").repeat(50);
+        for k in 0..9 {
+            obj += &format!("v {k}.000000000000001 0.000000000000001 {}.5\n", k % 2);
+        }
+        for k in 1..=7 {
+            obj += &format!("f {k} {} {}\n", k + 1, k + 2);
+        }
+        assert!(obj.len() / 12 > 8, "the old byte bound would refuse it");
+        let read = read_mesh("long.obj", obj.as_bytes(), &limited).unwrap();
+        assert_eq!(read.mesh.num_faces(), 7);
+        let over = obj.clone() + "f 1 3 5\nf 2 4 6\n";
+        let e = read_mesh("over.obj", over.as_bytes(), &limited).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                ImportError::TooLarge {
+                    triangles: 9,
+                    limit: 8
+                }
+            ),
+            "{e}"
+        );
+
+        let glb = crate::fabrication::panels_glb(
+            &[crate::fabrication::GlbLayer {
+                name: "panels",
+                mesh: &read.mesh,
+            }],
+            crate::fabrication::LengthUnit::Metre,
+        );
+        assert!(glb.len() / 12 > 8, "the old byte bound would refuse it");
+        assert_eq!(
+            read_mesh("p.glb", &glb, &limited).unwrap().mesh.num_faces(),
+            7
+        );
+        let tight = ImportOptions::default().with_max_triangles(6);
+        assert!(matches!(
+            read_mesh("p.glb", &glb, &tight),
+            Err(ImportError::TooLarge { .. })
+        ));
     }
 }
