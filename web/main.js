@@ -266,7 +266,9 @@ function uploadMesh() {
   meshNext = null;
   meshAt = performance.now();
   try {
-    showMesh(MeshData.fromArrays(a.positions, a.normals, a.indices, a.colors, a.edges), reframe);
+    const m = MeshData.fromArrays(a.positions, a.normals, a.indices, a.colors, a.edges);
+    m.setPanels(a.panelPositions, a.panelFaces);
+    showMesh(m, reframe);
   } catch (e) {
     showStatus(`${viewer.backend} · ${e.message ?? e}`, true);
   }

@@ -27,7 +27,8 @@ function applyLayers() {
 
 function meshMessage() {
   const m = session.mesh(mode);
-  const mesh = { positions: m.positions, normals: m.normals, indices: m.indices, colors: m.colors, edges: m.edges };
+  // The polygons travel too: presentation mode and OBJ need the panels, not their triangles.
+  const mesh = { positions: m.positions, normals: m.normals, indices: m.indices, colors: m.colors, edges: m.edges, panelPositions: m.panelPositions, panelFaces: m.panelFaces };
   m.free();
   return mesh;
 }
@@ -40,7 +41,7 @@ function send() {
   if (lastMetrics?.timing) lastMetrics.timing.mesh = t1 - t0;
   const layerState = { unavailable: session.offsetUnavailable() ?? null, info: session.layerInfo() };
   postMessage({ type: 'state', gen, metrics: lastMetrics, steps, done, playing: playing && !done, mesh, layers: layerState },
-    [mesh.positions.buffer, mesh.normals.buffer, mesh.indices.buffer, mesh.colors.buffer, mesh.edges.buffer]);
+    [mesh.positions.buffer, mesh.normals.buffer, mesh.indices.buffer, mesh.colors.buffer, mesh.edges.buffer, mesh.panelPositions.buffer, mesh.panelFaces.buffer]);
   // Posting (structured clone of the metrics; the typed arrays are transferred) is timed for
   // the step log of the next state.
   postMs = performance.now() - t1;

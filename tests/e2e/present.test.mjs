@@ -5,7 +5,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { writeFileSync } from 'node:fs';
-import { SHOTS, byId, openPage, pixelStats } from './harness.mjs';
+import { SHOTS, byId, exportText, openPage, pixelStats } from './harness.mjs';
 
 async function presentShot(page, name, scale = 1) {
   await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
@@ -93,3 +93,24 @@ for (const [backend, webgpu] of [['WebGPU', true], ['WebGL2', false]]) {
     }
   });
 }
+
+test('presentation frames panels, not triangles: counts are panels and beams follow panel edges', async () => {
+  const { browser, page, errors } = await openPage({ hash: '#scene=pq-catmull-clark' });
+  try {
+    await page.waitForFunction(() => document.querySelector('[data-testid=metrics]').dataset.steps === '1', null, { timeout: 60_000 });
+    await byId(page, 'play').click();
+    await page.waitForFunction(() => document.querySelector('[data-testid=metrics]').dataset.phase === 'done', null, { timeout: 120_000 });
+    const obj = await exportText(page, 'export-obj');
+    const faces = obj.split('\n').filter((l) => l.startsWith('f ')).map((l) => l.split(/\s+/).slice(1).map(Number));
+    const edges = new Set();
+    for (const f of faces) f.forEach((v, i) => { const w = f[(i + 1) % f.length]; edges.add(v < w ? `${v},${w}` : `${w},${v}`); });
+    await byId(page, 'present').click();
+    const status = byId(page, 'present-status');
+    await page.waitForFunction(() => document.querySelector('[data-testid="present-status"]').dataset.rendered === 'true', null, { timeout: 60_000 });
+    assert.equal(Number(await status.getAttribute('data-panels')), faces.length);
+    assert.match(await status.textContent(), new RegExp(`${faces.length} panels · ${edges.size} beams`));
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});

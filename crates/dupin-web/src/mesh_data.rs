@@ -18,6 +18,9 @@ pub struct MeshData {
     pub(crate) edges: Vec<f32>,
     /// The polygon mesh behind the triangles, when there is one (OBJ export keeps its faces).
     pub(crate) panels: Option<PolyMesh>,
+    /// The polygon mesh as handed over by a worker (`setPanels`): built into a [`PolyMesh`]
+    /// only when asked for (presentation, OBJ), not on every frame's update.
+    pub(crate) panel_arrays: Option<(Vec<f64>, Vec<u32>)>,
 }
 
 impl MeshData {
@@ -28,6 +31,7 @@ impl MeshData {
             colors: Vec::new(),
             edges: Vec::new(),
             panels: None,
+            panel_arrays: None,
         }
     }
 
@@ -39,6 +43,7 @@ impl MeshData {
             colors,
             edges: polymesh_edges(&mesh),
             panels: Some(mesh),
+            panel_arrays: None,
         }
     }
 
@@ -111,7 +116,31 @@ impl MeshData {
             colors,
             edges,
             panels: None,
+            panel_arrays: None,
         })
+    }
+
+    /// The polygons behind the triangles as `panelPositions` (x y z a vertex, f64) and
+    /// `panelFaces` (per face its corner count, then its corners); empty for a smooth surface.
+    #[wasm_bindgen(getter, js_name = panelPositions)]
+    pub fn panel_positions(&self) -> js_sys::Float64Array {
+        let (flat, _) = self.panels.as_ref().map(panel_arrays).unwrap_or_default();
+        js_sys::Float64Array::from(flat.as_slice())
+    }
+
+    /// See [`MeshData::panel_positions`].
+    #[wasm_bindgen(getter, js_name = panelFaces)]
+    pub fn panel_faces(&self) -> js_sys::Uint32Array {
+        let (_, flat) = self.panels.as_ref().map(panel_arrays).unwrap_or_default();
+        js_sys::Uint32Array::from(flat.as_slice())
+    }
+
+    /// Attaches the polygons of `panelPositions`/`panelFaces` (a worker's mesh rebuilt with
+    /// `fromArrays`), so that presentation and OBJ keep the true panels. Checked when used.
+    #[wasm_bindgen(js_name = setPanels)]
+    pub fn set_panels(&mut self, positions: Vec<f64>, faces: Vec<u32>) {
+        self.panels = None;
+        self.panel_arrays = (!faces.is_empty()).then_some((positions, faces));
     }
 
     /// Vertex positions, x y z per vertex.
@@ -169,6 +198,9 @@ impl MeshData {
         if let Some(mesh) = &self.panels {
             return Ok(mesh.clone());
         }
+        if let Some((positions, faces)) = &self.panel_arrays {
+            return panels_from_arrays(positions, faces).map_err(|e| JsError::new(&e));
+        }
         let positions = self
             .buffers
             .positions
@@ -177,6 +209,46 @@ impl MeshData {
             .collect();
         PolyMesh::new(positions, self.buffers.indices.chunks_exact(3)).map_err(crate::js::err)
     }
+}
+
+/// `mesh` as the `panelPositions`/`panelFaces` arrays (see [`MeshData::panel_faces`]).
+fn panel_arrays(mesh: &PolyMesh) -> (Vec<f64>, Vec<u32>) {
+    let positions = mesh
+        .positions
+        .iter()
+        .flat_map(|p| [p.x, p.y, p.z])
+        .collect();
+    let faces = mesh
+        .faces()
+        .flat_map(|f| std::iter::once(f.len() as u32).chain(f.iter().copied()))
+        .collect();
+    (positions, faces)
+}
+
+/// A polygon mesh from `panelPositions`/`panelFaces` arrays (see [`MeshData::panel_faces`]).
+fn panels_from_arrays(positions: &[f64], faces: &[u32]) -> Result<PolyMesh, String> {
+    let bad = || {
+        "panel arrays: positions need 3 numbers a vertex, faces a count then that many corners"
+            .to_string()
+    };
+    if !positions.len().is_multiple_of(3) {
+        return Err(bad());
+    }
+    let points: Vec<Vec3> = positions
+        .chunks_exact(3)
+        .map(|p| Vec3::new(p[0], p[1], p[2]))
+        .collect();
+    let mut polygons: Vec<&[u32]> = Vec::new();
+    let mut rest = faces;
+    while let Some((&n, tail)) = rest.split_first() {
+        let n = n as usize;
+        if n < 3 || n > tail.len() {
+            return Err(bad());
+        }
+        polygons.push(&tail[..n]);
+        rest = &tail[n..];
+    }
+    PolyMesh::new(points, polygons).map_err(|e| e.to_string())
 }
 
 /// Samples the torus ((R + r cos v) cos u, (R + r cos v) sin u, r sin v) on a `nu` x `nv` grid.
@@ -200,4 +272,27 @@ pub fn torus_mesh(major: f64, minor: f64, nu: u32, nv: u32) -> Result<MeshData, 
     }
     let buffers = sample_surface(&Torus { major, minor }, nu as usize, nv as usize);
     Ok(MeshData::smooth(buffers))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A worker's panels survive the trip through typed arrays polygon for polygon, and bad
+    /// arrays are refused.
+    #[test]
+    fn panels_travel_as_arrays() {
+        let m = dupin_core::scenes::benchmark_meshes::torus_centroid_dual(12, 6, 2.0, 0.7);
+        let colors = vec![[1.0f32; 3]; m.num_faces()];
+        let data = MeshData::panels(m.clone(), &colors);
+        let (p, f) = panel_arrays(data.panels.as_ref().unwrap());
+        let mut rebuilt = MeshData::smooth(data.buffers.clone());
+        rebuilt.set_panels(p.clone(), f.clone());
+        let back = rebuilt.to_polymesh().unwrap();
+        assert_eq!(back, m);
+        for bad in [vec![7, 0, 1, 2], vec![2, 0, 1], vec![3, 0, 1]] {
+            assert!(panels_from_arrays(&p, &bad).is_err(), "{bad:?}");
+        }
+        assert!(panels_from_arrays(&p[1..], &f).is_err());
+    }
 }

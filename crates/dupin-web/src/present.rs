@@ -23,6 +23,9 @@ pub(crate) struct Scene {
     pub(crate) offset_error: Option<String>,
 }
 
+/// The largest vertex move of a drawn offset layer, in face distances.
+const MAX_OFFSET_MOVE: f64 = 10.0;
+
 /// Builds the scene for `mesh`; with `offset`, adds the face-offset layer at a quarter of the
 /// mean edge length and a support beam from each vertex to its offset.
 pub(crate) fn build_scene(mesh: &PolyMesh, offset: bool) -> Scene {
@@ -42,7 +45,11 @@ pub(crate) fn build_scene(mesh: &PolyMesh, offset: bool) -> Scene {
     let mut offset_error = None;
     let mut panels = mesh.num_faces();
     if offset {
-        match offset_mesh(mesh, 0.25 * mean) {
+        let distance = 0.25 * mean;
+        let checked = offset_mesh(mesh, distance)
+            .map_err(|e| e.to_string())
+            .and_then(|off| offset_admitted(mesh, &off, distance).map(|()| off));
+        match checked {
             Ok(off) => {
                 let (g, _) = polymesh_buffers(&off, None);
                 append(&mut glass, &g);
@@ -65,6 +72,24 @@ pub(crate) fn build_scene(mesh: &PolyMesh, offset: bool) -> Scene {
         beams,
         offset_error,
     }
+}
+
+/// Whether the offset `off` of `mesh` at face distance `distance` is one to draw: faces that
+/// are nearly coplanar around a vertex meet far away, an offset that exists but is no frame
+/// anyone builds; the reason says so instead of drawing it.
+fn offset_admitted(mesh: &PolyMesh, off: &PolyMesh, distance: f64) -> Result<(), String> {
+    let (worst, v) = (0..mesh.num_vertices().min(off.num_vertices()))
+        .map(|i| ((off.positions[i] - mesh.positions[i]).norm(), i))
+        .fold((0.0f64, 0), |a, b| if b.0 > a.0 { b } else { a });
+    if worst > MAX_OFFSET_MOVE * distance.abs() {
+        return Err(format!(
+            "at face distance {distance:.3} vertex {v} would move {worst:.3} ({:.0}x): its faces \
+             are nearly coplanar; conical meshes have offsets within about the distance \
+             (conical paper, section 4), e.g. conical-station",
+            worst / distance.abs()
+        ));
+    }
+    Ok(())
 }
 
 fn append(a: &mut TriangleBuffers, b: &TriangleBuffers) {
@@ -253,5 +278,32 @@ mod tests {
             Some(e) => assert!(e.starts_with("no offset layer"), "{e}"),
         }
         assert!(torus_panels(3).is_err());
+    }
+
+    /// Frames follow panel edges and counts are panels: a hexagon mesh is framed along its
+    /// hexagons' edges (3 per face on a closed hexagon mesh), never across them.
+    #[test]
+    fn hexagons_are_framed_along_their_edges() {
+        let m = dupin_core::scenes::benchmark_meshes::torus_centroid_dual(24, 12, 2.0, 0.7);
+        assert!(m.faces().all(|f| f.len() == 6));
+        let s = build_scene(&m, false);
+        assert_eq!(s.panels, m.num_faces());
+        assert_eq!(s.beams, 3 * m.num_faces());
+        assert_eq!(s.glass.triangle_count(), 4 * m.num_faces());
+    }
+
+    #[test]
+    fn an_offset_moving_a_vertex_far_is_refused_with_its_reason() {
+        let m = torus_panels(100).unwrap();
+        let mut off = m.clone();
+        assert!(offset_admitted(&m, &off, 0.1).is_ok());
+        off.positions[7].z += 1.05;
+        let e = offset_admitted(&m, &off, 0.1).unwrap_err();
+        assert!(
+            e.contains("vertex 7 would move") && e.contains("conical-station"),
+            "{e}"
+        );
+        off.positions[7].z -= 0.1;
+        assert!(offset_admitted(&m, &off, 0.1).is_ok());
     }
 }
