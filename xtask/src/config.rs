@@ -19,6 +19,8 @@ struct Build {
     out_dir: String,
     profile: String,
     features: String,
+    #[serde(rename = "wasm-opt", default)]
+    wasm_opt: Vec<String>,
 }
 
 #[derive(Deserialize)]
@@ -40,10 +42,14 @@ impl WebBuild {
         let text =
             std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
         let file: File = toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
-        if !["release", "dev", "profiling"].contains(&file.build.profile.as_str()) {
+        let p = file.build.profile.as_str();
+        if p.is_empty()
+            || !p
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+        {
             return Err(format!(
-                "wasm-pack.toml: profile must be release, dev or profiling, not `{}`",
-                file.build.profile
+                "wasm-pack.toml: profile must be release, dev, profiling or a Cargo profile name, not `{p}`"
             ));
         }
         Ok(WebBuild { file })
@@ -60,13 +66,68 @@ impl WebBuild {
         let mut cmd = Command::new("wasm-pack");
         cmd.current_dir(root())
             .args(["build", &b.krate, "--target", &b.target, "--out-dir"])
-            .arg(self.out_dir())
-            .arg(format!("--{}", b.profile))
-            .arg("--no-pack");
+            .arg(self.out_dir());
+        if ["release", "dev", "profiling"].contains(&b.profile.as_str()) {
+            cmd.arg(format!("--{}", b.profile));
+        } else {
+            cmd.args(["--profile", &b.profile]);
+        }
+        cmd.arg("--no-pack");
         if !b.features.trim().is_empty() {
             cmd.args(["--features", b.features.trim()]);
         }
-        run(&mut cmd)
+        run(&mut cmd)?;
+        self.optimise()
+    }
+
+    /// Runs wasm-opt with the configured flags on the module, in place; a note instead when
+    /// wasm-opt is not installed (the module works, only larger).
+    fn optimise(&self) -> Result<()> {
+        let flags = &self.file.build.wasm_opt;
+        if flags.is_empty() {
+            return Ok(());
+        }
+        let wasm_opt = root().join("xtask/npm").join(crate::setup::WASM_OPT);
+        if !wasm_opt.exists() {
+            println!(
+                "build-web: wasm-opt (npm binaryen in xtask/npm) is not installed; the module \
+                 stays unoptimised (`cargo xtask setup`)"
+            );
+            return Ok(());
+        }
+        let module = self.out_dir().join("dupin_web_bg.wasm");
+        let input = std::fs::read(&module).map_err(|e| format!("{}: {e}", module.display()))?;
+        // wasm-opt takes over a minute: its output is kept per input and flags, so an
+        // unchanged module is not optimised again.
+        let key = {
+            use std::hash::{Hash, Hasher};
+            let mut h = std::collections::hash_map::DefaultHasher::new();
+            (&input, flags).hash(&mut h);
+            h.finish()
+        };
+        let cache = root().join("target/wasm-opt");
+        let cached = cache.join(format!("{key:016x}.wasm"));
+        if !cached.exists() {
+            std::fs::create_dir_all(&cache).map_err(|e| format!("{}: {e}", cache.display()))?;
+            let optimised = cache.join(format!("{key:016x}.part.wasm"));
+            run(Command::new("node")
+                .arg(&wasm_opt)
+                .args(flags)
+                .arg(&module)
+                .arg("-o")
+                .arg(&optimised))?;
+            std::fs::rename(&optimised, &cached)
+                .map_err(|e| format!("{}: {e}", cached.display()))?;
+        }
+        std::fs::copy(&cached, &module).map_err(|e| format!("{}: {e}", module.display()))?;
+        let after = std::fs::metadata(&module).map_err(|e| format!("{}: {e}", module.display()))?;
+        println!(
+            "build-web: wasm-opt {}: {:.2} MB -> {:.2} MB",
+            flags.join(" "),
+            input.len() as f64 / 1e6,
+            after.len() as f64 / 1e6
+        );
+        Ok(())
     }
 
     /// `wasm-pack test --node` with the configured test selection.

@@ -5,6 +5,7 @@
 //!   the end-to-end test's npm packages).
 //! - `cargo xtask build-web`: build the wasm package into the page (settings: `wasm-pack.toml`).
 //! - `cargo xtask serve [--port 8080]`: set up, build, and serve `web/` at http://127.0.0.1:8080/.
+//! - `cargo xtask dist --out DIR`: set up, build, and write the page as static files to DIR.
 //! - `cargo xtask test`: everything CI runs (`.ci/run` is exactly this).
 //! - `cargo xtask fuzz [TARGET...] [--runs N] [--seconds S] [--keep]`: coverage-guided fuzzing
 //!   of the `dupin-fuzz` targets with libFuzzer on the stable toolchain.
@@ -12,6 +13,7 @@
 //!   step of `test`).
 
 mod config;
+mod dist;
 mod fuzz;
 mod layering;
 mod serve;
@@ -45,6 +47,13 @@ enum Command {
         /// Port on 127.0.0.1.
         #[arg(long, default_value_t = 8080)]
         port: u16,
+    },
+    /// Write the configurator as static files (DIR/index.html and what it loads) that any
+    /// static file server can host.
+    Dist {
+        /// The folder to write (created; existing files are overwritten).
+        #[arg(long)]
+        out: std::path::PathBuf,
     },
     /// Run every check CI runs.
     Test,
@@ -83,6 +92,9 @@ fn main() -> ExitCode {
             config::WebBuild::load()?.build()
         }),
         Command::Serve { port } => serve::run(port),
+        Command::Dist { out } => dist::run(&out).map(|files| {
+            println!("dist: {} files in {}", files.len(), out.display());
+        }),
         Command::Test => test::run(),
         Command::Fuzz {
             targets,

@@ -8,6 +8,8 @@ use std::process::Command;
 const WASM_PACK_VERSION: &str = "0.15.1";
 /// The Vulkan driver file of lavapipe (Mesa's software rasteriser) for native render tests.
 const LAVAPIPE_ICD: &str = "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json";
+/// binaryen's wasm-opt script under `xtask/npm` (run with Node).
+pub const WASM_OPT: &str = "node_modules/binaryen/bin/wasm-opt";
 const APT_PACKAGES: [&str; 3] = ["chromium", "chromium-driver", "mesa-vulkan-drivers"];
 
 /// Installs the wasm toolchain (and with `browser`, the browser-test tools); returns what it
@@ -44,6 +46,15 @@ pub fn ensure(browser: bool) -> Result<Vec<String>> {
             &format!("={WASM_PACK_VERSION}"),
         ]))?;
         installed.push(format!("wasm-pack {WASM_PACK_VERSION}"));
+    }
+
+    // binaryen's wasm-opt (npm, compiled to wasm), which the web build runs on the module.
+    let tools = root().join("xtask/npm");
+    if !tools.join(WASM_OPT).exists() {
+        run(Command::new("npm")
+            .args(["ci", "--no-audit", "--no-fund"])
+            .current_dir(&tools))?;
+        installed.push("npm: binaryen (xtask/npm)".into());
     }
 
     // rhino3dm, which the page loads from web/vendor when a .3dm is opened or written.

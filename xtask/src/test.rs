@@ -114,6 +114,45 @@ pub fn run() -> Result<()> {
                 .env("DUPIN_URL", format!("http://127.0.0.1:{port}/")),
         )
     })?;
+    step("static dist on a plain file server", &mut || {
+        // `cargo xtask dist`'s folder, served by Python's http.server (no xtask, no CSP): the
+        // page's smoke test must pass there too.
+        let out = root().join("target/dist");
+        crate::dist::copy(&root().join("web"), &out)?;
+        let port = {
+            let l = serve::bind(0)?;
+            l.local_addr().map_err(|e| e.to_string())?.port()
+        };
+        let mut server = Command::new("python3")
+            .args([
+                "-m",
+                "http.server",
+                &port.to_string(),
+                "--bind",
+                "127.0.0.1",
+            ])
+            .arg("--directory")
+            .arg(&out)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .map_err(|e| format!("python3 -m http.server (a plain static server): {e}"))?;
+        // Wait until it listens (it starts in the background).
+        for _ in 0..100 {
+            if std::net::TcpStream::connect(("127.0.0.1", port)).is_ok() {
+                break;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(100));
+        }
+        let result = util::run(
+            Command::new("node")
+                .args(["--test", "--test-concurrency=1", "tests/e2e/smoke.test.mjs"])
+                .current_dir(root())
+                .env("DUPIN_URL", format!("http://127.0.0.1:{port}/")),
+        );
+        let _ = server.kill();
+        result
+    })?;
     println!("\nxtask test: all checks passed");
     for (name, secs) in &times {
         println!("  {secs:8.1} s  {name}");
