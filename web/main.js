@@ -71,8 +71,14 @@ function showMesh(next, reframe) {
 function setProp(el, key, value) { if (el[key] !== value) el[key] = value; }
 
 function updateButtons() {
-  setProp($('step'), 'disabled', !running || done);
-  setProp($('play'), 'disabled', !running || done);
+  // A value the core refused stays in its field, in red, while the run keeps the previous
+  // settings: Step and Play wait until it is fixed rather than run what the field does not show.
+  const refused = fieldsBox.querySelector('input.invalid');
+  const why = refused ? `fix the value in red first (${refused.dataset.testid}): the run on screen still uses the previous one` : '';
+  setProp($('step'), 'disabled', !running || done || !!refused);
+  setProp($('play'), 'disabled', !running || done || (!!refused && !playing));
+  setProp($('step'), 'title', why);
+  setProp($('play'), 'title', why);
   setProp($('reset'), 'disabled', !running);
   setProp($('stop'), 'disabled', !candidate && (!running || done));
   setProp($('play'), 'textContent', playing ? 'Pause' : 'Play');

@@ -110,9 +110,15 @@ test('free mode: bad input in any field shows the core error inline and the page
       const text = await err.textContent();
       assert.ok(text.length > 5, `${id}=${value}: ${text}`);
       assert.deepEqual(await metrics(page), before, `${id}=${value} changed the run`);
+      // Play and Step wait for the field to be fixed (the run still has the previous value).
+      if (id !== 'panel-edge') {
+        assert.equal(await byId(page, 'play').isDisabled(), true, id);
+        assert.match(await byId(page, 'play').getAttribute('title'), /fix the value in red first/);
+      }
       await byId(page, id).fill(good);
       await byId(page, id).dispatchEvent('change');
       await page.waitForFunction((t) => document.querySelector(`[data-testid="${t}-error"]`).textContent === '', id);
+      await page.waitForFunction(() => !document.querySelector('[data-testid=play]').disabled);
     }
     // The run still steps, and a new surface loads with its own parameters.
     const n = Number((await metrics(page)).steps);
