@@ -99,3 +99,34 @@ test('bad input shows an inline message and leaves the page usable', async () =>
     await browser.close();
   }
 });
+
+test('phone and tablet: every button is on screen, none overlaps another, the view is not cropped away', async () => {
+  for (const [w, h] of [[390, 844], [820, 1180]]) {
+    const { browser, page, errors } = await openPage();
+    try {
+      await page.setViewportSize({ width: w, height: h });
+      await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+      const boxes = await page.$$eval('header button, header select, header .open-design', (els) => els.map((e) => {
+        const r = e.getBoundingClientRect();
+        return { id: e.dataset.testid ?? e.textContent.trim(), x: r.left, y: r.top, r: r.right, b: r.bottom };
+      }));
+      assert.ok(boxes.length >= 12, `${boxes.length} controls`);
+      for (const a of boxes) {
+        assert.ok(a.x >= 0 && a.r <= w + 0.5, `${w}px: ${a.id} is off screen (${a.x}..${a.r})`);
+        for (const b of boxes) {
+          if (a === b) continue;
+          const overlap = Math.min(a.r, b.r) - Math.max(a.x, b.x) > 1 && Math.min(a.b, b.b) - Math.max(a.y, b.y) > 1;
+          assert.ok(!overlap, `${w}px: ${a.id} overlaps ${b.id}`);
+        }
+      }
+      const canvas = await byId(page, 'canvas').boundingBox();
+      assert.ok(canvas.width >= 0.9 * w && canvas.height >= 0.3 * h, `${w}px: the view is ${canvas.width} x ${canvas.height}`);
+      // The colour mode and legend are reachable by scrolling the page, not hidden in a box.
+      await byId(page, 'color-mode').scrollIntoViewIfNeeded();
+      assert.ok(await byId(page, 'color-mode').isVisible());
+      assert.deepEqual(errors, []);
+    } finally {
+      await browser.close();
+    }
+  }
+});
