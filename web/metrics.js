@@ -8,7 +8,10 @@ const svgEl = (tag, attrs) => {
 };
 
 const exp = (x) => (x === 0 ? '0' : x.toExponential(2));
-const mm = (rel, edge) => `${(rel * edge * 1000).toPrecision(3)} mm`;
+// Planarity as a person reads it: the corner distance in millimetres with three decimals (what a
+// fabricator measures), the contract's relative figure (distance over mean edge) after it.
+const mm = (rel, edge) => `${(rel * edge * 1000).toFixed(3)} mm`;
+const planarity = (rel, edge) => `${mm(rel, edge)} · ${exp(rel)} of an edge`;
 
 // Both writers below touch only what changed since the last call (cached per element): a step
 // changes a few numbers, and rebuilding ~50 nodes per worker message cost style, layout and
@@ -30,6 +33,8 @@ function setText(node, text) {
 
 /** Writes metrics `m` (from Session.step/metrics, plus `ms` and `steps`) into `dl`. */
 export function showMetrics(dl, m, { panelEdge }) {
+  // An opened design is measured in its own unit; a scene at the page's panel edge.
+  const edge = m.meanEdgeM ?? panelEdge;
   const data = {
     phase: m.phase,
     layer: m.layer ?? 0,
@@ -47,8 +52,8 @@ export function showMetrics(dl, m, { panelEdge }) {
   const rows = [
     ['phase', m.phase], ['layer', m.layer ?? 0], ['iteration', m.iteration], ['faces', m.faces],
     ['vertices', m.vertices],
-    ['max planarity', `${exp(m.maxPlanarity)} · ${mm(m.maxPlanarity, panelEdge)}`],
-    ['mean planarity', `${exp(m.meanPlanarity ?? 0)} · ${mm(m.meanPlanarity ?? 0, panelEdge)}`],
+    ['max planarity', planarity(m.maxPlanarity, edge)],
+    ['mean planarity', planarity(m.meanPlanarity ?? 0, edge)],
     ['invalid faces', m.invalidFaces ?? 0],
     ['step time', m.ms === undefined ? '–' : `${m.ms.toFixed(1)} ms`],
   ];

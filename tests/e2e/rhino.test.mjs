@@ -153,12 +153,19 @@ test('a Rhino roof in millimetres is panelled and leaves as 3dm, DXF and GLB tha
     assert.match(await byId(page, 'status').textContent(), /3\.00 × 3\.00 × [0-9.]+ m \(unit cm\)/);
     assert.equal(await byId(page, 'import-as').inputValue(), 'panels');
     assert.equal(await byId(page, 'import-unit').inputValue(), 'cm');
+    // The design as read (+-1 mm of noise): its planarity in mm follows from its own 50 cm
+    // panels, not from the page's 1.5 m panel edge.
+    const g0 = await metrics(page);
+    const shown = await page.locator('[data-metric="max-planarity"]').textContent();
+    const mmShown = Number(shown.split(' mm')[0]);
+    assert.ok(mmShown > 0.01 && Math.abs(mmShown - Number(g0.maxPlanarity) * 500) <= 0.0006, `${shown} vs ${g0.maxPlanarity}`);
     await play(page);
     const g = await metrics(page);
     assert.equal(g.phase, 'done', await byId(page, 'status').textContent());
     assert.equal(g.faces, '36');
     assert.ok(Number(g.maxPlanarity) <= 1e-9, g.maxPlanarity);
     assert.ok(Number(g.maxDeviationMm) <= 2, g.maxDeviationMm);
+
 
     // A broken .3dm: its name and what is wrong; the grid stays.
     await byId(page, 'import-file').setInputFiles({ name: 'broken.3dm', mimeType: 'application/octet-stream', buffer: Buffer.from('3D Geometry File Format, but cut short') });

@@ -14,6 +14,8 @@ test('smoke: start, run a scene to the end, export, open a .3dm', async () => {
     await byId(page, 'play').click();
     await page.waitForFunction(() => document.querySelector('[data-testid=metrics]').dataset.phase === 'done', null, { timeout: 120_000 });
     const m = await metrics(page);
+    // Planarity as people read it: millimetres with three decimals, then the relative figure.
+    assert.match(await page.locator('[data-metric="max-planarity"]').textContent(), /^\d+\.\d{3} mm · (0|\d\.\d{2}e[-+]\d+) of an edge$/);
     assert.equal(parseObj(await exportText(page, 'export-obj')).faces, Number(m.faces));
 
     const rhino = await rhino3dm();

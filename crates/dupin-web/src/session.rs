@@ -127,6 +127,10 @@ struct Metrics {
     /// and mean, in millimetres.
     #[serde(skip_serializing_if = "Option::is_none")]
     deviation_mm: Option<[f64; 2]>,
+    /// An opened design: the current mesh's mean edge in metres (its planarity in mm follows
+    /// from it, not from the page's panel edge).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    mean_edge_m: Option<f64>,
 }
 
 /// The extra layers `Session.mesh` can draw with the panels: `{ offset, support, distance }`
@@ -935,6 +939,10 @@ impl Session {
         let mean_planarity = mean_planarity(&per_face);
         let histogram = planarity_histogram(&per_face);
         let hist_log10 = [PLANARITY_HIST_LO, PLANARITY_HIST_HI];
+        let mean_edge_m = self
+            .design
+            .as_ref()
+            .map(|d| mesh.mean_edge() * d.unit.parse::<LengthUnit>().unwrap_or_default().to_m());
         match &self.run {
             Run::Phex(p, goals) => {
                 let m = p.metrics();
@@ -968,6 +976,7 @@ impl Session {
                     singular_points_inside: None,
                     design: self.design.clone(),
                     deviation_mm: None,
+                    mean_edge_m,
                 }
             }
             Run::Pq { stepper, started } => {
@@ -1016,6 +1025,7 @@ impl Session {
                     singular_points_inside,
                     design: self.design.clone(),
                     deviation_mm: self.design.as_ref().and_then(|d| d.deviation_mm(&mesh)),
+                    mean_edge_m,
                 }
             }
         }
