@@ -3,7 +3,7 @@
 // DOM events, the URL hash and the frame loop; the pieces are small modules:
 //   config.js (configuration <-> hash), controls.js (picker and fields), metrics.js (panel,
 //   histogram, legend), solver.js (worker client). Other tabs plug in through `window.dupin`.
-import init, { MeshData, Viewer, colorLegend, freeDefaults, pageSchema, sceneNames, surfaceCatalog, torusMesh } from './pkg/dupin_web.js';
+import init, { MeshData, Viewer, colorLegend, freeDefaults, pageSchema, sceneDescription, sceneNames, surfaceCatalog, torusMesh } from './pkg/dupin_web.js';
 import { FREE, IMPORTED, defaults, readHash, sessionConfig, useSchema, writeHash } from './config.js';
 import { buildFields, clearFieldErrors, fillScenePicker, showFieldError } from './controls.js';
 import { drawHistogram, drawLegend, showMetrics } from './metrics.js';
@@ -48,7 +48,20 @@ function showStatus(text, isError = false) {
 }
 
 // Only when the hash changed: replaceState per worker message was main-thread work for nothing.
+/** One line for people about what is on screen and what to press. */
+function describe(c) {
+  const text = c.scene === 'torus'
+    ? 'Dupin makes freeform designs buildable from flat panels. Pick a scene from the papers and press Play, or open your own design.'
+    : c.scene === FREE
+      ? 'Any library surface panelled by P-Hex: choose the surface, method, panel size and weights, then press Play.'
+      : c.scene === IMPORTED
+        ? 'Your design: a surface is panelled by P-Hex, panels are made planar keeping the design; press Play, then export.'
+        : `${sceneDescription(c.scene) ?? ''} Press Play to run it, Step to watch it step by step.`;
+  setProp($('scene-description'), 'textContent', text);
+}
+
 function syncHash() {
+  describe(config);
   const h = writeHash(config);
   if (h !== location.hash) history.replaceState(null, '', h);
 }
@@ -599,6 +612,7 @@ function frame() {
 
 // ---- controls -----------------------------------------------------------------------------------
 function rebuildFields() {
+  describe(config);
   buildFields(fieldsBox, config, {
     catalog: ctx.catalog,
     torusParams: TORUS,

@@ -130,3 +130,21 @@ test('phone and tablet: every button is on screen, none overlaps another, the vi
     }
   }
 });
+
+test('every scene says in one sentence what it shows, with its paper figure', async () => {
+  const { browser, page, errors } = await openPage();
+  try {
+    assert.match(await byId(page, 'scene-description').textContent(), /flat panels.*press Play/);
+    const scenes = await byId(page, 'scene-select').evaluate((s) => [...s.options].map((o) => o.value));
+    for (const scene of scenes.filter((s) => !['torus', 'free'].includes(s))) {
+      await byId(page, 'scene-select').selectOption(scene);
+      await page.waitForFunction((s) => location.hash.includes(`scene=${s}`), scene, { timeout: 60_000 });
+      assert.match(await byId(page, 'scene-description').textContent(), /\((P-Hex|conical) paper, (Figs?\.|section) [0-9].*\)\. Press Play/, scene);
+    }
+    await byId(page, 'scene-select').selectOption('free');
+    assert.match(await byId(page, 'scene-description').textContent(), /library surface/);
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});

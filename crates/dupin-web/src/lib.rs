@@ -24,7 +24,9 @@ pub use mesh_data::{MeshData, torus_mesh};
 pub use present::Presenter;
 pub use present::torus_panels_js;
 pub use schema::page_schema;
-pub use session::{Session, color_legend, free_defaults, scene_names, surface_catalog_js};
+pub use session::{
+    Session, color_legend, free_defaults, scene_description, scene_names, surface_catalog_js,
+};
 pub use teach::DupinLesson;
 #[cfg(target_arch = "wasm32")]
 pub use viewer::Viewer;

@@ -201,6 +201,13 @@ pub fn scene_names() -> Vec<String> {
         .collect()
 }
 
+/// One sentence for people about scene `name` and the paper figure it follows; `undefined` for
+/// a name that is not a scene.
+#[wasm_bindgen(js_name = sceneDescription)]
+pub fn scene_description(name: &str) -> Option<String> {
+    dupin_core::scenes::scene_description(name).map(str::to_string)
+}
+
 #[derive(Serialize)]
 struct ParamOut {
     key: &'static str,

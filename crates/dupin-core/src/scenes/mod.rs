@@ -6,12 +6,15 @@
 //! |---|---|---|
 //! | P-Hex (Figs. 1, 11, 15, 18-22, sec. 3) | `cyclide-architecture`, `sphere-radial`, ... | `phex.rs` |
 //! | conical (Figs. 1, 7-9, 14, 16, 17) | `pq-catmull-clark`, `conical-station`, ... | `pq.rs` |
+//! | both, for people | one sentence per scene with its figure | `descriptions.rs` |
 //! | conical (benchmarks), import | skew grid on z = xy, torus quads, triangulation and centroid dual, noisy vase; a NURBS roof | `benchmark_meshes.rs` |
 
 pub mod benchmark_meshes;
+mod descriptions;
 mod phex;
 mod pq;
 
+pub use descriptions::scene_description;
 #[cfg(test)]
 pub(crate) use phex::acceptance_for_tests;
 pub use phex::{PHEX_SCENES, PhexScene, phex_scene};
