@@ -12,7 +12,8 @@ let pendingSeg = null;
 let cells = null;
 let dual = null;
 let inputError = null;
-let panel, canvas, hist, statusEl, modeSel, toolSel, stepBtn, runBtn;
+let panel, canvas, hist, statusEl, modeSel, toolSel, stepBtn, runBtn, speedSel;
+let running = null; // the animation or chunked run in progress (a timer id), if any
 let modes = [];      // [{ name, angleBounds: [min, max] }] from pageSchema, simple then extended
 
 const el = (tag, attrs = {}, text) => {
@@ -56,9 +57,12 @@ function refresh() {
   statusEl.dataset.minAngle = tri ? dual.minAngle.toFixed(4) : '';
   statusEl.dataset.maxAngle = tri ? dual.maxAngle.toFixed(4) : '';
   statusEl.classList.toggle('error', !!inputError);
+  const segmentHint = toolSel.value !== 'segments' ? ''
+    : pendingSeg === null ? ' · segments: click a point (or empty space for a new one), then the other end'
+      : ' · now click the segment\'s other end';
   if (inputError) statusEl.textContent = inputError;
-  else if (points.length === 0) statusEl.textContent = 'Click to add points, drag to move them.';
-  else statusEl.textContent = `${points.length} points · ${segments.length} segments · step ${lab.steps()}${done ? ' (done)' : ''} · ${tri} triangles · angles ${dual.minAngle.toFixed(1)}°–${dual.maxAngle.toFixed(1)}°`;
+  else if (points.length === 0) statusEl.textContent = `Click to add points, drag to move them, or pick a point set.${segmentHint}`;
+  else statusEl.textContent = `${points.length} points · ${segments.length} segments · step ${lab.steps()}${done ? ' (done)' : ''} · ${tri} triangles · angles ${dual.minAngle.toFixed(1)}°–${dual.maxAngle.toFixed(1)}°${segmentHint}`;
 }
 
 function draw() {
@@ -130,7 +134,69 @@ function drawHistogram() {
     g.fillText(`${deg}°`, x(deg) + 2, 12);
   }
   g.fillStyle = '#8d93a3';
-  for (const deg of [0, 60, 180]) g.fillText(`${deg}`, x(deg) - 4, h - 3);
+  // Axis labels in degrees, the last one right-aligned so that it stays inside the canvas.
+  for (const deg of [0, 60, 120, 180]) {
+    g.textAlign = deg === 180 ? 'right' : 'center';
+    g.fillText(`${deg}°`, deg === 180 ? w - 2 : x(deg), h - 3);
+  }
+  g.textAlign = 'start';
+}
+
+/** Seeded point sets (so a class sees the same picture twice): uniform, clustered, on a line. */
+function pointSet(kind) {
+  let seed = 12345;
+  const rnd = () => { seed = (seed * 1103515245 + 12345) % 2147483648; return seed / 2147483648; };
+  const r = VIEW * 0.8;
+  if (kind === 'random') return Array.from({ length: 40 }, () => [(2 * rnd() - 1) * r, (2 * rnd() - 1) * r]);
+  if (kind === 'clustered') {
+    const centres = [[-1.2, 0.8], [1.1, -0.6], [0.2, 1.6]];
+    return Array.from({ length: 45 }, (_, i) => {
+      const [cx, cy] = centres[i % 3];
+      const a = 2 * Math.PI * rnd(), d = 0.5 * Math.sqrt(rnd());
+      return [cx + d * Math.cos(a), cy + d * Math.sin(a)];
+    });
+  }
+  // On a line, with a little noise off it.
+  return Array.from({ length: 16 }, (_, i) => [-r + (2 * r * i) / 15, 0.3 * (-r + (2 * r * i) / 15) + 0.02 * (rnd() - 0.5)]);
+}
+
+/** The picture as SVG: cells, the dual triangulation, segments and points, in canvas pixels. */
+function pictureSvg() {
+  const parts = [`<svg xmlns="http://www.w3.org/2000/svg" width="${canvas.width}" height="${canvas.height}" viewBox="0 0 ${canvas.width} ${canvas.height}">`,
+    `<rect width="100%" height="100%" fill="#101218"/>`];
+  const pt = (p) => toScreen(p).map((c) => c.toFixed(2)).join(',');
+  if (cells && cells.domain.length) {
+    let k = 0;
+    cells.sizes.forEach((n, i) => {
+      const corners = Array.from({ length: n }, (_, j) => pt([cells.corners[2 * (k + j)], cells.corners[2 * (k + j) + 1]]));
+      parts.push(`<polygon points="${corners.join(' ')}" fill="rgba(127,178,229,${cells.occupied[i] ? 0.18 : 0.05})" stroke="rgba(127,178,229,0.45)"/>`);
+      k += n;
+    });
+  }
+  if (dual && dual.triangles.length) {
+    const v = dual.vertices;
+    for (let t = 0; t < dual.triangles.length; t += 3) {
+      const c = [0, 1, 2].map((q) => pt([v[2 * dual.triangles[t + q]], v[2 * dual.triangles[t + q] + 1]]));
+      parts.push(`<polygon points="${c.join(' ')}" fill="none" stroke="#e6e8ee" stroke-width="0.8"/>`);
+    }
+  }
+  for (const [i, j] of segments) {
+    const [a, b] = [toScreen(points[i]), toScreen(points[j])];
+    parts.push(`<line x1="${a[0]}" y1="${a[1]}" x2="${b[0]}" y2="${b[1]}" stroke="#ff9e64" stroke-width="2"/>`);
+  }
+  for (const p of points) {
+    const [x, y] = toScreen(p);
+    parts.push(`<circle cx="${x}" cy="${y}" r="4" fill="#f2c14e"/>`);
+  }
+  parts.push('</svg>');
+  return parts.join('\n');
+}
+
+function save(name, blob) {
+  const url = URL.createObjectURL(blob);
+  const a = Object.assign(document.createElement('a'), { href: url, download: name });
+  a.click();
+  setTimeout(() => URL.revokeObjectURL(url), 1000);
 }
 
 function nearest(px, py) {
@@ -174,16 +240,32 @@ function wire() {
     refresh();
   });
   runBtn.addEventListener('click', () => {
-    // Steps with a redraw between them, so the subdivision is watched rather than jumped over.
-    const tick = () => {
-      if (!lab || lab.done() || inputError || panel.hidden) return;
-      try { lab.step(); } catch (e) { inputError = String(e.message ?? e); }
-      refresh();
-      setTimeout(tick, 40);
+    clearTimeout(running);
+    const perSecond = Number(speedSel.value);
+    if (perSecond > 0) {
+      // Animated: one step per tick with a redraw, so the subdivision can be watched.
+      const tick = () => {
+        if (!lab || lab.done() || inputError || panel.hidden) return;
+        try { lab.step(); } catch (e) { inputError = String(e.message ?? e); }
+        refresh();
+        running = setTimeout(tick, 1000 / perSecond);
+      };
+      tick();
+      return;
+    }
+    // At once: steps in slices of at most 30 ms (the page stays responsive), one redraw at the end.
+    const slice = () => {
+      const t0 = performance.now();
+      while (lab && !lab.done() && !inputError && performance.now() - t0 < 30) {
+        try { lab.step(); } catch (e) { inputError = String(e.message ?? e); }
+      }
+      if (lab && !lab.done() && !inputError) running = setTimeout(slice, 0);
+      else refresh();
     };
-    tick();
+    slice();
   });
   modeSel.addEventListener('change', restart);
+  toolSel.addEventListener('change', () => { pendingSeg = null; refresh(); });
 }
 
 /** Adds the 2D tab button and panel to the page. */
@@ -200,10 +282,27 @@ export function initHexd2d() {
   toolSel.append(new Option('points', 'points'), new Option('segments', 'segments'));
   stepBtn = el('button', { type: 'button', 'data-testid': 'hexd-step' }, 'Step');
   runBtn = el('button', { type: 'button', 'data-testid': 'hexd-run' }, 'Run');
+  speedSel = el('select', { 'data-testid': 'hexd-speed', 'aria-label': 'Run speed', title: 'Run: at once, or animated step by step' });
+  speedSel.append(new Option('at once', '0'), new Option('animate: 4 steps/s', '4'), new Option('animate: 25 steps/s', '25'));
   const clear = el('button', { type: 'button', 'data-testid': 'hexd-clear' }, 'Clear');
-  clear.addEventListener('click', () => { points = []; segments = []; pendingSeg = null; restart(); });
+  clear.addEventListener('click', () => { clearTimeout(running); points = []; segments = []; pendingSeg = null; restart(); });
+  const setSel = el('select', { 'data-testid': 'hexd-points', 'aria-label': 'Point set' });
+  setSel.append(new Option('point set…', ''), new Option('random (40)', 'random'), new Option('clustered (45)', 'clustered'), new Option('on a line (16)', 'line'));
+  setSel.addEventListener('change', () => {
+    if (!setSel.value) return;
+    clearTimeout(running);
+    points = pointSet(setSel.value);
+    segments = [];
+    pendingSeg = null;
+    setSel.value = '';
+    restart();
+  });
+  const png = el('button', { type: 'button', 'data-testid': 'hexd-png', title: 'the picture as PNG, for slides' }, 'PNG');
+  png.addEventListener('click', () => canvas.toBlob((b) => b && save('hexagonal-delaunay.png', b), 'image/png'));
+  const svg = el('button', { type: 'button', 'data-testid': 'hexd-svg', title: 'the picture as SVG, for slides' }, 'SVG');
+  svg.addEventListener('click', () => save('hexagonal-delaunay.svg', new Blob([pictureSvg()], { type: 'image/svg+xml' })));
   const bar = el('div', { class: 'hexd-controls' });
-  bar.append(modeSel, toolSel, stepBtn, runBtn, clear);
+  bar.append(modeSel, toolSel, setSel, stepBtn, runBtn, speedSel, clear, png, svg);
   const side = el('div', { class: 'hexd-side' });
   const note = el('p', { class: 'hint' }, `Hexagon cells (blue) are split one refinement step at a time; white: the dual triangulation. The histogram counts its angles; the ${modes[0].name} refinement keeps them in ${bounds(modes[0])} (section 4), the ${modes[1].name} one in ${bounds(modes[1])} (section 5).`);
   side.append(bar, statusEl, hist, note);

@@ -78,3 +78,41 @@ test('2D tab: segments are accepted and the extended mode surfaces any core mess
     await browser.close();
   }
 });
+
+test('2D tab: a point set runs to the end at once, and the picture leaves as SVG and PNG', async () => {
+  const { browser, page, errors } = await openPage();
+  try {
+    await byId(page, 'hexd').click();
+    const status = byId(page, 'hexd-status');
+    await byId(page, 'hexd-tool').selectOption('segments');
+    assert.match(await status.textContent(), /segments: click a point .* then the other end/);
+    await byId(page, 'hexd-tool').selectOption('points');
+    for (const set of ['line', 'clustered', 'random']) {
+      await byId(page, 'hexd-points').selectOption(set);
+      assert.equal(await status.getAttribute('data-steps'), '0');
+      const t0 = Date.now();
+      await byId(page, 'hexd-run').click();
+      await page.waitForFunction(() => document.querySelector('[data-testid=hexd-status]').dataset.done === 'true', null, { timeout: 30_000 });
+      assert.ok(Date.now() - t0 < 15_000, `${set}: ${Date.now() - t0} ms`);
+      assert.ok(Number(await status.getAttribute('data-steps')) >= 2, set);
+      assert.ok(Number(await status.getAttribute('data-min-angle')) >= 30 - 1e-9, set);
+      assert.ok(Number(await status.getAttribute('data-max-angle')) <= 120 + 1e-9, set);
+    }
+    const triangles = Number(await status.getAttribute('data-triangles'));
+    const [svgDl] = await Promise.all([page.waitForEvent('download'), byId(page, 'hexd-svg').click()]);
+    const svg = (await import('node:fs')).readFileSync(await svgDl.path(), 'utf8');
+    const parsed = await page.evaluate((text) => {
+      const doc = new DOMParser().parseFromString(text, 'image/svg+xml');
+      return { error: doc.querySelector('parsererror')?.textContent ?? null, open: doc.querySelectorAll('polygon[fill=none]').length, points: doc.querySelectorAll('circle').length };
+    }, svg);
+    assert.equal(parsed.error, null);
+    assert.equal(parsed.open, triangles);
+    assert.equal(parsed.points, 40);
+    const [pngDl] = await Promise.all([page.waitForEvent('download'), byId(page, 'hexd-png').click()]);
+    const png = (await import('node:fs')).readFileSync(await pngDl.path());
+    assert.equal(png.toString('latin1', 1, 4), 'PNG');
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
