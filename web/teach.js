@@ -38,9 +38,22 @@ function label(x, y, text, size) {
   return t;
 }
 
+/** Half-width of the view: the lesson's extent, grown so that every construction point and
+ * segment shown so far stays inside the inset. */
+function viewExtent() {
+  let E = state.extent;
+  if (steps && stepIndex >= 0) {
+    for (const s of steps.slice(0, stepIndex + 1)) {
+      for (const [, x, y] of s.points) E = Math.max(E, 1.15 * Math.abs(x), 1.15 * Math.abs(y));
+      for (const [x1, y1, x2, y2] of s.segments) E = Math.max(E, 1.05 * Math.max(Math.abs(x1), Math.abs(y1), Math.abs(x2), Math.abs(y2)));
+    }
+  }
+  return E;
+}
+
 function draw() {
   if (!state) return;
-  const E = state.extent;
+  const E = viewExtent();
   svg.setAttribute('viewBox', `${-E} ${-E} ${2 * E} ${2 * E}`);
   const r = E * 0.03;
   const g = [];
@@ -79,11 +92,28 @@ function draw() {
   }
   g.push(dot(0, 0, r, COLORS.star));
   ring.forEach(([x, y], i) => {
-    const h = dot(x, y, r * 1.3, i < 2 ? '#ffffff' : COLORS.star, { 'data-vertex': String(i), class: 'teach-handle' });
+    const h = dot(x, y, r * 1.3, i < 2 ? '#ffffff' : COLORS.star, {
+      'data-vertex': String(i), class: 'teach-handle', tabindex: '0', role: 'button',
+      'aria-label': `star vertex ${i + 1} of 6 at (${x.toFixed(2)}, ${y.toFixed(2)}): arrow keys move it`,
+    });
     h.addEventListener('pointerdown', (e) => startDrag(e, i));
+    h.addEventListener('keydown', (e) => keyMove(e, i));
     g.push(h);
   });
+  // Labels of the elements, for a class reading the picture: a legend in the top-left corner
+  // (labels on the curves themselves collide where the elements meet at the centre).
+  const fs = E * 0.06;
+  const entries = [['Dupin indicatrix', COLORS.indicatrix], ['triangle star', COLORS.star]];
+  if (state.hexagon.length === 6) entries.push(['Dupin hexagon', state.verdict === 'invalid' ? COLORS.invalid : COLORS.hexagon]);
+  if (state.triangleConics.length) entries.push(['Dupin center', COLORS.center]);
+  if (state.dragged && state.conjugate) entries.push(['dragged and conjugate directions', COLORS.conjugate]);
+  entries.forEach(([text, fill], k) => {
+    const y = E - fs * (1.4 + 1.25 * k);
+    g.push(el('svg:rect', { x: -E + fs * 0.5, y: y - fs * 0.1, width: fs * 0.9, height: fs * 0.3, fill, class: 'teach-label' }));
+    g.push(el('svg:text', { x: -E + fs * 1.7, y: -y, 'font-size': fs, fill, transform: 'scale(1,-1)', class: 'teach-label' }, text));
+  });
   layer.replaceChildren(...g);
+  if (focusIndex >= 0) layer.querySelector(`[data-vertex="${focusIndex}"]`)?.focus();
   verdictEl.textContent = state.verdict === 'undecided' ? `${state.kind} point: no verdict` : `${state.kind} point: star ${state.verdict}`;
   verdictEl.dataset.verdict = state.verdict;
   verdictEl.dataset.kind = state.kind;
@@ -125,16 +155,35 @@ function moveDrag(ev) {
   draw();
 }
 
+// Arrow keys move the focused star vertex by 5% of the view (Shift: 1%), as a drag would.
+let focusIndex = -1;
+function keyMove(e, i) {
+  const d = { ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowUp: [0, 1], ArrowDown: [0, -1] }[e.key];
+  if (!d || !state) return;
+  e.preventDefault();
+  const step = (e.shiftKey ? 0.01 : 0.05) * state.extent;
+  const [x, y] = state.ring[i];
+  try {
+    state = lesson.dragVertex(i, x + d[0] * step, y + d[1] * step);
+    steps = null; stepIndex = -1;
+    showError(null);
+  } catch (err) { showError(err); }
+  focusIndex = i;
+  draw();
+  focusIndex = -1;
+}
+
 function load() {
   const spec = CATALOG.find((s) => s.name === surfaceSel.value);
-  const params = {};
+  // The run's surface parameters when the inset shows the surface of a picked vertex.
+  const params = pickedSurface?.name === spec.name ? { ...pickedSurface.params } : {};
   try {
     const u = Number(uIn.value), v = Number(vIn.value);
     if (uIn.value.trim() === '' || vIn.value.trim() === '' || !Number.isFinite(u) || !Number.isFinite(v)) throw new Error('u and v must be numbers');
     const next = new DupinLesson(spec.name, params, u, v);
     lesson?.free();
     lesson = next;
-    setPicked(null);
+    setPicked(null, true);
     state = lesson.state();
     steps = null; stepIndex = -1;
     showError(null);
@@ -142,12 +191,24 @@ function load() {
   draw();
 }
 
-function setPicked(pick) {
+let pickedSurface = null; // { name, params } of the last picked vertex's run
+
+function setPicked(pick, keepSurface = false) {
   picked = pick;
+  if (!keepSurface) pickedSurface = null;
   if (pick) {
+    // The controls show where the lesson is: the run's surface (when it is a library surface)
+    // at the vertex's (u, v).
+    uIn.value = pick.uv[0].toFixed(4);
+    vIn.value = pick.uv[1].toFixed(4);
+    if (CATALOG.some((c) => c.name === pick.surface)) {
+      surfaceSel.value = pick.surface;
+      pickedSurface = { name: pick.surface, params: pick.params ?? {} };
+    }
     svg.dataset.pickedVertex = String(pick.vertex);
     svg.dataset.pickedNeighbours = pick.neighbours.join(',');
-    sourceEl.textContent = `Mesh vertex ${pick.vertex} at (u, v) = (${pick.uv.map((x) => x.toFixed(3)).join(', ')}), k1 = ${pick.k1.toPrecision(3)}, k2 = ${pick.k2.toPrecision(3)}`;
+    const where = CATALOG.some((c) => c.name === pick.surface) ? `${pick.surface} ` : '';
+    sourceEl.textContent = `Mesh vertex ${pick.vertex} on ${where}at (u, v) = (${pick.uv.map((x) => x.toFixed(3)).join(', ')}), k1 = ${pick.k1.toPrecision(3)}, k2 = ${pick.k2.toPrecision(3)}`;
   } else {
     delete svg.dataset.pickedVertex;
     delete svg.dataset.pickedNeighbours;
@@ -191,6 +252,39 @@ export function showPick(pick, error) {
 
 let CATALOG = [];
 
+/** The inset as a standalone SVG document (its current picture, labels included). */
+function insetSvg() {
+  const copy = svg.cloneNode(true);
+  copy.setAttribute('xmlns', SVGNS);
+  copy.setAttribute('width', '600');
+  copy.setAttribute('height', '600');
+  for (const h of copy.querySelectorAll('[tabindex]')) { h.removeAttribute('tabindex'); h.removeAttribute('role'); }
+  return new XMLSerializer().serializeToString(copy);
+}
+
+/** The inset rendered to a PNG blob at `scale` x 300 px. */
+async function insetPng(scale) {
+  const url = URL.createObjectURL(new Blob([insetSvg()], { type: 'image/svg+xml' }));
+  try {
+    const img = new Image();
+    img.src = url;
+    await img.decode();
+    const c = document.createElement('canvas');
+    c.width = c.height = 300 * scale;
+    c.getContext('2d').drawImage(img, 0, 0, c.width, c.height);
+    return await new Promise((resolve, reject) => c.toBlob((b) => (b ? resolve(b) : reject(new Error('PNG export failed'))), 'image/png'));
+  } finally {
+    URL.revokeObjectURL(url);
+  }
+}
+
+function save(name, blob) {
+  const url = URL.createObjectURL(blob);
+  const a = Object.assign(document.createElement('a'), { href: url, download: name });
+  a.click();
+  setTimeout(() => URL.revokeObjectURL(url), 1000);
+}
+
 /** Adds the Teach button and the inset panel to the page. */
 export function initTeach() {
   CATALOG = surfaceCatalog();
@@ -201,10 +295,15 @@ export function initTeach() {
   uIn = el('input', { type: 'number', step: '0.1', value: '0.3', 'data-testid': 'teach-u', 'aria-label': 'u' });
   vIn = el('input', { type: 'number', step: '0.1', value: '0.4', 'data-testid': 'teach-v', 'aria-label': 'v' });
   const stepBtn = el('button', { type: 'button', 'data-testid': 'teach-step', title: 'Section 5.1 construction, one step at a time' }, 'Ideal △ step');
+  const backBtn = el('button', { type: 'button', 'data-testid': 'teach-step-back', title: 'Section 5.1 construction, one step back', 'aria-label': 'construction step back' }, '◀');
   const idealBtn = el('button', { type: 'button', 'data-testid': 'teach-ideal' }, 'Reset star');
+  const bigBtn = el('button', { type: 'button', 'data-testid': 'teach-enlarge', 'aria-pressed': 'false', title: 'Fill the view with the inset (for a class)' }, 'Enlarge');
+  const svgBtn = el('button', { type: 'button', 'data-testid': 'teach-svg', title: 'The inset as SVG, for slides' }, 'SVG');
+  const pngBtn = el('button', { type: 'button', 'data-testid': 'teach-png', title: 'The inset as PNG (2x), for slides' }, 'PNG');
+  const closeBtn = el('button', { type: 'button', 'data-testid': 'teach-close', 'aria-label': 'Close the inset (Escape)', title: 'Close (Escape)' }, '✕');
   const controls = el('div', { class: 'teach-controls' });
   const lab = (t, c) => { const l = el('label', {}, t); l.append(c); return l; };
-  controls.append(lab('Surface ', surfaceSel), lab('u ', uIn), lab('v ', vIn), stepBtn, idealBtn);
+  controls.append(lab('Surface ', surfaceSel), lab('u ', uIn), lab('v ', vIn), backBtn, stepBtn, idealBtn, bigBtn, svgBtn, pngBtn, closeBtn);
   svg = el('svg:svg', { 'data-testid': 'teach-inset', class: 'teach-inset', width: '300', height: '300', role: 'img', 'aria-label': 'Dupin indicatrix, triangle star and Dupin hexagon' });
   svg.append(el('svg:rect', { x: '-1e6', y: '-1e6', width: '2e6', height: '2e6', fill: '#101218' }));
   layer = el('svg:g', { transform: 'scale(1,-1)' });
@@ -231,6 +330,26 @@ export function initTeach() {
   const endDrag = () => { dragIndex = -1; };
   svg.addEventListener('pointerup', endDrag);
   svg.addEventListener('pointercancel', endDrag);
+  backBtn.addEventListener('click', () => {
+    if (!steps || stepIndex < 0) return;
+    stepIndex -= 1;
+    draw();
+  });
+  const close = () => {
+    panel.hidden = true;
+    toggle.setAttribute('aria-pressed', 'false');
+    toggle.focus();
+  };
+  closeBtn.addEventListener('click', close);
+  document.addEventListener('keydown', (e) => { if (e.key === 'Escape' && !panel.hidden) close(); });
+  bigBtn.addEventListener('click', () => {
+    const big = panel.classList.toggle('teach-big');
+    bigBtn.setAttribute('aria-pressed', String(big));
+  });
+  svgBtn.addEventListener('click', () => save('dupin-indicatrix.svg', new Blob([insetSvg()], { type: 'image/svg+xml' })));
+  pngBtn.addEventListener('click', async () => {
+    try { save('dupin-indicatrix.png', await insetPng(2)); } catch (e) { showError(e); }
+  });
   stepBtn.addEventListener('click', () => {
     try {
       steps ??= lesson.idealTriangleSteps();

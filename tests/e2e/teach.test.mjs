@@ -156,6 +156,11 @@ test('teach inset from a clicked 3D vertex: its real star, a boundary message, d
     await page.mouse.click(best.q.x, best.q.y);
     await page.waitForFunction((i) => document.querySelector('[data-testid=teach-inset]').dataset.pickedVertex === String(i), best.i);
     const inset = byId(page, 'teach-inset');
+    // The controls show where the lesson is: the run's surface at the vertex's (u, v).
+    assert.equal(await byId(page, 'teach-surface').inputValue(), 'torus');
+    const [pu, pv] = (await byId(page, 'teach-source').textContent()).match(/\(u, v\) = \(([-0-9.]+), ([-0-9.]+)\)/).slice(1).map(Number);
+    assert.ok(Math.abs(Number(await byId(page, 'teach-u').inputValue()) - pu) < 1e-3);
+    assert.ok(Math.abs(Number(await byId(page, 'teach-v').inputValue()) - pv) < 1e-3);
     const got = (await inset.getAttribute('data-picked-neighbours')).split(',').map(Number);
     assert.deepEqual([...got].sort((a, b) => a - b), nbrs(best.i), 'the star is the vertex\'s six neighbours');
     // Counter-clockwise ring: consecutive neighbours span a triangle of the vertex.
@@ -200,6 +205,67 @@ test('teach inset from a clicked 3D vertex: its real star, a boundary message, d
     await page.mouse.click(best.q.x, best.q.y);
     await page.waitForFunction((i) => document.querySelector('[data-testid=teach-inset]').dataset.pickedVertex === String(i), best.i);
     assert.deepEqual(errors, [], 'console errors');
+  } finally {
+    await browser.close();
+  }
+});
+
+test('teach inset for a class: the construction stays in view, steps back, keys move the star, labels, enlarge, export, Escape', async () => {
+  const { browser, page, errors } = await openPage();
+  try {
+    await byId(page, 'teach').click();
+    const inset = byId(page, 'teach-inset');
+    await page.waitForFunction(() => document.querySelector('[data-testid=teach-inset]').dataset.star);
+    // Every element is labelled.
+    const labels = await inset.locator('text.teach-label').allTextContents();
+    for (const l of ['Dupin indicatrix', 'Dupin hexagon', 'Dupin center']) assert.ok(labels.includes(l), `${l} in ${labels}`);
+    // The section 5.1 construction, to its last step: every point inside the view.
+    let n = 0;
+    while (true) {
+      await byId(page, 'teach-step').click();
+      const caption = await byId(page, 'teach-caption').textContent();
+      const m = caption.match(/^Step (\d+)\/(\d+)/);
+      if (!m) break;
+      n = Number(m[1]);
+      const outside = await page.evaluate(() => {
+        const svg = document.querySelector('[data-testid=teach-inset]');
+        const box = svg.getBoundingClientRect();
+        return [...svg.querySelectorAll('circle')].filter((c) => {
+          const r = c.getBoundingClientRect();
+          const [x, y] = [r.left + r.width / 2, r.top + r.height / 2];
+          return x < box.left - 0.5 || x > box.right + 0.5 || y < box.top - 0.5 || y > box.bottom + 0.5;
+        }).length;
+      });
+      assert.equal(outside, 0, `step ${n}: ${outside} points outside the inset`);
+      if (n === Number(m[2])) break;
+    }
+    assert.ok(n >= 2, `${n} construction steps`);
+    await byId(page, 'teach-step-back').click();
+    assert.match(await byId(page, 'teach-caption').textContent(), new RegExp(`^Step ${n - 1}/`));
+    // Keyboard: a focused star vertex moves with the arrow keys.
+    const before = await inset.getAttribute('data-ring');
+    await inset.locator('[data-vertex="2"]').focus();
+    await page.keyboard.press('ArrowRight');
+    await page.keyboard.press('ArrowUp');
+    assert.notEqual(await inset.getAttribute('data-ring'), before);
+    assert.equal(await page.evaluate(() => document.activeElement?.dataset.vertex), '2');
+    // Enlarge for a class, and back.
+    await byId(page, 'teach-enlarge').click();
+    const big = await inset.boundingBox();
+    assert.ok(big.width > 320, `enlarged inset ${big.width} px`);
+    await byId(page, 'teach-enlarge').click();
+    // Exports for slides.
+    const [svgDl] = await Promise.all([page.waitForEvent('download'), byId(page, 'teach-svg').click()]);
+    const text = (await import('node:fs')).readFileSync(await svgDl.path(), 'utf8');
+    assert.match(text, /^<svg[^>]*xmlns="http:\/\/www.w3.org\/2000\/svg"/);
+    assert.match(text, /Dupin indicatrix/);
+    const [pngDl] = await Promise.all([page.waitForEvent('download'), byId(page, 'teach-png').click()]);
+    const png = (await import('node:fs')).readFileSync(await pngDl.path());
+    assert.equal(png.toString('latin1', 1, 4), 'PNG');
+    // Escape closes the inset.
+    await page.keyboard.press('Escape');
+    assert.equal(await byId(page, 'teach-panel').isHidden(), true);
+    assert.deepEqual(errors, []);
   } finally {
     await browser.close();
   }

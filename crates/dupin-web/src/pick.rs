@@ -80,6 +80,12 @@ pub(crate) struct StarPick {
     pub(crate) ring: Vec<[f64; 3]>,
     /// Why there is no star (boundary vertex, valence other than 6, singular point).
     pub(crate) message: Option<String>,
+    /// The run's surface and its parameters (so the teaching inset can show the same surface
+    /// at the same (u, v)); empty when not known.
+    #[serde(default)]
+    pub(crate) surface: String,
+    #[serde(default)]
+    pub(crate) params: std::collections::BTreeMap<String, f64>,
 }
 
 impl StarPick {
@@ -136,6 +142,8 @@ pub(crate) fn star_of(p: &PhexPipeline, triangles: &[[u32; 3]], v: usize) -> Sta
         neighbours: Vec::new(),
         ring: Vec::new(),
         message: None,
+        surface: p.config().surface.clone(),
+        params: p.config().params.iter().cloned().collect(),
     };
     match p.surface().curvature(uv.x, uv.y) {
         Ok(c) => {

@@ -798,6 +798,8 @@ mod mesh_star_tests {
             neighbours: Vec::new(),
             ring: Vec::new(),
             message: Some("vertex 3 is on the boundary".into()),
+            surface: "torus".into(),
+            params: Default::default(),
         };
         assert_eq!(
             DupinLesson::from_pick(&pick).err().as_deref(),
