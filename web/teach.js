@@ -304,7 +304,7 @@ export function initTeach() {
   const controls = el('div', { class: 'teach-controls' });
   const lab = (t, c) => { const l = el('label', {}, t); l.append(c); return l; };
   controls.append(lab('Surface ', surfaceSel), lab('u ', uIn), lab('v ', vIn), backBtn, stepBtn, idealBtn, bigBtn, svgBtn, pngBtn, closeBtn);
-  svg = el('svg:svg', { 'data-testid': 'teach-inset', class: 'teach-inset', width: '300', height: '300', role: 'img', 'aria-label': 'Dupin indicatrix, triangle star and Dupin hexagon' });
+  svg = el('svg:svg', { 'data-testid': 'teach-inset', class: 'teach-inset', width: '300', height: '300', role: 'group', 'aria-label': 'Dupin indicatrix, triangle star and Dupin hexagon; its six star vertices move with the arrow keys' });
   svg.append(el('svg:rect', { x: '-1e6', y: '-1e6', width: '2e6', height: '2e6', fill: '#101218' }));
   layer = el('svg:g', { transform: 'scale(1,-1)' });
   svg.append(layer);

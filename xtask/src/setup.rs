@@ -88,7 +88,12 @@ pub fn ensure(browser: bool) -> Result<Vec<String>> {
             installed.push(format!("apt: {}", APT_PACKAGES.join(", ")));
         }
         let e2e = root().join("tests/e2e");
-        let packages = ["playwright-core", "dxf-parser", "gltf-validator"];
+        let packages = [
+            "playwright-core",
+            "dxf-parser",
+            "gltf-validator",
+            "@axe-core/playwright",
+        ];
         if packages
             .iter()
             .any(|p| !e2e.join("node_modules").join(p).exists())
