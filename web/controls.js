@@ -58,7 +58,7 @@ function anchorsField(anchors, onClear) {
 
 // One labelled field: a numeric input (optionally with a slider, linear or, with `log`, over
 // decades) and its message slot.
-function numberField({ id, label, value, min, max, step = 'any', slider = false, log = false, title = '', onCommit }) {
+function numberField({ id, label, value, min, max, step = 'any', slider = false, log = false, range: span = null, title = '', onCommit }) {
   const input = el('input', { type: 'number', step, value: value ?? '', title });
   if (min !== undefined) input.min = min;
   if (max !== undefined) input.max = max;
@@ -68,9 +68,10 @@ function numberField({ id, label, value, min, max, step = 'any', slider = false,
   msg.dataset.for = id;
   const parts = [el('span', { className: 'field-label', textContent: label })];
   let range = null;
-  if (slider && Number.isFinite(min) && Number.isFinite(max)) {
+  const [smin, smax] = span ?? [min, max];
+  if (slider && Number.isFinite(smin) && Number.isFinite(smax)) {
     // A log slider moves the exponent, 100 steps a decade.
-    const [lo, hi] = log ? [Math.log10(min), Math.log10(max)] : [min, max];
+    const [lo, hi] = log ? [Math.log10(smin), Math.log10(smax)] : [smin, smax];
     const toRange = (v) => (log ? Math.log10(v) : v);
     const fromRange = (r) => (log ? Number((10 ** r).toPrecision(3)) : r);
     const rangeStep = log ? 0.01 : step === 'any' ? (hi - lo) / 200 : step;
@@ -176,13 +177,35 @@ export function buildFields(box, c, { catalog, torusParams, defaults, onChange }
   const run = (apply, id) => onChange((n) => apply(n.free), id);
   runFields(box, c.free, run, defaults, null, () => {
     for (const p of surface?.params ?? []) {
+      const { range, log } = sliderSpan(p);
       box.append(numberField({
         id: `param-${p.key}`, label: p.key, value: c.params[p.key], min: p.min, max: p.max,
-        step: p.integer ? 1 : 'any', slider: true, title: `${p.doc} [${p.min}, ${p.max}]`,
+        step: p.integer ? 1 : 'any', slider: true, range, log, title: `${p.doc} [${p.min}, ${p.max}]; the slider spans ${range[0]}..${range[1]}, type any value in range`,
         onCommit: (v, id) => onChange((n) => { n.params[p.key] = v ?? NaN; }, id),
       }));
     }
   });
+}
+
+/**
+ * The slider of a surface parameter spans the values people use, not the whole range the core
+ * accepts (1e-6..1e6 for a length would leave R = 2 at the far left): positive parameters over
+ * four decades around the default on a log scale, others ten times the default either side;
+ * integers their whole range. Typed values reach the rest.
+ */
+/** A small default as `1e-6` rather than `0.000001`, so that it fits its field. */
+const compact = (x) => (x !== 0 && Math.abs(x) < 1e-3 ? x.toExponential() : String(x));
+
+export function sliderSpan(p) {
+  const clamp = (x) => Math.min(p.max, Math.max(p.min, x));
+  if (p.integer) return { range: [p.min, p.max], log: false };
+  const d = p.default;
+  if (d > 0 && p.max > 0) {
+    const lo = clamp(Math.max(d / 100, p.min > 0 ? p.min : d / 100));
+    return { range: [lo, clamp(d * 100)], log: lo > 0 };
+  }
+  const w = d === 0 ? 1 : 10 * Math.abs(d);
+  return { range: [clamp(d - w), clamp(d + w)], log: false };
 }
 
 /**
@@ -208,7 +231,7 @@ function runFields(box, s, onChange, defaults, unit, between = () => {}) {
   ];
   for (const [k, label, title] of run) {
     box.append(numberField({
-      id: `free-${k}`, label, value: s[k] ?? (k === 'size' ? '' : defaults[k]), title,
+      id: `free-${k}`, label, value: s[k] ?? (k === 'size' ? '' : compact(defaults[k])), title,
       onCommit: (v, id) => onChange((t) => { t[k] = v; }, id),
     }));
   }

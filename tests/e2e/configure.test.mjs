@@ -187,3 +187,26 @@ test('WebGL2 fallback steps a scene in the worker', async () => {
     await browser.close();
   }
 });
+
+test('free mode: sliders span the values people use, on a log scale for lengths', async () => {
+  const { browser, page, errors } = await openPage({ hash: '#scene=free&surface=torus&size=0.6' });
+  try {
+    await page.waitForFunction(() => document.querySelector('[data-testid=metrics]').dataset.steps === '1', null, { timeout: 60_000 });
+    const slider = byId(page, 'param-R-slider');
+    // R = 2 sits mid-slider (log scale over 0.02..200), not at the far left of 1e-6..1e6.
+    const pos = await slider.evaluate((s) => (Number(s.value) - Number(s.min)) / (Number(s.max) - Number(s.min)));
+    assert.ok(pos > 0.4 && pos < 0.6, `R = 2 at ${pos} of the slider`);
+    // Moving the slider sets a readable value in the field (three significant digits).
+    await slider.evaluate((s) => { s.value = '0.5'; s.dispatchEvent(new Event('input')); s.dispatchEvent(new Event('change')); });
+    await page.waitForFunction(() => /p\.R=3\.1\d(&|$)/.test(location.hash), null, { timeout: 60_000 });
+    const typed = await byId(page, 'param-R').inputValue();
+    assert.match(typed, /^3\.1\d$/);
+    assert.match(page.url(), new RegExp(`p\\.R=${typed.replace('.', '\\.')}(&|$)`));
+    // The mu field shows its whole default.
+    const mu = byId(page, 'free-mu');
+    assert.ok(await mu.evaluate((e) => e.scrollWidth <= e.clientWidth + 1), 'mu fits its field');
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
