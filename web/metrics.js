@@ -31,6 +31,16 @@ function setText(node, text) {
   if (node.textContent !== text) node.textContent = text;
 }
 
+/** How many panels are not convex, and why that is no defect for P-Hex. */
+function nonConvex(m) {
+  const n = m.nonConvexFaces ?? 0;
+  if (n === 0) return '0';
+  const why = m.level === undefined
+    ? 'where K < 0 a P-Hex hexagon is non-convex (P-Hex paper, sec. 4.2): planar and valid'
+    : 'planar, but not convex';
+  return `${n} of ${m.faces}: ${why}`;
+}
+
 /** Writes metrics `m` (from Session.step/metrics, plus `ms` and `steps`) into `dl`. */
 export function showMetrics(dl, m, { panelEdge }) {
   // An opened design is measured in its own unit; a scene at the page's panel edge.
@@ -43,6 +53,7 @@ export function showMetrics(dl, m, { panelEdge }) {
     maxPlanarity: m.maxPlanarity,
     meanPlanarity: m.meanPlanarity ?? 0,
     invalidFaces: m.invalidFaces ?? 0,
+    nonConvexFaces: m.nonConvexFaces ?? 0,
     steps: m.steps ?? 0,
     // PQ scenes: level and the scene's residuals (absent attributes for other runs).
     maxDeviationMm: m.deviationMm?.[0], meanDeviationMm: m.deviationMm?.[1],
@@ -55,6 +66,7 @@ export function showMetrics(dl, m, { panelEdge }) {
     ['max planarity', planarity(m.maxPlanarity, edge)],
     ['mean planarity', planarity(m.meanPlanarity ?? 0, edge)],
     ['invalid faces', m.invalidFaces ?? 0],
+    ['non-convex panels', nonConvex(m)],
     ['step time', m.ms === undefined ? '–' : `${m.ms.toFixed(1)} ms`],
   ];
   if (m.level !== undefined) rows.splice(1, 1, ['level', `${m.level} of ${m.levels}`]);

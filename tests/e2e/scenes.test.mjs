@@ -83,3 +83,20 @@ test('every contract scene steps to completion with planar faces', async () => {
     await browser.close();
   }
 });
+
+test('non-convex P-Hex panels are counted, with the paper\'s reason', async () => {
+  const { browser, page, errors } = await openPage({ hash: '#scene=hyperboloid-valid' });
+  try {
+    await page.waitForFunction(() => document.querySelector('[data-testid=metrics]').dataset.steps === '1', null, { timeout: 60_000 });
+    await byId(page, 'play').click();
+    await page.waitForFunction(() => ['done', 'warning'].includes(document.querySelector('[data-testid=metrics]').dataset.phase), null, { timeout: 180_000 });
+    const n = Number(await byId(page, 'metrics').getAttribute('data-non-convex-faces'));
+    const faces = Number(await byId(page, 'metrics').getAttribute('data-faces'));
+    // The hyperboloid has K < 0 everywhere: its hexagons are non-convex (section 4.2).
+    assert.ok(n > faces / 2, `${n} of ${faces}`);
+    assert.match(await page.locator('[data-metric="non-convex-panels"]').textContent(), new RegExp(`^${n} of ${faces}: where K < 0 a P-Hex hexagon is non-convex \\(P-Hex paper, sec\\. 4\\.2\\)`));
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});

@@ -17,8 +17,7 @@ use dupin_core::mesh::{
     planarity_color, planarity_histogram, regularity_color, write_obj,
 };
 use dupin_core::phex::{
-    Initialisation, LayerRule, PhexConfig, PhexGoals, PhexPipeline, TriangulationMethod,
-    count_invalid_faces, face_info,
+    Initialisation, LayerRule, PhexConfig, PhexGoals, PhexPipeline, TriangulationMethod, face_info,
 };
 use dupin_core::scenes::{PHEX_SCENES, PQ_SCENES, phex_scene, pq_scene_stepper};
 use dupin_core::surface::surface_catalog;
@@ -127,6 +126,8 @@ struct Metrics {
     /// and mean, in millimetres.
     #[serde(skip_serializing_if = "Option::is_none")]
     deviation_mm: Option<[f64; 2]>,
+    /// Simple faces that are not convex (a P-Hex hexagon where K < 0 is, by section 4.2).
+    non_convex_faces: usize,
     /// An opened design: the current mesh's mean edge in metres (its planarity in mm follows
     /// from it, not from the page's panel edge).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -946,6 +947,13 @@ impl Session {
         let mean_planarity = mean_planarity(&per_face);
         let histogram = planarity_histogram(&per_face);
         let hist_log10 = [PLANARITY_HIST_LO, PLANARITY_HIST_HI];
+        // One pass over the faces: self-intersecting ones, and simple ones that are not convex.
+        let (mut self_intersecting, mut non_convex_faces) = (0, 0);
+        for i in 0..mesh.num_faces() {
+            let f = face_info(&mesh, i, 0.0);
+            self_intersecting += usize::from(!f.simple);
+            non_convex_faces += usize::from(f.simple && !f.convex);
+        }
         let mean_edge_m = self
             .design
             .as_ref()
@@ -983,6 +991,7 @@ impl Session {
                     singular_points_inside: None,
                     design: self.design.clone(),
                     deviation_mm: None,
+                    non_convex_faces,
                     mean_edge_m,
                 }
             }
@@ -1021,7 +1030,7 @@ impl Session {
                     max_planarity,
                     mean_planarity,
                     // Self-intersecting panels, tested in each face's plane.
-                    invalid_faces: count_invalid_faces(&mesh),
+                    invalid_faces: self_intersecting,
                     histogram,
                     hist_log10,
                     level: Some(level),
@@ -1032,6 +1041,7 @@ impl Session {
                     singular_points_inside,
                     design: self.design.clone(),
                     deviation_mm: self.design.as_ref().and_then(|d| d.deviation_mm(&mesh)),
+                    non_convex_faces,
                     mean_edge_m,
                 }
             }
