@@ -112,7 +112,7 @@ function load(next, { reframe = true, field = null, rebuild = false } = {}) {
       meshNext = null;
       config = next;
       showMesh(m, reframe);
-      lastMetrics = { phase: 'done', iteration: 0, faces: m.triangleCount, vertices: m.vertexCount, maxPlanarity: 0 };
+      lastMetrics = { phase: 'done', preview: true, iteration: 0, faces: m.triangleCount, vertices: m.vertexCount, maxPlanarity: 0 };
       showMetrics(metricsEl, lastMetrics, config);
       drawHistogram($('histogram'), {});
       showLayers({ unavailable: 'the torus preview is a smooth surface: offset and support beams need a conical scene (conical-station)', info: null });

@@ -60,7 +60,13 @@ export function showMetrics(dl, m, { panelEdge }) {
     level: m.level, levels: m.levels, conicalResidual: m.conicalResidual, circularResidual: m.circularResidual, maxDeterminant: m.maxDeterminant, singularPointsInside: m.singularPointsInside,
   };
   for (const [k, v] of Object.entries(data)) setData(dl, k, v);
-  const rows = [
+  // The torus preview is a smooth surface, not a run: no planarity figures to read.
+  const rows = m.preview ? [
+    ['showing', 'a smooth surface preview, no panels yet'],
+    ['triangles', m.faces],
+    ['vertices', m.vertices],
+    ['next', 'pick a scene and press Play, or open your design'],
+  ] : [
     ['phase', m.phase], ['layer', m.layer ?? 0], ['iteration', m.iteration], ['faces', m.faces],
     ['vertices', m.vertices],
     ['max planarity', planarity(m.maxPlanarity, edge)],
@@ -69,7 +75,7 @@ export function showMetrics(dl, m, { panelEdge }) {
     ['non-convex panels', nonConvex(m)],
     ['step time', m.ms === undefined ? '–' : `${m.ms.toFixed(1)} ms`],
   ];
-  if (m.level !== undefined) rows.splice(1, 1, ['level', `${m.level} of ${m.levels}`]);
+  if (m.level !== undefined && !m.preview) rows.splice(1, 1, ['level', `${m.level} of ${m.levels}`]);
   if (m.conicalResidual !== undefined) rows.push(['conical residual', `${exp(m.conicalResidual)} rad`]);
   if (m.circularResidual !== undefined) rows.push(['circular residual', exp(m.circularResidual)]);
   if (m.maxDeterminant !== undefined) rows.push(['max determinant', exp(m.maxDeterminant)]);

@@ -135,6 +135,9 @@ test('every scene says in one sentence what it shows, with its paper figure', as
   const { browser, page, errors } = await openPage();
   try {
     assert.match(await byId(page, 'scene-description').textContent(), /flat panels.*press Play/);
+    // The torus preview reads as a preview, not as a finished run with zero planarity.
+    assert.match(await byId(page, 'metrics').textContent(), /smooth surface preview, no panels yet/);
+    assert.doesNotMatch(await byId(page, 'metrics').textContent(), /max planarity/);
     const scenes = await byId(page, 'scene-select').evaluate((s) => [...s.options].map((o) => o.value));
     for (const scene of scenes.filter((s) => !['torus', 'free'].includes(s))) {
       await byId(page, 'scene-select').selectOption(scene);
