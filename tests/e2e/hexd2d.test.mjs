@@ -116,3 +116,21 @@ test('2D tab: a point set runs to the end at once, and the picture leaves as SVG
     await browser.close();
   }
 });
+
+test('2D tab on a phone: the picture fits the screen and a tap adds a point where it lands', async () => {
+  const { browser, page, errors } = await openPage();
+  try {
+    await page.setViewportSize({ width: 390, height: 844 });
+    await byId(page, 'hexd').click();
+    const canvas = byId(page, 'hexd-canvas');
+    await canvas.scrollIntoViewIfNeeded();
+    const box = await canvas.boundingBox();
+    assert.ok(box.x >= 0 && box.x + box.width <= 390.5, `canvas spans ${box.x}..${box.x + box.width}`);
+    await page.mouse.click(box.x + box.width / 2, box.y + box.height / 2);
+    await page.waitForFunction(() => /^1 points/.test(document.querySelector('[data-testid=hexd-status]').textContent));
+    assert.ok(await byId(page, 'hexd-run').isVisible());
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
