@@ -69,14 +69,14 @@ impl MeshRenderer {
         };
         let bind_group = make_group(&uniforms);
         let line_bind_group = make_group(&line_uniforms);
-        let pipeline = |topology, fs, constant| {
+        let pipeline = |topology, vs, fs, slope_scale| {
             let bias = wgpu::DepthBiasState {
-                constant,
-                slope_scale: 0.0,
+                constant: 0,
+                slope_scale,
                 clamp: 0.0,
             };
             let spec = PipelineSpec {
-                vertex: "vs_main",
+                vertex: vs,
                 fragment: Some((fs, format, None)),
                 topology,
                 depth_write: true,
@@ -85,9 +85,15 @@ impl MeshRenderer {
             };
             gpu_mesh::pipeline(device, &layout, &shader, spec)
         };
-        // Push triangles back a little so edges drawn on top of them win the depth test.
-        let tri_pipeline = pipeline(wgpu::PrimitiveTopology::TriangleList, "fs_main", 2);
-        let line_pipeline = pipeline(wgpu::PrimitiveTopology::LineList, "fs_line", 0);
+        // Faces also step back by their own depth slope (a pixel's worth), which keeps the
+        // far, nearly edge-on outlines whole where `vs_line`'s pull alone is too small.
+        let tri_pipeline = pipeline(
+            wgpu::PrimitiveTopology::TriangleList,
+            "vs_main",
+            "fs_main",
+            1.0,
+        );
+        let line_pipeline = pipeline(wgpu::PrimitiveTopology::LineList, "vs_line", "fs_line", 0.0);
         MeshRenderer {
             format,
             tri_pipeline,
