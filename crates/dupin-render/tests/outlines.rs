@@ -9,7 +9,7 @@ use dupin_core::mesh::TriangleBuffers;
 use dupin_render::{OffscreenImage, OrbitCamera, render_offscreen};
 
 mod common;
-use common::{H, W, expect_image, save};
+use common::{H, W, expect_image, reference_image, save};
 
 /// A flat `n` x `n` grid of unit quads at height `z` (two triangles each), and its quad edges as
 /// line segments.
@@ -95,6 +95,30 @@ fn outlines_are_continuous_from_steep_and_grazing_views() {
             kept * 100.0
         );
     }
+}
+
+#[test]
+fn outlined_grid_matches_reference_image() {
+    let (mesh, lines) = grid(10, 0.0);
+    let cam = OrbitCamera::framing_points(&mesh.positions);
+    let img = expect_image(render_offscreen(&mesh, Some(&lines), &cam, W, H));
+    let actual = save(&img, "outlines.png");
+    let (want, reference) = reference_image("outlines.png", &actual);
+    let off = img
+        .rgba
+        .chunks_exact(4)
+        .zip(want.chunks_exact(4))
+        .filter(|(p, q)| (0..3).any(|k| (p[k] as i32 - q[k] as i32).abs() > 24))
+        .count();
+    let fraction = off as f64 / (W * H) as f64;
+    assert!(
+        fraction < 0.005,
+        "render differs from reference ({}): {:.2}% pixels off; adapter {}; see {}",
+        reference.display(),
+        fraction * 100.0,
+        img.adapter,
+        actual.display()
+    );
 }
 
 #[test]
