@@ -3,12 +3,14 @@
 // this file handles clicks and drags and draws into 2D canvases.
 import { HexDelaunayLab, pageSchema } from './pkg/dupin_web.js';
 
-const VIEW = 3.2; // half-height of the shown world square
+const VIEW = 3.2; // half-height of the shown world square when everything fits inside it
+const DOT = 4;    // radius of a drawn point, px
 
 let lab = null;
 let points = [];     // [x, y] world coordinates
 let segments = [];   // [i, j]
 let pendingSeg = null;
+let notice = ''; // a one-off remark on the last click, shown once in the status
 let cells = null;
 let dual = null;
 let inputError = null;
@@ -23,7 +25,22 @@ const el = (tag, attrs = {}, text) => {
   return e;
 };
 
-function scale() { return Math.min(canvas.width, canvas.height) / (2 * VIEW); }
+let viewHalf = VIEW; // grows so every point and the refined triangulation stay in the picture
+
+/**
+ * The half-size of the world square to show: VIEW, or more when the points or the refined
+ * triangulation reach further. The empty cells around the bounding hexagon are only context and
+ * may leave the picture: fitting them would zoom out at every click near the border.
+ */
+function fitView() {
+  let far = 0;
+  const reach = (xy) => { for (const c of xy) far = Math.max(far, Math.abs(c)); };
+  if (dual && lab?.steps() > 0) reach(dual.vertices);
+  reach(points.flat());
+  viewHalf = Math.max(VIEW, far * 1.04);
+}
+
+function scale() { return Math.min(canvas.width, canvas.height) / (2 * viewHalf); }
 function toScreen([x, y]) { const s = scale(); return [canvas.width / 2 + x * s, canvas.height / 2 - y * s]; }
 function toWorld(px, py) { const s = scale(); return [(px - canvas.width / 2) / s, (canvas.height / 2 - py) / s]; }
 
@@ -45,6 +62,7 @@ function refresh() {
     cells = lab ? lab.cells() : null;
     dual = lab ? lab.dual() : null;
   } catch (e) { inputError = String(e.message ?? e); }
+  fitView();
   draw();
   drawHistogram();
   const done = !lab || lab.done();
@@ -60,9 +78,12 @@ function refresh() {
   const segmentHint = toolSel.value !== 'segments' ? ''
     : pendingSeg === null ? ' · segments: click a point (or empty space for a new one), then the other end'
       : ' · now click the segment\'s other end';
+  const said = notice;
+  notice = '';
   if (inputError) statusEl.textContent = inputError;
   else if (points.length === 0) statusEl.textContent = `Click to add points, drag to move them, or pick a point set.${segmentHint}`;
-  else statusEl.textContent = `${points.length} points · ${segments.length} segments · step ${lab.steps()}${done ? ' (done)' : ''} · ${tri} triangles · angles ${dual.minAngle.toFixed(1)}°–${dual.maxAngle.toFixed(1)}°${segmentHint}`;
+  else if (lab.steps() === 0) statusEl.textContent = `${points.length} points · ${segments.length} segments · press Step or Run to refine${segmentHint}${said}`;
+  else statusEl.textContent = `${points.length} points · ${segments.length} segments · step ${lab.steps()}${done ? ' (done)' : ''} · ${tri} triangles · angles ${dual.minAngle.toFixed(1)}°–${dual.maxAngle.toFixed(1)}°${segmentHint}${said}`;
 }
 
 function draw() {
@@ -86,7 +107,8 @@ function draw() {
       k += n;
     });
   }
-  if (dual && dual.triangles.length) {
+  // Before the first step the dual is only the bounding hexagon's 7 cell centres: nothing to read.
+  if (dual && dual.triangles.length && lab?.steps() > 0) {
     g.strokeStyle = '#e6e8ee';
     g.lineWidth = 0.8;
     g.beginPath();
@@ -105,7 +127,7 @@ function draw() {
   points.forEach((p, i) => {
     const [x, y] = toScreen(p);
     g.fillStyle = i === pendingSeg ? '#ff9e64' : '#f2c14e';
-    g.beginPath(); g.arc(x, y, 4, 0, Math.PI * 2); g.fill();
+    g.beginPath(); g.arc(x, y, DOT, 0, Math.PI * 2); g.fill();
   });
 }
 
@@ -173,7 +195,8 @@ function pictureSvg() {
       k += n;
     });
   }
-  if (dual && dual.triangles.length) {
+  // Before the first step the dual is only the bounding hexagon's 7 cell centres: nothing to read.
+  if (dual && dual.triangles.length && lab?.steps() > 0) {
     const v = dual.vertices;
     for (let t = 0; t < dual.triangles.length; t += 3) {
       const c = [0, 1, 2].map((q) => pt([v[2 * dual.triangles[t + q]], v[2 * dual.triangles[t + q] + 1]]));
@@ -199,8 +222,9 @@ function save(name, blob) {
   setTimeout(() => URL.revokeObjectURL(url), 1000);
 }
 
-function nearest(px, py) {
-  let best = -1, bd = 10;
+/** The point within `reach` px of (px, py), nearest first, or -1. */
+function nearest(px, py, reach = 10) {
+  let best = -1, bd = reach;
   points.forEach((p, i) => {
     const [x, y] = toScreen(p);
     const d = Math.hypot(x - px, y - py);
@@ -211,9 +235,13 @@ function nearest(px, py) {
 
 function wire() {
   let dragging = -1;
-  canvas.addEventListener('pointerdown', (e) => {
+  let press = null; // where a press near a point started, to tell a click beside it from a drag
+  const at = (e) => {
     const r = canvas.getBoundingClientRect();
-    const px = (e.clientX - r.left) * (canvas.width / r.width), py = (e.clientY - r.top) * (canvas.height / r.height);
+    return [(e.clientX - r.left) * (canvas.width / r.width), (e.clientY - r.top) * (canvas.height / r.height)];
+  };
+  canvas.addEventListener('pointerdown', (e) => {
+    const [px, py] = at(e);
     let i = nearest(px, py);
     if (toolSel.value === 'segments') {
       if (i < 0) { points.push(toWorld(px, py)); i = points.length - 1; }
@@ -223,18 +251,32 @@ function wire() {
       return;
     }
     if (i < 0) { points.push(toWorld(px, py)); restart(); return; }
+    // Near a point: a drag moves it; a click that did not land on its dot still adds a point
+    // (a grab radius larger than the dot must not swallow clicks beside it).
     dragging = i;
+    press = { px, py, moved: false, onDot: nearest(px, py, DOT + 2) >= 0 };
     canvas.setPointerCapture(e.pointerId);
   });
   canvas.addEventListener('pointermove', (e) => {
     if (dragging < 0) return;
-    const r = canvas.getBoundingClientRect();
-    points[dragging] = toWorld((e.clientX - r.left) * (canvas.width / r.width), (e.clientY - r.top) * (canvas.height / r.height));
+    const [px, py] = at(e);
+    if (!press.moved && Math.hypot(px - press.px, py - press.py) < 3) return;
+    press.moved = true;
+    points[dragging] = toWorld(px, py);
     restart();
   });
-  const up = () => { dragging = -1; };
-  canvas.addEventListener('pointerup', up);
-  canvas.addEventListener('pointercancel', up);
+  canvas.addEventListener('pointerup', () => {
+    if (dragging >= 0 && !press.moved && !press.onDot) {
+      points.push(toWorld(press.px, press.py));
+      restart();
+    } else if (dragging >= 0 && !press.moved) {
+      // Said, so a click on a dot is not mistaken for a lost click.
+      notice = ' · a point is already there: drag it to move it';
+      refresh();
+    }
+    dragging = -1;
+  });
+  canvas.addEventListener('pointercancel', () => { dragging = -1; });
   stepBtn.addEventListener('click', () => {
     try { lab.step(); } catch (e) { inputError = String(e.message ?? e); }
     refresh();

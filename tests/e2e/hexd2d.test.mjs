@@ -52,6 +52,53 @@ test('2D tab: click points, step to completion, angles within [30, 120]', async 
   }
 });
 
+test('2D tab: no click is lost, nothing is drawn before a step, the picture stays on the canvas', async () => {
+  const { browser, page, errors } = await openPage();
+  try {
+    await byId(page, 'hexd').click();
+    const canvas = byId(page, 'hexd-canvas');
+    const box = await canvas.boundingBox();
+    const status = byId(page, 'hexd-status');
+    const count = async () => Number((await status.textContent()).split(' ')[0]);
+    // Bright pixels of the dual triangulation's lines (#e6e8ee), all over and on the border.
+    const bright = () => page.evaluate(() => {
+      const c = document.querySelector('[data-testid=hexd-canvas]');
+      const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+      let all = 0, border = 0;
+      for (let y = 0; y < c.height; y++) for (let x = 0; x < c.width; x++) {
+        const k = 4 * (y * c.width + x);
+        if (d[k] > 150 && d[k + 1] > 150 && d[k + 2] > 150) {
+          all++;
+          if (x < 2 || y < 2 || x >= c.width - 2 || y >= c.height - 2) border++;
+        }
+      }
+      return { all, border };
+    });
+    // Points near the corners of the canvas: their bounding hexagon reaches far outside it.
+    const spots = [[0.04, 0.05], [0.95, 0.06], [0.5, 0.5], [0.06, 0.94], [0.93, 0.95], [0.3, 0.7]];
+    for (const [fx, fy] of spots) await page.mouse.click(box.x + fx * box.width, box.y + fy * box.height);
+    assert.equal(await count(), spots.length);
+    assert.match(await status.textContent(), /press Step or Run/);
+    assert.equal((await bright()).all, 0, 'no triangulation drawn before the first step');
+    // A click 8 px beside a point (inside the 10 px grab radius, off its dot) adds a point...
+    await page.mouse.click(box.x + 0.5 * box.width + 8, box.y + 0.5 * box.height);
+    assert.equal(await count(), spots.length + 1);
+    // ...and one on a dot says why nothing was added.
+    await page.mouse.click(box.x + 0.5 * box.width, box.y + 0.5 * box.height);
+    assert.equal(await count(), spots.length + 1);
+    assert.match(await status.textContent(), /already there: drag it/);
+    await byId(page, 'hexd-run').click();
+    await page.waitForFunction(() => document.querySelector('[data-testid=hexd-status]').dataset.done === 'true', null, { timeout: 60_000 });
+    const lit = await bright();
+    assert.ok(lit.all > 1000, `${lit.all} triangulation pixels after the run`);
+    assert.equal(lit.border, 0, 'the triangulation reaches the canvas border');
+    await canvas.screenshot({ path: `${SHOTS}/hexd-corners.png` });
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
+
 test('2D tab: segments are accepted and the extended mode surfaces any core message inline', async () => {
   const { browser, page } = await openPage();
   try {
