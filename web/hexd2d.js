@@ -169,7 +169,9 @@ function pointSet(kind) {
   let seed = 12345;
   const rnd = () => { seed = (seed * 1103515245 + 12345) % 2147483648; return seed / 2147483648; };
   const r = VIEW * 0.8;
-  if (kind === 'random') return Array.from({ length: 40 }, () => [(2 * rnd() - 1) * r, (2 * rnd() - 1) * r]);
+  if (kind === 'random' || kind === 'dense') {
+    return Array.from({ length: kind === 'dense' ? 300 : 30 }, () => [(2 * rnd() - 1) * r, (2 * rnd() - 1) * r]);
+  }
   if (kind === 'clustered') {
     const centres = [[-1.2, 0.8], [1.1, -0.6], [0.2, 1.6]];
     return Array.from({ length: 45 }, (_, i) => {
@@ -329,7 +331,7 @@ export function initHexd2d() {
   const clear = el('button', { type: 'button', 'data-testid': 'hexd-clear' }, 'Clear');
   clear.addEventListener('click', () => { clearTimeout(running); points = []; segments = []; pendingSeg = null; restart(); });
   const setSel = el('select', { 'data-testid': 'hexd-points', 'aria-label': 'Point set' });
-  setSel.append(new Option('point set…', ''), new Option('random (40)', 'random'), new Option('clustered (45)', 'clustered'), new Option('on a line (16)', 'line'));
+  setSel.append(new Option('point set…', ''), new Option('random (30)', 'random'), new Option('dense (300)', 'dense'), new Option('clustered (45)', 'clustered'), new Option('on a line (16)', 'line'));
   setSel.addEventListener('change', () => {
     if (!setSel.value) return;
     clearTimeout(running);

@@ -6,7 +6,7 @@
 import init, { MeshData, Viewer, colorLegend, freeDefaults, pageSchema, sceneDescription, sceneNames, surfaceCatalog, torusMesh } from './pkg/dupin_web.js';
 import { FREE, IMPORTED, defaults, readHash, sessionConfig, useSchema, writeHash } from './config.js';
 import { buildFields, clearFieldErrors, fillScenePicker, showFieldError } from './controls.js';
-import { drawHistogram, drawLegend, showMetrics } from './metrics.js';
+import { drawHistogram, drawLegend, showMetrics, showProgress } from './metrics.js';
 import { Solver } from './solver.js';
 import { initTeach, showPick } from './teach.js';
 import { initHexd2d } from './hexd2d.js';
@@ -41,6 +41,11 @@ const marker = document.createElement('div');
 const stepLog = [];      // per-step { phase, faces, ms } for benchmarks (window.dupin.stepLog)
 let settled = false;      // something was shown or reported (the first frame may count as ready)
 let opened = null;        // the design the user opened: { name, bytes } (never leaves the page)
+// A first visit (no hash) opens on a finished, attractive result rather than an empty scene, with
+// a line saying what Dupin does; any choice of the user's own ends the welcome.
+const OPENING = { scene: 'cyclide-architecture', what: 'the P-Hex paper\'s Fig. 1, 3 200 planar hexagons on a Dupin cyclide' };
+let welcome = false;
+let runT0 = 0;            // when the run on show was loaded (its progress estimate starts there)
 
 function showStatus(text, isError = false) {
   statusEl.textContent = text;
@@ -50,7 +55,10 @@ function showStatus(text, isError = false) {
 // Only when the hash changed: replaceState per worker message was main-thread work for nothing.
 /** One line for people about what is on screen and what to press. */
 function describe(c) {
-  const text = c.scene === 'torus'
+  $('scene-description').classList.toggle('welcome', welcome && c.scene === OPENING.scene);
+  const text = welcome && c.scene === OPENING.scene
+    ? `Dupin turns freeform designs into exactly planar panels for flat glass or metal. This is ${OPENING.what}: drag to orbit it, Reset then Play to watch it computed, or pick a scene or open your own design.`
+    : c.scene === 'torus'
     ? 'Dupin makes freeform designs buildable from flat panels. Pick a scene from the papers and press Play, or open your own design.'
     : c.scene === FREE
       ? 'Any library surface panelled by P-Hex: choose the surface, method, panel size and weights, then press Play.'
@@ -114,6 +122,7 @@ function load(next, { reframe = true, field = null, rebuild = false } = {}) {
       showMesh(m, reframe);
       lastMetrics = { phase: 'done', preview: true, iteration: 0, faces: m.triangleCount, vertices: m.vertexCount, maxPlanarity: 0 };
       showMetrics(metricsEl, lastMetrics, config);
+      showProgress($('progress'), lastMetrics, { show: false, recentMs: [] });
       drawHistogram($('histogram'), {});
       showLayers({ unavailable: 'the torus preview is a smooth surface: offset and support beams need a conical scene (conical-station)', info: null });
       if (field) showFieldError(fieldsBox, field, '');
@@ -138,6 +147,7 @@ function load(next, { reframe = true, field = null, rebuild = false } = {}) {
   }
   lastFaces = 0;
   lastPhase = '';
+  runT0 = performance.now();
   userMoved = !!pendingCamera;
   candidate = { config: next, field, reframe, rebuild };
   const file = next.scene === IMPORTED ? { name: opened.name, bytes: opened.bytes } : null;
@@ -167,6 +177,7 @@ function watchRead(pending, name) {
  * it; a file it cannot read leaves the current run on screen and says why. */
 async function openDesign(file) {
   if (!file) return;
+  welcome = false;
   let bytes;
   try {
     bytes = new Uint8Array(await file.arrayBuffer());
@@ -319,6 +330,9 @@ function showPanel() {
   const { m, entry } = panelNext;
   panelNext = null;
   showMetrics(metricsEl, m, config);
+  // The bar: after a second of playing (short runs would only flash it), or while stepping.
+  const recentMs = stepLog.slice(-5).filter((e) => e.at >= runT0 && e.phase === m.phase && Number.isFinite(e.ms)).map((e) => e.ms);
+  showProgress($('progress'), m, { show: !done && !m.preview && (playing ? performance.now() - runT0 > 1000 : (m.steps ?? 0) > 1), recentMs });
   const t2 = performance.now();
   drawHistogram($('histogram'), m);
   const t3 = performance.now();
@@ -689,6 +703,7 @@ async function main() {
     openDesign(e.dataTransfer.files[0]);
   });
   $('scene-select').addEventListener('change', (e) => {
+    welcome = false;
     const next = defaults();
     Object.assign(next, { scene: e.target.value, color: config.color, panelEdge: config.panelEdge, layers: config.layers, backend: config.backend });
     if (next.scene === 'torus') for (const [k, s] of Object.entries(TORUS)) next.params[k] = s.value;
@@ -711,7 +726,7 @@ async function main() {
     updateButtons();
   });
   $('stop').addEventListener('click', stop);
-  $('reset').addEventListener('click', () => { if (running) load({ ...config, steps: 1 }, { reframe: true }); });
+  $('reset').addEventListener('click', () => { welcome = false; if (running) load({ ...config, steps: 1 }, { reframe: true }); });
   $('color-mode').addEventListener('change', (e) => setColorMode(e.target.value));
   $('panel-edge').addEventListener('change', (e) => {
     const v = Number(e.target.value);
@@ -750,7 +765,11 @@ async function main() {
     opened = await loadDesign();
     if (opened) fillScenePicker($('scene-select'), ctx.scenes, opened.name);
   }
-  restore(location.hash);
+  if (location.hash === '' || location.hash === '#') {
+    welcome = true;
+    // Replayed to the end in the worker (about 0.1 s), so the first picture is the finished roof.
+    restore(`#scene=${OPENING.scene}&steps=100000`);
+  } else restore(location.hash);
   requestAnimationFrame(frame);
 }
 

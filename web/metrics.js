@@ -31,6 +31,10 @@ function setText(node, text) {
   if (node.textContent !== text) node.textContent = text;
 }
 
+function setProp(node, key, value) {
+  if (node[key] !== value) node[key] = value;
+}
+
 /** How many panels are not convex, and why that is no defect for P-Hex. */
 function nonConvex(m) {
   const n = m.nonConvexFaces ?? 0;
@@ -152,4 +156,31 @@ export function drawLegend(box, stops) {
     item.append(sw, s.label);
     return item;
   }));
+}
+
+/**
+ * The progress bar of a run (`box` holds a <progress> and a text span): the share of steps done
+ * under the core's upper bound on the steps left (`m.stepsLeftAtMost`; an iterative phase counts
+ * its cap, so the bar may jump to the end when it converges early), and the time that bound takes
+ * at the pace of `recentMs` (the last steps' worker times). Hidden when `show` is false.
+ */
+export function showProgress(box, m, { show, recentMs }) {
+  const left = m.stepsLeftAtMost;
+  const visible = show && Number.isFinite(left) && left > 0;
+  setProp(box, 'hidden', !visible);
+  if (!visible) return;
+  const steps = m.steps ?? 0;
+  const [bar, text] = box.children;
+  setProp(bar, 'value', steps / (steps + left));
+  const pace = recentMs.length ? recentMs.reduce((a, b) => a + b, 0) / recentMs.length : null;
+  const eta = pace === null ? '' : ` · ${duration((pace * left) / 1000)} at the current pace`;
+  setText(text, `step ${steps} · at most ${left} more${eta}`);
+  setData(box, 'stepsLeft', left);
+}
+
+/** Seconds as a person reads them: "0.4 s", "12 s", "3 min 5 s". */
+function duration(s) {
+  if (s < 10) return `${s.toFixed(1)} s`;
+  if (s < 60) return `${Math.round(s)} s`;
+  return `${Math.floor(s / 60)} min ${Math.round(s % 60)} s`;
 }

@@ -2,7 +2,7 @@
 // the flags that give headless WebGPU on SwiftShader (see DEVELOPERS.md), screenshots saved
 // under target/e2e/ and pixel statistics computed in the page (no image library needed).
 import { chromium } from 'playwright-core';
-import { mkdirSync, writeFileSync } from 'node:fs';
+import { existsSync, mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { dirname, join } from 'node:path';
 import { fileURLToPath } from 'node:url';
 
@@ -20,13 +20,13 @@ const FLAGS = [
 ];
 
 /** Opens the page; with `webgpu: false` the browser offers no `navigator.gpu` at all. */
-export async function openPage({ webgpu = true, hash = '' } = {}) {
+export async function openPage({ webgpu = true, hash = '', viewport = { width: 960, height: 640 } } = {}) {
   const browser = await chromium.launch({
     executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
     headless: true,
     args: FLAGS,
   });
-  const context = await browser.newContext({ viewport: { width: 960, height: 640 }, acceptDownloads: true });
+  const context = await browser.newContext({ viewport, acceptDownloads: true });
   if (!webgpu) {
     await context.addInitScript(() => {
       Object.defineProperty(Navigator.prototype, 'gpu', { get: () => undefined, configurable: true });
@@ -144,4 +144,39 @@ export function parseObj(text) {
     if (!(idx.length >= 3 && idx.every((i) => Number.isInteger(i) && i >= 1 && i <= v.length))) throw new Error(`bad face ${l}`);
   }
   return { vertices: v.length, faces: f.length };
+}
+
+/**
+ * Compares PNG `actual` with the committed reference `tests/e2e/reference/NAME.png` (decoded in
+ * the page): `{ differing, mean }`, the fraction of pixels farther than 24 levels in some channel
+ * and the mean largest channel difference, as the native render tests measure. With
+ * `DUPIN_BLESS` set, or no reference yet, `actual` becomes the reference first (look at it in
+ * git before committing). A size mismatch counts as every pixel differing.
+ */
+export async function compareWithReference(page, actual, name) {
+  const ref = join(dirname(fileURLToPath(import.meta.url)), 'reference', `${name}.png`);
+  if (process.env.DUPIN_BLESS || !existsSync(ref)) {
+    mkdirSync(dirname(ref), { recursive: true });
+    writeFileSync(ref, actual);
+  }
+  const want = readFileSync(ref);
+  return page.evaluate(async ([a64, b64]) => {
+    const decode = async (s) => {
+      const img = await createImageBitmap(await (await fetch(`data:image/png;base64,${s}`)).blob());
+      const c = new OffscreenCanvas(img.width, img.height);
+      const g = c.getContext('2d');
+      g.drawImage(img, 0, 0);
+      return { w: img.width, h: img.height, d: g.getImageData(0, 0, img.width, img.height).data };
+    };
+    const [p, q] = [await decode(a64), await decode(b64)];
+    if (p.w !== q.w || p.h !== q.h) return { differing: 1, mean: 255, size: [p.w, p.h, q.w, q.h] };
+    let differing = 0, sum = 0;
+    for (let i = 0; i < p.d.length; i += 4) {
+      const d = Math.max(Math.abs(p.d[i] - q.d[i]), Math.abs(p.d[i + 1] - q.d[i + 1]), Math.abs(p.d[i + 2] - q.d[i + 2]));
+      sum += d;
+      if (d > 24) differing++;
+    }
+    const n = p.d.length / 4;
+    return { differing: differing / n, mean: sum / n };
+  }, [actual.toString('base64'), want.toString('base64')]);
 }

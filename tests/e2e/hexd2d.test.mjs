@@ -154,10 +154,38 @@ test('2D tab: a point set runs to the end at once, and the picture leaves as SVG
     }, svg);
     assert.equal(parsed.error, null);
     assert.equal(parsed.open, triangles);
-    assert.equal(parsed.points, 40);
+    assert.equal(parsed.points, 30);
     const [pngDl] = await Promise.all([page.waitForEvent('download'), byId(page, 'hexd-png').click()]);
     const png = (await import('node:fs')).readFileSync(await pngDl.path());
     assert.equal(png.toString('latin1', 1, 4), 'PNG');
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
+
+test('2D tab: Run at once on 30 and 300 random points (the times BENCHMARKS.md quotes)', async () => {
+  const { browser, page, errors } = await openPage();
+  try {
+    await byId(page, 'hexd').click();
+    const status = byId(page, 'hexd-status');
+    for (const [set, n] of [['random', 30], ['dense', 300]]) {
+      await byId(page, 'hexd-points').selectOption(set);
+      assert.match(await status.textContent(), new RegExp(`^${n} points`));
+      const ms = await page.evaluate(() => new Promise((resolve) => {
+        const s = document.querySelector('[data-testid=hexd-status]');
+        const t0 = performance.now();
+        new MutationObserver((_, o) => { if (s.dataset.done === 'true') { o.disconnect(); resolve(performance.now() - t0); } })
+          .observe(s, { attributes: true, attributeFilter: ['data-done'] });
+        document.querySelector('[data-testid=hexd-run]').click();
+      }));
+      const steps = Number(await status.getAttribute('data-steps'));
+      const triangles = Number(await status.getAttribute('data-triangles'));
+      console.log(`# 2D Run at once, ${n} points: ${ms.toFixed(0)} ms, ${steps} steps, ${triangles} triangles`);
+      assert.ok(ms < 10_000, `${n} points took ${ms} ms`);
+      assert.ok(Number(await status.getAttribute('data-min-angle')) >= 30 - 1e-9);
+      assert.ok(Number(await status.getAttribute('data-max-angle')) <= 120 + 1e-9);
+    }
     assert.deepEqual(errors, []);
   } finally {
     await browser.close();

@@ -27,17 +27,27 @@ for (const [backend, webgpu] of [['WebGPU', true], ['WebGL2', false]]) {
   });
 }
 
-test('contract test ids and metrics are present', async () => {
+test('contract test ids and metrics are present; a first visit opens on a finished result', async () => {
   const { browser, page } = await openPage();
   try {
     for (const id of ['canvas', 'scene-select', 'step', 'play', 'reset', 'export-obj', 'status', 'metrics']) {
       assert.equal(await byId(page, id).count(), 1, `data-testid=${id}`);
     }
+    // No hash: the P-Hex paper's Fig. 1 roof, run to the end, and one line on what to press.
     const m = byId(page, 'metrics');
-    assert.equal(await m.getAttribute('data-phase'), 'done');
+    await page.waitForFunction(() => document.querySelector('[data-testid=metrics]').dataset.phase === 'done');
+    assert.equal(await byId(page, 'scene-select').inputValue(), 'cyclide-architecture');
     assert.equal(await m.getAttribute('data-iteration'), '0');
-    assert.ok(Number(await m.getAttribute('data-faces')) > 0);
-    assert.equal(Number(await m.getAttribute('data-max-planarity')), 0);
+    assert.equal(Number(await m.getAttribute('data-faces')), 3200);
+    assert.equal(Number(await m.getAttribute('data-invalid-faces')), 0);
+    assert.ok(Number(await m.getAttribute('data-max-planarity')) < 1e-12);
+    assert.ok(await byId(page, 'step').isDisabled());
+    assert.match(await byId(page, 'scene-description').textContent(), /planar panels .* drag to orbit .* Play .* open your own design/);
+    assert.ok(await byId(page, 'progress').isHidden());
+    // Picking a scene ends the welcome: its own description, ready to play.
+    await byId(page, 'scene-select').selectOption('sphere-radial');
+    await page.waitForFunction(() => document.querySelector('[data-testid=metrics]').dataset.phase !== 'done');
+    assert.doesNotMatch(await byId(page, 'scene-description').textContent(), /drag to orbit/);
   } finally {
     await browser.close();
   }
@@ -82,7 +92,7 @@ test('the exported OBJ parses and has the reported face count', async () => {
 });
 
 test('bad input shows an inline message and leaves the page usable', async () => {
-  const { browser, page, errors } = await openPage();
+  const { browser, page, errors } = await openPage({ hash: '#scene=torus' });
   try {
     const faces = await byId(page, 'metrics').getAttribute('data-faces');
     await byId(page, 'param-R').fill('-5');
@@ -132,7 +142,7 @@ test('phone and tablet: every button is on screen, none overlaps another, the vi
 });
 
 test('every scene says in one sentence what it shows, with its paper figure', async () => {
-  const { browser, page, errors } = await openPage();
+  const { browser, page, errors } = await openPage({ hash: '#scene=torus' });
   try {
     assert.match(await byId(page, 'scene-description').textContent(), /flat panels.*press Play/);
     // The torus preview reads as a preview, not as a finished run with zero planarity.
@@ -146,6 +156,35 @@ test('every scene says in one sentence what it shows, with its paper figure', as
     }
     await byId(page, 'scene-select').selectOption('free');
     assert.match(await byId(page, 'scene-description').textContent(), /library surface/);
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
+
+test('a run shows a progress bar: steps done under the core\'s bound on the steps left, and a time at the current pace', async () => {
+  const { browser, page, errors } = await openPage({ hash: '#scene=cyclide-prescribed' });
+  try {
+    const bar = byId(page, 'progress');
+    const m = byId(page, 'metrics');
+    assert.ok(await bar.isHidden(), 'no bar before the run moves');
+    let lastLeft = Infinity;
+    for (let k = 2; k <= 4; k++) {
+      await byId(page, 'step').click();
+      await page.waitForFunction((n) => document.querySelector('[data-testid=metrics]').dataset.steps === String(n), k);
+      await bar.waitFor({ state: 'visible' });
+      const left = Number(await bar.getAttribute('data-steps-left'));
+      assert.ok(left > 0 && left < lastLeft, `steps left ${left} after ${lastLeft}`);
+      lastLeft = left;
+      const value = await bar.locator('progress').evaluate((p) => p.value);
+      assert.ok(Math.abs(value - k / (k + left)) < 1e-9, `bar at ${value} after ${k} steps with ${left} left`);
+      assert.match(await bar.textContent(), new RegExp(`step ${k} · at most ${left} more · [0-9.]+ (s|min)`));
+    }
+    // Played to the end: the steps taken stay under the first bound, and the bar goes away.
+    await byId(page, 'play').click();
+    await page.waitForFunction(() => ['done', 'warning'].includes(document.querySelector('[data-testid=metrics]').dataset.phase), null, { timeout: 60_000 });
+    assert.ok(Number(await m.getAttribute('data-steps')) <= 4 + lastLeft);
+    await bar.waitFor({ state: 'hidden' });
     assert.deepEqual(errors, []);
   } finally {
     await browser.close();

@@ -38,6 +38,13 @@ pub trait Stepper {
     /// The current state's measures, without stepping.
     fn metrics(&self) -> Self::Metrics;
 
+    /// An upper bound on the steps still to take before [`is_done`](Stepper::is_done) (0 once
+    /// done), for a progress bar; None when the stepper cannot bound it. Iterative phases count
+    /// their iteration cap, so a run that converges early finishes under the bound.
+    fn steps_left_at_most(&self) -> Option<usize> {
+        None
+    }
+
     /// Steps until [`is_done`](Stepper::is_done) (a stepper may take a shortcut to the same
     /// final state).
     fn run_to_end(&mut self) -> Result<(), Self::Error> {

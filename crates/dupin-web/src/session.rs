@@ -132,6 +132,10 @@ struct Metrics {
     /// from it, not from the page's panel edge).
     #[serde(skip_serializing_if = "Option::is_none")]
     mean_edge_m: Option<f64>,
+    /// At most this many steps are left (iterative phases count their cap): the page's progress
+    /// bar. See `Stepper::steps_left_at_most`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    steps_left_at_most: Option<usize>,
 }
 
 /// The extra layers `Session.mesh` can draw with the panels: `{ offset, support, distance }`
@@ -993,6 +997,7 @@ impl Session {
                     deviation_mm: None,
                     non_convex_faces,
                     mean_edge_m,
+                    steps_left_at_most: p.steps_left_at_most(),
                 }
             }
             Run::Pq { stepper, started } => {
@@ -1043,6 +1048,10 @@ impl Session {
                     deviation_mm: self.design.as_ref().and_then(|d| d.deviation_mm(&mesh)),
                     non_convex_faces,
                     mean_edge_m,
+                    // The first step only shows the control mesh.
+                    steps_left_at_most: stepper
+                        .steps_left_at_most()
+                        .map(|n| n + usize::from(!*started)),
                 }
             }
         }

@@ -396,6 +396,20 @@ impl Stepper for PqSceneStepper {
         self.phase == PqScenePhase::Done
     }
 
+    /// The running perturbation's iterations under its cap, then per level still to come a
+    /// subdivision and a perturbation's cap.
+    fn steps_left_at_most(&self) -> Option<usize> {
+        if self.is_done() {
+            return Some(0);
+        }
+        let running = self
+            .perturbation
+            .as_ref()
+            .and_then(|p| p.steps_left_at_most())
+            .unwrap_or(0);
+        Some(running + (self.levels - self.level) * (1 + self.options.max_iterations))
+    }
+
     /// The current state and its measures (computed on the current mesh).
     fn metrics(&self) -> PqSceneStepInfo {
         let conical = (self.options.mode == PqMode::Conical).then(|| {

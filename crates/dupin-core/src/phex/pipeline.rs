@@ -588,6 +588,21 @@ impl Stepper for PhexPipeline {
         self.phase == PhexPhase::Done
     }
 
+    /// The layers still to show, the hexagon step, and the optimisation's iteration cap.
+    fn steps_left_at_most(&self) -> Option<usize> {
+        let iterations = if self.config.optimize {
+            self.config.iterations
+        } else {
+            0
+        };
+        Some(match self.phase {
+            PhexPhase::Triangulation => self.tri.layers.len() - self.shown + 1 + iterations,
+            PhexPhase::Hexagons => 1 + iterations,
+            PhexPhase::Optimisation => iterations.saturating_sub(self.metrics.iteration),
+            PhexPhase::Done => 0,
+        })
+    }
+
     /// Metrics after the last step.
     fn metrics(&self) -> PhexMetrics {
         self.metrics

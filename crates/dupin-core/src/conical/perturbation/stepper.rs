@@ -468,6 +468,15 @@ impl Stepper for PqPerturbation {
         self.phase == PqPhase::Done
     }
 
+    /// The iterations left under the cap.
+    fn steps_left_at_most(&self) -> Option<usize> {
+        Some(if self.is_done() {
+            0
+        } else {
+            self.options.max_iterations.saturating_sub(self.iteration)
+        })
+    }
+
     fn metrics(&self) -> PqStepInfo {
         PqStepInfo {
             iteration: self.iteration,
