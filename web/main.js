@@ -376,6 +376,8 @@ function setLayers(patch) {
 
 function reportError(message, field) {
   settled = true;
+  dirty = true; // a refused first configuration still draws its (empty) frame: the page is ready
+
   if (field === 'offset-distance') { showLayerError(message); return; }
   if (!(field && showFieldError(fieldsBox, field, message))) showStatus(`${viewer.backend} · ${message}`, true);
 }

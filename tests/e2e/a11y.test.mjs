@@ -6,8 +6,12 @@ import assert from 'node:assert/strict';
 import AxeBuilder from '@axe-core/playwright';
 import { byId, openPage } from './harness.mjs';
 
-async function serious(page) {
+/** The serious and critical violations; every violation is tallied by impact in the log. */
+async function serious(page, where = '') {
   const r = await new AxeBuilder({ page }).analyze();
+  const tally = {};
+  for (const v of r.violations) tally[v.impact] = (tally[v.impact] ?? 0) + v.nodes.length;
+  console.log(`# axe, ${where}: ${r.passes.length} rules pass, violations by impact ${JSON.stringify(tally)} (${r.violations.map((v) => v.id).join(', ') || 'none'})`);
   return r.violations
     .filter((v) => ['serious', 'critical'].includes(v.impact))
     .map((v) => `${v.id} (${v.impact}): ${v.nodes.slice(0, 3).map((n) => n.target.join(' ')).join(' | ')}`);
@@ -16,18 +20,29 @@ async function serious(page) {
 test('axe finds no serious or critical violation on the main view, the inset, the 2D tab and presentation mode', async () => {
   const { browser, page, errors } = await openPage({ hash: '#scene=sphere-radial' });
   try {
-    assert.deepEqual(await serious(page), [], 'main view');
+    assert.deepEqual(await serious(page, 'main view'), [], 'main view');
     await byId(page, 'teach').click();
     await page.waitForFunction(() => document.querySelector('[data-testid=teach-inset]').dataset.star);
-    assert.deepEqual(await serious(page), [], 'teaching inset');
+    assert.deepEqual(await serious(page, 'teaching inset'), [], 'teaching inset');
     await page.keyboard.press('Escape');
     await byId(page, 'hexd').click();
     await byId(page, 'hexd-points').selectOption('random');
-    assert.deepEqual(await serious(page), [], '2D tab');
+    assert.deepEqual(await serious(page, '2D tab'), [], '2D tab');
     await byId(page, 'hexd').click();
     await byId(page, 'present').click();
     await page.waitForFunction(() => document.querySelector('[data-testid="present-status"]').dataset.rendered === 'true', null, { timeout: 60_000 });
-    assert.deepEqual(await serious(page), [], 'presentation mode');
+    assert.deepEqual(await serious(page, 'presentation mode'), [], 'presentation mode');
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
+
+test('axe finds no serious or critical violation at first sight (the finished roof and its welcome line)', async () => {
+  const { browser, page, errors } = await openPage();
+  try {
+    await page.waitForFunction(() => document.querySelector('[data-testid=metrics]').dataset.phase === 'done');
+    assert.deepEqual(await serious(page, 'first sight'), [], 'first sight');
     assert.deepEqual(errors, []);
   } finally {
     await browser.close();

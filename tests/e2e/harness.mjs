@@ -44,7 +44,7 @@ export async function openPage({ webgpu = true, hash = '', viewport = { width: 9
     if (!['data:', 'blob:'].includes(u.protocol) && u.origin !== origin) errors.push(`request outside the page's origin: ${r.url()}`);
   });
   await page.goto(URL_BASE + hash);
-  await page.waitForFunction(() => document.body.dataset.ready === 'true', null, { timeout: 90_000 });
+  await page.waitForFunction(() => document.body.dataset.ready === 'true', null, { timeout: Number(process.env.READY_MS ?? 90_000) });
   return { browser, page, errors };
 }
 

@@ -190,3 +190,16 @@ test('a run shows a progress bar: steps done under the core\'s bound on the step
     await browser.close();
   }
 });
+
+test('a link whose run the core refuses (over the page\'s face limit) opens ready, says why, and stays usable', async () => {
+  const { browser, page, errors } = await openPage({ hash: '#scene=free&surface=torus&method=prescribed&size=0.025' });
+  try {
+    assert.match(await byId(page, 'status').textContent(), /limit of 100000 .* use a larger size/);
+    await byId(page, 'scene-select').selectOption('sphere-radial');
+    await page.waitForFunction(() => document.querySelector('[data-testid=metrics]').dataset.steps === '1', null, { timeout: 60_000 });
+    assert.doesNotMatch(await byId(page, 'status').textContent(), /limit/);
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});

@@ -26,6 +26,18 @@ pub(crate) const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::Vertex
     attributes: &ATTRIBUTES,
 };
 
+const POSITION: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![0 => Float32x3];
+
+/// Line vertices: a position only (`vs_line` in `shader.wgsl` colours them from its uniforms).
+/// A full [`Vertex`] per line end made the panel outlines 78% of a large mesh's upload (250k
+/// segments at 166k triangles: 18 MB of 23), and the upload was the page's longest main-thread
+/// task.
+pub(crate) const POSITION_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: 12,
+    step_mode: wgpu::VertexStepMode::Vertex,
+    attributes: &POSITION,
+};
+
 /// An indexed triangle or line list on the GPU.
 pub(crate) struct GpuMesh {
     vertices: wgpu::Buffer,
@@ -35,10 +47,10 @@ pub(crate) struct GpuMesh {
 
 impl GpuMesh {
     /// Uploads `vertices` and `indices`; None when there is nothing to draw.
-    pub fn upload(
+    pub fn upload<V: bytemuck::Pod>(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        vertices: &[Vertex],
+        vertices: &[V],
         indices: &[u32],
         label: &str,
     ) -> Option<GpuMesh> {
@@ -232,13 +244,15 @@ pub(crate) struct PipelineSpec<'a> {
     /// Fragment entry point with its colour target format and blending; None for depth only.
     pub fragment: Option<(&'a str, wgpu::TextureFormat, Option<wgpu::BlendState>)>,
     pub topology: wgpu::PrimitiveTopology,
+    /// [`VERTEX_LAYOUT`], or [`POSITION_LAYOUT`] for lines.
+    pub layout: wgpu::VertexBufferLayout<'static>,
     pub depth_write: bool,
     pub bias: wgpu::DepthBiasState,
     /// Faces not drawn (closed meshes wound counter-clockwise seen from outside).
     pub cull: Option<wgpu::Face>,
 }
 
-/// A render pipeline over [`Vertex`] buffers with a `LessEqual` depth test.
+/// A render pipeline over vertex buffers of `spec.layout` with a `LessEqual` depth test.
 pub(crate) fn pipeline(
     device: &wgpu::Device,
     layout: &wgpu::PipelineLayout,
@@ -259,7 +273,7 @@ pub(crate) fn pipeline(
             module: shader,
             entry_point: Some(spec.vertex),
             compilation_options: Default::default(),
-            buffers: &[Some(VERTEX_LAYOUT)],
+            buffers: &[Some(spec.layout)],
         },
         primitive: wgpu::PrimitiveState {
             topology: spec.topology,

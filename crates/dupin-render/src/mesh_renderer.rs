@@ -3,7 +3,7 @@
 use crate::camera::OrbitCamera;
 use crate::draw::{Draw, Frame};
 use crate::error::RenderError;
-use crate::gpu_mesh::{self, DepthBuffer, GpuMesh, PipelineSpec, Vertex};
+use crate::gpu_mesh::{self, DepthBuffer, GpuMesh, PipelineSpec};
 use dupin_core::mesh::TriangleBuffers;
 
 /// Background colour of every view (linear RGB), also used by tests to count covered pixels.
@@ -37,6 +37,8 @@ pub struct MeshRenderer {
     line_bind_group: wgpu::BindGroup,
     mesh: Option<GpuMesh>,
     lines: Option<GpuMesh>,
+    /// Linear RGB of the lines (the line pipeline's `base_color`).
+    line_color: [f32; 3],
     vertex_colors: bool,
     depth: DepthBuffer,
 }
@@ -69,7 +71,7 @@ impl MeshRenderer {
         };
         let bind_group = make_group(&uniforms);
         let line_bind_group = make_group(&line_uniforms);
-        let pipeline = |topology, vs, fs, slope_scale| {
+        let pipeline = |topology, vertex_layout, vs, fs, slope_scale| {
             let bias = wgpu::DepthBiasState {
                 constant: 0,
                 slope_scale,
@@ -79,6 +81,7 @@ impl MeshRenderer {
                 vertex: vs,
                 fragment: Some((fs, format, None)),
                 topology,
+                layout: vertex_layout,
                 depth_write: true,
                 bias,
                 cull: None,
@@ -89,11 +92,18 @@ impl MeshRenderer {
         // far, nearly edge-on outlines whole where `vs_line`'s pull alone is too small.
         let tri_pipeline = pipeline(
             wgpu::PrimitiveTopology::TriangleList,
+            gpu_mesh::VERTEX_LAYOUT,
             "vs_main",
             "fs_main",
             1.0,
         );
-        let line_pipeline = pipeline(wgpu::PrimitiveTopology::LineList, "vs_line", "fs_line", 0.0);
+        let line_pipeline = pipeline(
+            wgpu::PrimitiveTopology::LineList,
+            gpu_mesh::POSITION_LAYOUT,
+            "vs_line",
+            "fs_line",
+            0.0,
+        );
         MeshRenderer {
             format,
             tri_pipeline,
@@ -104,6 +114,7 @@ impl MeshRenderer {
             line_bind_group,
             mesh: None,
             lines: None,
+            line_color: [0.0; 3],
             vertex_colors: false,
             depth: DepthBuffer::default(),
         }
@@ -131,16 +142,10 @@ impl MeshRenderer {
         segments: &[f32],
         color: [f32; 3],
     ) {
-        let vertices: Vec<Vertex> = segments
-            .chunks_exact(3)
-            .map(|p| Vertex {
-                pos: [p[0], p[1], p[2]],
-                normal: [0.0, 0.0, 1.0],
-                color,
-            })
-            .collect();
-        let indices: Vec<u32> = (0..vertices.len() as u32 & !1).collect();
-        self.lines = GpuMesh::upload(device, queue, &vertices, &indices, "lines");
+        let ends = (segments.len() / 3) & !1;
+        let indices: Vec<u32> = (0..ends as u32).collect();
+        self.lines = GpuMesh::upload(device, queue, &segments[..3 * ends], &indices, "lines");
+        self.line_color = color;
     }
 
     /// Removes the line segments.
@@ -190,7 +195,8 @@ impl Draw for MeshRenderer {
             flags: [gamma, if self.vertex_colors { 1.0 } else { 0.0 }, 0.0, 0.0],
         };
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
-        u.flags[1] = 1.0;
+        let [r, g, b] = self.line_color;
+        u.base_color = [r, g, b, 1.0];
         queue.write_buffer(&self.line_uniforms, 0, bytemuck::bytes_of(&u));
 
         let mut encoder = device.create_command_encoder(&Default::default());

@@ -345,6 +345,7 @@ impl PresentationRenderer {
                 vertex: "vs_shadow",
                 fragment: None,
                 topology: wgpu::PrimitiveTopology::TriangleList,
+                layout: gpu_mesh::VERTEX_LAYOUT,
                 depth_write: true,
                 bias: wgpu::DepthBiasState {
                     constant: 2,
@@ -359,6 +360,7 @@ impl PresentationRenderer {
                 vertex: "vs_main",
                 fragment: Some((fs, format, blend)),
                 topology: wgpu::PrimitiveTopology::TriangleList,
+                layout: gpu_mesh::VERTEX_LAYOUT,
                 depth_write,
                 bias: Default::default(),
                 cull,

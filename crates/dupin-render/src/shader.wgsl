@@ -21,11 +21,13 @@ fn vs_main(v: VsIn) -> VsOut {
 // (0.2% of its distance) leaves it where it is on screen but in front of its own faces at any
 // slope, where a constant depth bias loses at oblique views and dashes the line; a surface
 // further in front still hides it.
+// Line vertices carry a position only (`POSITION_LAYOUT`); their colour is `base_color`.
 @vertex
-fn vs_line(v: VsIn) -> VsOut {
-    var pulled = v;
-    pulled.pos = mix(v.pos, u.eye.xyz, 0.002);
-    return project(pulled, u.view_proj, v.color);
+fn vs_line(@location(0) pos: vec3<f32>) -> VsOut {
+    var v: VsIn;
+    v.pos = mix(pos, u.eye.xyz, 0.002);
+    v.normal = vec3<f32>(0.0, 0.0, 1.0);
+    return project(v, u.view_proj, u.base_color.rgb);
 }
 
 fn encode(c: vec3<f32>) -> vec4<f32> {
