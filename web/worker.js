@@ -58,15 +58,15 @@ let overhead = 0;
 // `timing` splits the worker's time per state: solver, metrics, render buffers (mesh) and the
 // previous post; `stepsInState` counts the steps the state took.
 //
-// While playing (`batch`), a state takes one step for every 10 ms its predecessor's metrics and
-// mesh cost, while their solve time stays under that overhead (and 250 ms): revealing a large
-// triangulation takes steps of a hundredth of a millisecond whose states cost 100 ms or more
-// (190k triangles), so measuring and shipping every layer was nearly the whole run (49 s of
-// 55 at 96k faces). Layers still appear a few at a time, and runs whose states cost under 10 ms
-// (every scene of the papers) show every step.
+// While playing (`batch`), once a state's metrics and mesh cost 30 ms or more, a state takes
+// one step for every 10 ms of that overhead, while their solve time stays under it (and 250 ms):
+// revealing a large triangulation takes steps of a hundredth of a millisecond whose states cost
+// 100 ms or more (190k triangles), so measuring and shipping every layer was nearly the whole
+// run (49 s of 55 at 96k faces). Layers still appear a few at a time, and runs whose states
+// cost less (every scene of the papers: 2-20 ms) show every step.
 function stepOnce(batch = false) {
   const t0 = performance.now();
-  const most = batch ? Math.max(1, Math.ceil(overhead / 10)) : 1;
+  const most = batch && overhead >= 30 ? Math.ceil(overhead / 10) : 1;
   let k = 0;
   do {
     session.advance();
