@@ -142,7 +142,7 @@ async function snapshotPng(scale) {
 /** Adds the Present button and the presentation overlay; `currentMesh()` gives the MeshData. */
 export function initPresent(currentMesh) {
   getMesh = currentMesh;
-  panel = el('section', { class: 'present', 'data-testid': 'present-panel', hidden: '' });
+  panel = el('section', { class: 'present', 'data-testid': 'present-panel', 'aria-label': 'Presentation', hidden: '' });
   canvas = el('canvas', { 'data-testid': 'present-canvas', 'aria-label': 'Presentation view: drag to orbit' });
   offsetBox = el('input', { type: 'checkbox', 'data-testid': 'present-offset' });
   const offsetLabel = el('label', {}, ' offset layer');
