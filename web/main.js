@@ -6,7 +6,7 @@
 import init, { MeshData, Viewer, colorLegend, freeDefaults, pageSchema, sceneDescription, sceneNames, surfaceCatalog, torusMesh } from './pkg/dupin_web.js';
 import { FREE, IMPORTED, defaults, readHash, sessionConfig, useSchema, writeHash } from './config.js';
 import { buildFields, clearFieldErrors, fillScenePicker, showFieldError } from './controls.js';
-import { drawHistogram, drawLegend, showMetrics, showProgress } from './metrics.js';
+import { drawHistogram, drawLegend, legendCaption, showMetrics, showProgress } from './metrics.js';
 import { Solver } from './solver.js';
 import { initTeach, showPick } from './teach.js';
 import { initHexd2d } from './hexd2d.js';
@@ -330,6 +330,7 @@ function showPanel() {
   const { m, entry } = panelNext;
   panelNext = null;
   showMetrics(metricsEl, m, config);
+  showLegend();
   // The bar: after a second of playing (short runs would only flash it), or while stepping.
   const recentMs = stepLog.slice(-5).filter((e) => e.at >= runT0 && e.phase === m.phase && Number.isFinite(e.ms)).map((e) => e.ms);
   showProgress($('progress'), m, { show: !done && !m.preview && (playing ? performance.now() - runT0 > 1000 : (m.steps ?? 0) > 1), recentMs });
@@ -645,9 +646,15 @@ function rebuildFields() {
   });
 }
 
+/** The colour legend of the current mode, its caption in the design's units. */
+function showLegend() {
+  const edge = lastMetrics?.meanEdgeM ?? config.panelEdge;
+  drawLegend($('legend'), colorLegend(config.color), legendCaption(config.color, edge));
+}
+
 function setColorMode(mode) {
   config.color = mode;
-  drawLegend($('legend'), colorLegend(mode));
+  showLegend();
   if (running) solver.post('mode', { mode });
   syncHash();
 }
@@ -665,7 +672,7 @@ function restore(hash) {
   $('toggle-support').checked = next.layers.support;
   $('offset-distance').value = String(next.layers.distance);
   showLayerError('');
-  drawLegend($('legend'), colorLegend(next.color));
+  showLegend();
   clearFieldErrors(fieldsBox);
   rebuildFields();
   load(next, { reframe: !next.camera });
@@ -739,6 +746,7 @@ async function main() {
     if (!ok) return;
     config.panelEdge = v;
     if (lastMetrics) showMetrics(metricsEl, lastMetrics, config);
+    showLegend();
     syncHash();
   });
   $('toggle-offset').addEventListener('change', (e) => setLayers({ offset: e.target.checked }));

@@ -45,6 +45,15 @@ function nonConvex(m) {
   return `${n} of ${m.faces}: ${why}`;
 }
 
+/** The design's overall size in metres: an opened design's own, a scene's scaled so that its
+ * mean edge is the page's panel edge (the scale every mm figure of a scene uses). */
+function dimensions(m, panelEdge) {
+  const m3 = (d) => d.map((x) => (x >= 10 ? x.toFixed(1) : x.toPrecision(2))).join(' × ');
+  if (m.design?.dimensionsM) return `${m3(m.design.dimensionsM)} m`;
+  if (!m.extent || !(m.meanEdge > 0)) return '–';
+  return `${m3(m.extent.map((x) => (x * panelEdge) / m.meanEdge))} m at a ${panelEdge} m mean edge`;
+}
+
 /** Writes metrics `m` (from Session.step/metrics, plus `ms` and `steps`) into `dl`. */
 export function showMetrics(dl, m, { panelEdge }) {
   // An opened design is measured in its own unit; a scene at the page's panel edge.
@@ -73,6 +82,7 @@ export function showMetrics(dl, m, { panelEdge }) {
   ] : [
     ['phase', m.phase], ['layer', m.layer ?? 0], ['iteration', m.iteration], ['faces', m.faces],
     ['vertices', m.vertices],
+    ['dimensions', dimensions(m, panelEdge)],
     ['max planarity', planarity(m.maxPlanarity, edge)],
     ['mean planarity', planarity(m.meanPlanarity ?? 0, edge)],
     ['invalid faces', m.invalidFaces ?? 0],
@@ -146,16 +156,35 @@ export function drawHistogram(svg, m) {
 }
 
 /** Legend of a colour mode from its stops `[{label, color: [r, g, b] linear}]`. */
-export function drawLegend(box, stops) {
+export function drawLegend(box, stops, caption = '') {
+  const key = JSON.stringify([stops.map((s) => s.label), caption]);
+  if (box.dataset.key === key) return;
+  box.dataset.key = key;
   const srgb = (c) => Math.round(255 * (c <= 0.0031308 ? 12.92 * c : 1.055 * c ** (1 / 2.4) - 0.055));
-  box.replaceChildren(...stops.map((s) => {
+  const items = stops.map((s) => {
     const item = document.createElement('span');
     item.className = 'legend-item';
     const sw = document.createElement('i');
     sw.style.background = `rgb(${s.color.map(srgb).join(',')})`;
     item.append(sw, s.label);
     return item;
-  }));
+  });
+  const note = document.createElement('span');
+  note.className = 'legend-caption hint';
+  note.dataset.testid = 'legend-caption';
+  note.textContent = caption;
+  box.replaceChildren(...items, ...(caption ? [note] : []));
+}
+
+/** What a colour mode's legend measures, in units: planarity relative to the mean edge, with
+ * what one stop means in millimetres at an edge of `edgeM` metres. */
+export function legendCaption(mode, edgeM) {
+  if (mode === 'planarity') {
+    const mm = 1e-6 * edgeM * 1000;
+    return `corner distance from the panel's plane ÷ mean edge: at a ${Number(edgeM.toPrecision(3))} m edge, 1e-6 is ${Number(mm.toPrecision(3))} mm`;
+  }
+  if (mode === 'regularity') return 'shape deviation from the affine regular hexagon (P-Hex paper, sec. 4.2), relative';
+  return 'panels by shape: a P-Hex hexagon is non-convex where K < 0 (sec. 4.2)';
 }
 
 /**

@@ -44,6 +44,17 @@ test('contract test ids and metrics are present; a first visit opens on a finish
     assert.ok(await byId(page, 'step').isDisabled());
     assert.match(await byId(page, 'scene-description').textContent(), /planar panels .* drag to orbit .* Play .* open your own design/);
     assert.ok(await byId(page, 'progress').isHidden());
+    // The design's dimensions in metres at the page's panel edge, and the legend's units.
+    const dims = async () => (await page.locator('[data-metric=dimensions]').textContent()).split(' m')[0].split(' × ').map(Number);
+    const at15 = await dims();
+    assert.equal(at15.length, 3);
+    assert.ok(at15.every((x) => x > 1 && x < 1000), `dimensions ${at15}`);
+    assert.match(await byId(page, 'legend-caption').textContent(), /÷ mean edge: at a 1.5 m edge, 1e-6 is 0.0015 mm/);
+    await byId(page, 'panel-edge').fill('3');
+    await byId(page, 'panel-edge').dispatchEvent('change');
+    const at3 = await dims();
+    at3.forEach((x, k) => assert.ok(Math.abs(x / at15[k] - 2) < 0.05, `${x} vs ${at15[k]} at twice the edge`));
+    assert.match(await byId(page, 'legend-caption').textContent(), /at a 3 m edge, 1e-6 is 0.003 mm/);
     // Picking a scene ends the welcome: its own description, ready to play.
     await byId(page, 'scene-select').selectOption('sphere-radial');
     await page.waitForFunction(() => document.querySelector('[data-testid=metrics]').dataset.phase !== 'done');

@@ -136,6 +136,11 @@ struct Metrics {
     /// bar. See `Stepper::steps_left_at_most`.
     #[serde(skip_serializing_if = "Option::is_none")]
     steps_left_at_most: Option<usize>,
+    /// The current mesh's bounding box extent along x, y, z and its mean edge, in the run's
+    /// own units (a scene's, or the opened design's): the page shows the dimensions in metres
+    /// at its panel edge (or, for a design, its unit).
+    extent: [f64; 3],
+    mean_edge: f64,
 }
 
 /// The extra layers `Session.mesh` can draw with the panels: `{ offset, support, distance }`
@@ -958,10 +963,12 @@ impl Session {
             self_intersecting += usize::from(!f.simple);
             non_convex_faces += usize::from(f.simple && !f.convex);
         }
+        let mean_edge = mesh.mean_edge();
         let mean_edge_m = self
             .design
             .as_ref()
-            .map(|d| mesh.mean_edge() * d.unit.parse::<LengthUnit>().unwrap_or_default().to_m());
+            .map(|d| mean_edge * d.unit.parse::<LengthUnit>().unwrap_or_default().to_m());
+        let extent = extent(&mesh);
         match &self.run {
             Run::Phex(p, goals) => {
                 let m = p.metrics();
@@ -998,6 +1005,8 @@ impl Session {
                     non_convex_faces,
                     mean_edge_m,
                     steps_left_at_most: p.steps_left_at_most(),
+                    extent,
+                    mean_edge,
                 }
             }
             Run::Pq { stepper, started } => {
@@ -1052,10 +1061,25 @@ impl Session {
                     steps_left_at_most: stepper
                         .steps_left_at_most()
                         .map(|n| n + usize::from(!*started)),
+                    extent,
+                    mean_edge,
                 }
             }
         }
     }
+}
+
+/// The bounding box extent of `mesh` along x, y and z (zeros for an empty mesh).
+fn extent(mesh: &PolyMesh) -> [f64; 3] {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in &mesh.positions {
+        for (k, c) in [p.x, p.y, p.z].into_iter().enumerate() {
+            lo[k] = lo[k].min(c);
+            hi[k] = hi[k].max(c);
+        }
+    }
+    [0, 1, 2].map(|k| if hi[k] >= lo[k] { hi[k] - lo[k] } else { 0.0 })
 }
 
 #[cfg(test)]
@@ -1136,6 +1160,22 @@ mod tests {
 
     /// A finished run that misses what it was asked ends in `warning` with the reason, never
     /// `done`: the free-mode torus at panel size 0.2 ends with self-intersecting faces.
+    #[test]
+    fn metrics_carry_the_extent_and_mean_edge_of_the_mesh_on_show() {
+        let cfg = PhexConfig::for_surface("torus", &[], TriangulationMethod::Prescribed, Some(0.6));
+        let mut session = torus_session(cfg);
+        while !session.done() {
+            session.advance().unwrap();
+        }
+        let m = session.metrics_struct();
+        let mesh = session.current_mesh().unwrap();
+        // The library torus (R = 2, r = 0.7 by default) spans 2 (R + r) across and 2 r high.
+        assert!((m.extent[0] - 5.4).abs() < 0.1 && (m.extent[1] - 5.4).abs() < 0.1);
+        assert!((m.extent[2] - 1.4).abs() < 0.05, "height {}", m.extent[2]);
+        assert_eq!(m.mean_edge, mesh.mean_edge());
+        assert!(extent(&PolyMesh::default()) == [0.0; 3]);
+    }
+
     #[test]
     fn a_missed_result_ends_in_warning_not_done() {
         let cfg =
