@@ -3,9 +3,10 @@
 
 use crate::common::{CliError, read_mesh_file};
 use clap::{Args, ValueEnum};
+use dupin_core::conical::offset_mesh;
 use dupin_core::fabrication::{
     DEFAULT_SHEET_MM, DxfOptions, GlbLayer, LengthUnit, panel_csv, panel_dxf, panel_schedule_svg,
-    panels_glb, schedule_mm,
+    panels_glb, schedule_mm, support_csv,
 };
 use std::path::PathBuf;
 
@@ -40,6 +41,10 @@ pub struct ExportArgs {
     /// Sheet size in mm, WIDTHxHEIGHT (DXF and SVG).
     #[arg(long, value_parser = parse_sheet)]
     pub sheet: Option<(f64, f64)>,
+    /// CSV of a conical mesh: also its support structure at this face distance (in the
+    /// input's unit; conical paper, Sec. 4): node axes and beams, as two more tables.
+    #[arg(long, allow_negative_numbers = true)]
+    pub support: Option<f64>,
 }
 
 /// `2500x1250` -> (2500, 1250), both positive and finite.
@@ -58,6 +63,11 @@ fn parse_sheet(s: &str) -> Result<(f64, f64), String> {
 
 /// Runs `dupin export`.
 pub fn run(args: ExportArgs) -> Result<(), CliError> {
+    if args.support.is_some() && args.format != Format::Csv {
+        return Err(CliError::Input(
+            "--support adds the node and beam tables of a CSV: use it with --format csv".into(),
+        ));
+    }
     let mesh = read_mesh_file(&args.input)?;
     let (w, h) = args.sheet.unwrap_or(DEFAULT_SHEET_MM);
     let options = DxfOptions::default()
@@ -72,7 +82,15 @@ pub fn run(args: ExportArgs) -> Result<(), CliError> {
             let schedule = schedule_mm(&mesh, &options).map_err(|e| CliError::input("svg", e))?;
             panel_schedule_svg(&schedule, 1.0).into_bytes()
         }
-        Format::Csv => panel_csv(&mesh, args.unit, None).into_bytes(),
+        Format::Csv => {
+            let mut csv = panel_csv(&mesh, args.unit, None);
+            if let Some(d) = args.support {
+                let offset = offset_mesh(&mesh, d).map_err(|e| CliError::input("support", e))?;
+                csv += &support_csv(&mesh, &offset, args.unit)
+                    .map_err(|e| CliError::input("support", e))?;
+            }
+            csv.into_bytes()
+        }
         Format::Glb => panels_glb(
             &[GlbLayer {
                 name: "panels",

@@ -193,3 +193,26 @@ fn csv_glb_and_svg_carry_every_panel() {
     let _ = std::fs::remove_file(tmp("export-glb-back.obj"));
     let _ = std::fs::remove_file(&obj);
 }
+
+#[test]
+fn csv_of_a_conical_mesh_lists_node_axes_and_planar_beams() {
+    let obj = tmp("export-conical-station.obj");
+    dupin_ok(&["pq", "--scene", "conical-station", "--out", obj.to_str().unwrap()]);
+    let csv = tmp("export-conical-station.csv");
+    let (i, o) = (obj.to_str().unwrap(), csv.to_str().unwrap());
+    dupin_ok(&["export", "--input", i, "--format", "csv", "--out", o, "--support", "0.05"]);
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let tables: Vec<&str> = text.split("\n\n").collect();
+    assert_eq!(tables.len(), 3, "panels, nodes and beams");
+    assert!(tables[1].starts_with("node,x_m,y_m,z_m,axis_x,axis_y,axis_z,offset_mm\n"));
+    assert!(tables[2].starts_with("beam,node_a,node_b,length_mm,max_planarity_mm\n"));
+    // Beams of a conical mesh are planar (conical paper, Sec. 4), to the CSV's 0.001 mm.
+    for row in tables[2].lines().skip(1) {
+        let planarity: f64 = row.rsplit(',').next().unwrap().parse().unwrap();
+        assert!(planarity <= 0.001, "{row}");
+    }
+    // --support belongs to the CSV.
+    let out = dupin(&["export", "--input", i, "--format", "dxf", "--out", o, "--support", "0.05"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--format csv"));
+}

@@ -5,11 +5,12 @@ use crate::js::{err, refuse_unknown_keys, to_js};
 use crate::mesh_data::MeshData;
 use dupin_core::Stepper;
 use dupin_core::conical::{
-    PqMode, PqSceneMeasures, PqSceneStepInfo, PqSceneStepper, pq_scene_shortfall, support_structure,
+    PqMode, PqSceneMeasures, PqSceneStepInfo, PqSceneStepper, offset_mesh, pq_scene_shortfall,
+    support_structure,
 };
 use dupin_core::fabrication::{
     DxfOptions, GlbLayer, LengthUnit, SheetOptions, panel_csv, panel_dxf, panel_schedule,
-    panel_schedule_svg, panels_glb,
+    panel_schedule_svg, panels_glb, support_csv,
 };
 use dupin_core::mesh::{
     ColorMode, NOT_HEX, PLANARITY_HIST_HI, PLANARITY_HIST_LO, PLANARITY_LEGEND_LOG10, PolyMesh,
@@ -614,7 +615,9 @@ impl Session {
     }
 
     /// The panel schedule as CSV: number, corners, area (m²), perimeter, planarity (mm), the
-    /// deviation from an opened panel design (mm), edge lengths. Units as [`Session::export_dxf`].
+    /// deviation from an opened panel design (mm), edge lengths. A conical run adds its support
+    /// structure at the offset distance set for its layers: node axes and beams (see
+    /// `support_csv`). Units as [`Session::export_dxf`].
     #[wasm_bindgen(js_name = exportCsv)]
     pub fn export_csv(&self, panel_edge_m: f64) -> Result<String, JsError> {
         let (mesh, unit) = self.fabrication_mesh(panel_edge_m)?;
@@ -623,7 +626,20 @@ impl Session {
             .as_ref()
             .and_then(|d| d.positions.as_deref())
             .filter(|p| p.len() == mesh.num_vertices());
-        Ok(panel_csv(&mesh, unit, design))
+        let mut csv = panel_csv(&mesh, unit, design);
+        if self.offset_reason().is_none() {
+            // The distance is in the run's units: scale it as the panels were.
+            let raw = self.current_mesh().unwrap_or_default().mean_edge();
+            let scale = if raw > 0.0 {
+                mesh.mean_edge() / raw
+            } else {
+                1.0
+            };
+            let d = self.layers.distance.unwrap_or(DEFAULT_OFFSET) * scale;
+            let offset = offset_mesh(&mesh, d).map_err(err)?;
+            csv += &support_csv(&mesh, &offset, unit).map_err(err)?;
+        }
+        Ok(csv)
     }
 
     /// The panels as binary glTF 2.0, written in metres (readable by three.js, model-viewer and

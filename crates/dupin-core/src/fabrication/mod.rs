@@ -21,5 +21,5 @@ pub use glb::{GlbLayer, panels_glb};
 pub use panel_schedule::{
     FlatPanel, PanelSchedule, PanelScheduleError, SheetOptions, panel_schedule, panel_schedule_svg,
 };
-pub use schedule_csv::{CSV_HEADER, panel_csv};
+pub use schedule_csv::{BEAM_HEADER, CSV_HEADER, NODE_HEADER, panel_csv, support_csv};
 pub use units::{LENGTH_UNITS, LengthUnit, UnknownUnit};
