@@ -7,7 +7,7 @@
 // scenes disable the toggles with a reason. Screenshots: target/e2e/pq-levels-*.png.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { byId, metrics, openPage, pixelStats, shot, waitSteps } from './harness.mjs';
+import { byId, exportText, metrics, openPage, pixelStats, shot, waitSteps } from './harness.mjs';
 
 const KEYS = ['phase', 'level', 'iteration', 'faces', 'maxPlanarity', 'conicalResidual'];
 
@@ -77,6 +77,15 @@ test('conical-station steps level by level; offset and support beams toggle and 
     assert.equal(await byId(page, 'offset-distance-error').textContent(), '');
     await page.waitForFunction(() => new URLSearchParams(location.hash.slice(1)).get('dist') === '0.3');
     await page.waitForFunction(() => document.querySelector('[data-testid=layer-info]').textContent.includes('beams'));
+
+    // The CSV schedule of the conical mesh carries its node axes and planar beams.
+    const tables = (await exportText(page, 'export-csv')).split('\n\n');
+    assert.equal(tables.length, 3, 'panels, nodes and beams');
+    assert.match(tables[1], /^node,x_m,y_m,z_m,axis_x,axis_y,axis_z,offset_mm\n/);
+    const beams = tables[2].trim().split('\n');
+    assert.equal(beams[0], 'beam,node_a,node_b,length_mm,max_planarity_mm');
+    assert.equal(beams.length - 1, Number(info.beams), 'one row per beam');
+    assert.ok(beams.slice(1).every((r) => Number(r.split(',')[4]) <= 0.001), 'beams planar to 0.001 mm');
 
     // The copied URL restores scene, steps and both toggles.
     const hash = await page.evaluate(() => location.hash);
