@@ -219,9 +219,9 @@ function onState(s) {
 // Main-thread work per worker message and per frame over 16 ms (window.dupin.slowTasks), to
 // find what a long task was.
 const slowTasks = [];
-function noteTask(what, t0) {
+function noteTask(what, t0, parts = null) {
   const ms = performance.now() - t0;
-  if (ms > 16 && slowTasks.length < 1000) slowTasks.push({ what, ms: Math.round(ms), faces: lastFaces });
+  if (ms > 16 && slowTasks.length < 1000) slowTasks.push({ what, ms: Math.round(ms), faces: lastFaces, ...(parts && { parts }) });
 }
 
 function applyState(s) {
@@ -295,14 +295,17 @@ function uploadMesh() {
   const { arrays: a, reframe } = meshNext;
   meshNext = null;
   meshAt = performance.now();
+  const parts = {};
   try {
     const m = MeshData.fromArrays(a.positions, a.normals, a.indices, a.colors, a.edges);
     m.setPanels(a.panelPositions, a.panelFaces);
+    parts.copy = performance.now() - meshAt;
     showMesh(m, reframe);
+    parts.gpu = performance.now() - meshAt - parts.copy;
   } catch (e) {
     showStatus(`${viewer.backend} · ${e.message ?? e}`, true);
   }
-  noteTask('mesh', meshAt);
+  noteTask('mesh', meshAt, parts);
 }
 
 // The panel (contract data attributes, text, histogram), URL and buttons are written together in
