@@ -7,6 +7,7 @@ import init, { MeshData, Viewer, colorLegend, freeDefaults, pageSchema, sceneDes
 import { FREE, IMPORTED, defaults, readHash, sessionConfig, useSchema, writeHash } from './config.js';
 import { buildFields, clearFieldErrors, fillScenePicker, showFieldError } from './controls.js';
 import { drawHistogram, drawLegend, legendCaption, showMetrics, showProgress } from './metrics.js';
+import { SettingsHistory } from './undo.js';
 import { Solver } from './solver.js';
 import { initTeach, showPick } from './teach.js';
 import { initHexd2d } from './hexd2d.js';
@@ -45,6 +46,7 @@ let opened = null;        // the design the user opened: { name, bytes } (never 
 // a line saying what Dupin does; any choice of the user's own ends the welcome.
 const OPENING = { scene: 'cyclide-architecture', what: 'the P-Hex paper\'s Fig. 1, 3 200 planar hexagons on a Dupin cyclide' };
 let welcome = false;
+const undoStack = new SettingsHistory();
 let runT0 = 0;            // when the run on show was loaded (its progress estimate starts there)
 
 function showStatus(text, isError = false) {
@@ -72,6 +74,23 @@ function syncHash() {
   describe(config);
   const h = writeHash(config);
   if (h !== location.hash) history.replaceState(null, '', h);
+  undoStack.note(h);
+  updateUndoButtons();
+}
+
+function updateUndoButtons() {
+  setProp($('undo'), 'disabled', !undoStack.past.length);
+  setProp($('redo'), 'disabled', !undoStack.future.length);
+}
+
+/** Undo (or redo) the last change of a setting: the page restores that setting's hash. */
+function undoRedo(redo) {
+  const h = redo ? undoStack.redo() : undoStack.undo();
+  updateUndoButtons();
+  if (!h) return;
+  welcome = false;
+  history.replaceState(null, '', h);
+  restore(h);
 }
 
 function showMesh(next, reframe) {
@@ -738,6 +757,17 @@ async function main() {
     updateButtons();
   });
   $('stop').addEventListener('click', stop);
+  $('undo').addEventListener('click', () => undoRedo(false));
+  $('redo').addEventListener('click', () => undoRedo(true));
+  // Ctrl+Z, Ctrl+Shift+Z and Ctrl+Y (Cmd on a Mac), except in a text field, which keeps its own.
+  document.addEventListener('keydown', (e) => {
+    if (!(e.ctrlKey || e.metaKey) || e.altKey) return;
+    if (e.target.closest?.('input:not([type=checkbox]):not([type=range]), textarea')) return;
+    const key = e.key.toLowerCase();
+    if (key !== 'z' && key !== 'y') return;
+    e.preventDefault();
+    undoRedo(key === 'y' || e.shiftKey);
+  });
   $('reset').addEventListener('click', () => { welcome = false; if (running) load({ ...config, steps: 1 }, { reframe: true }); });
   $('color-mode').addEventListener('change', (e) => setColorMode(e.target.value));
   $('panel-edge').addEventListener('change', (e) => {
