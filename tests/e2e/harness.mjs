@@ -19,8 +19,10 @@ const FLAGS = [
   '--disable-background-networking', '--disable-component-update', '--disable-sync', '--no-first-run',
 ];
 
-/** Opens the page; with `webgpu: false` the browser offers no `navigator.gpu` at all. */
-export async function openPage({ webgpu = true, hash = '', viewport = { width: 960, height: 640 } } = {}) {
+/** Opens the page (`hash` is appended to its URL: a hash, or another page of web/); with
+ * `webgpu: false` the browser offers no `navigator.gpu` at all; `ready: false` does not wait for
+ * the configurator's first frame. */
+export async function openPage({ webgpu = true, hash = '', viewport = { width: 960, height: 640 }, ready = true } = {}) {
   const browser = await chromium.launch({
     executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
     headless: true,
@@ -44,7 +46,7 @@ export async function openPage({ webgpu = true, hash = '', viewport = { width: 9
     if (!['data:', 'blob:'].includes(u.protocol) && u.origin !== origin) errors.push(`request outside the page's origin: ${r.url()}`);
   });
   await page.goto(URL_BASE + hash);
-  await page.waitForFunction(() => document.body.dataset.ready === 'true', null, { timeout: Number(process.env.READY_MS ?? 90_000) });
+  if (ready) await page.waitForFunction(() => document.body.dataset.ready === 'true', null, { timeout: Number(process.env.READY_MS ?? 90_000) });
   return { browser, page, errors };
 }
 

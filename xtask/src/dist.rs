@@ -16,6 +16,8 @@ const FILES: &[&str] = &[
     "pkg/dupin_web_bg.wasm",
     "vendor/node_modules/rhino3dm/rhino3dm.module.js",
     "vendor/node_modules/rhino3dm/rhino3dm.wasm",
+    // The design `viewer-example.html` embeds with `<dupin-viewer>`.
+    "examples/conical-station.json",
 ];
 
 /// Sets up, builds the page and copies it to `out`; returns the files written.

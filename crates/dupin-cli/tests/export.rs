@@ -197,10 +197,26 @@ fn csv_glb_and_svg_carry_every_panel() {
 #[test]
 fn csv_of_a_conical_mesh_lists_node_axes_and_planar_beams() {
     let obj = tmp("export-conical-station.obj");
-    dupin_ok(&["pq", "--scene", "conical-station", "--out", obj.to_str().unwrap()]);
+    dupin_ok(&[
+        "pq",
+        "--scene",
+        "conical-station",
+        "--out",
+        obj.to_str().unwrap(),
+    ]);
     let csv = tmp("export-conical-station.csv");
     let (i, o) = (obj.to_str().unwrap(), csv.to_str().unwrap());
-    dupin_ok(&["export", "--input", i, "--format", "csv", "--out", o, "--support", "0.05"]);
+    dupin_ok(&[
+        "export",
+        "--input",
+        i,
+        "--format",
+        "csv",
+        "--out",
+        o,
+        "--support",
+        "0.05",
+    ]);
     let text = std::fs::read_to_string(&csv).unwrap();
     let tables: Vec<&str> = text.split("\n\n").collect();
     assert_eq!(tables.len(), 3, "panels, nodes and beams");
@@ -212,7 +228,17 @@ fn csv_of_a_conical_mesh_lists_node_axes_and_planar_beams() {
         assert!(planarity <= 0.001, "{row}");
     }
     // --support belongs to the CSV.
-    let out = dupin(&["export", "--input", i, "--format", "dxf", "--out", o, "--support", "0.05"]);
+    let out = dupin(&[
+        "export",
+        "--input",
+        i,
+        "--format",
+        "dxf",
+        "--out",
+        o,
+        "--support",
+        "0.05",
+    ]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--format csv"));
 }

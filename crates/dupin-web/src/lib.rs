@@ -19,7 +19,7 @@ mod teach;
 mod viewer;
 
 pub use hexd2d::HexDelaunayLab;
-pub use mesh_data::{MeshData, torus_mesh};
+pub use mesh_data::{MeshData, design_mesh, torus_mesh};
 #[cfg(target_arch = "wasm32")]
 pub use present::Presenter;
 pub use present::torus_panels_js;

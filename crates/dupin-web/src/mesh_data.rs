@@ -1,6 +1,9 @@
 //! Triangle buffers handed to JavaScript as typed arrays.
 
-use dupin_core::mesh::{PolyMesh, TriangleBuffers, polymesh_buffers, polymesh_edges, write_obj};
+use dupin_core::mesh::{
+    PolyMesh, TriangleBuffers, face_planarity, planarity_color, polymesh_buffers, polymesh_edges,
+    write_obj,
+};
 
 use dupin_core::surface::{Torus, sample_surface};
 
@@ -126,6 +129,13 @@ impl MeshData {
     pub fn panel_positions(&self) -> js_sys::Float64Array {
         let (flat, _) = self.panels.as_ref().map(panel_arrays).unwrap_or_default();
         js_sys::Float64Array::from(flat.as_slice())
+    }
+
+    /// The number of polygons behind the triangles (0 for a smooth surface or a worker's mesh
+    /// before `setPanels`).
+    #[wasm_bindgen(getter, js_name = panelCount)]
+    pub fn panel_count(&self) -> usize {
+        self.panels.as_ref().map_or(0, PolyMesh::num_faces)
     }
 
     /// See [`MeshData::panel_positions`].
@@ -294,5 +304,100 @@ mod tests {
             assert!(panels_from_arrays(&p, &bad).is_err(), "{bad:?}");
         }
         assert!(panels_from_arrays(&p[1..], &f).is_err());
+    }
+}
+
+/// Largest design text `designMesh` parses (bytes) and largest face count it shows.
+const DESIGN_TEXT_LIMIT: usize = 256 << 20;
+const DESIGN_FACE_LIMIT: usize = 2_000_000;
+
+/// The polygon mesh of a design file: `{ vertices: [[x, y, z]], faces: [[i, ...]] }` (0-based),
+/// bare or under `mesh` as Dupin's JSON export writes it (`Session.exportJson`).
+#[derive(serde::Deserialize)]
+struct DesignJson {
+    mesh: Option<PanelsJson>,
+    #[serde(flatten)]
+    bare: Option<PanelsJson>,
+}
+
+#[derive(serde::Deserialize)]
+struct PanelsJson {
+    vertices: Vec<[f64; 3]>,
+    faces: Vec<Vec<u32>>,
+}
+
+/// The panels of a design file (see [`DesignJson`]) for a `Viewer`, flat and coloured by
+/// planarity as the page colours a run, with their edges: what the `<dupin-viewer>` element
+/// shows.
+///
+/// Throws, naming what to fix, for text over 256 MB, JSON without `vertices` and `faces`,
+/// over 2 000 000 faces, and faces naming missing vertices or with fewer than three.
+#[wasm_bindgen(js_name = designMesh)]
+pub fn design_mesh(json: &str) -> Result<MeshData, JsError> {
+    let mesh = design_panels(json).map_err(|e| JsError::new(&e))?;
+    let colors: Vec<[f32; 3]> = (0..mesh.num_faces())
+        .map(|i| planarity_color(face_planarity(&mesh, i)))
+        .collect();
+    Ok(MeshData::panels(mesh, &colors))
+}
+
+/// The polygon mesh of a design file, or what is wrong with it (see [`design_mesh`]).
+fn design_panels(json: &str) -> Result<PolyMesh, String> {
+    if json.len() > DESIGN_TEXT_LIMIT {
+        return Err(format!(
+            "the design is {} MB of text; a viewer reads at most 256 MB",
+            json.len() >> 20
+        ));
+    }
+    let design: DesignJson = serde_json::from_str(json).map_err(|e| {
+        format!(
+            "not a Dupin design: {e} (expected {{\"mesh\": {{\"vertices\": [[x, y, z], ...], \"faces\": [[0, 1, 2], ...]}}}}, as the JSON export writes it)"
+        )
+    })?;
+    let panels = design.mesh.or(design.bare).ok_or(
+        "not a Dupin design: no `mesh` with `vertices` and `faces` (as the JSON export writes it)",
+    )?;
+    if panels.faces.len() > DESIGN_FACE_LIMIT {
+        return Err(format!(
+            "the design has {} faces; a viewer shows at most 2000000",
+            panels.faces.len()
+        ));
+    }
+    let points = panels.vertices.iter().map(|p| Vec3::new(p[0], p[1], p[2]));
+    PolyMesh::new(points.collect(), panels.faces).map_err(|e| format!("the design's mesh: {e}"))
+}
+
+#[cfg(test)]
+mod design_tests {
+    use super::*;
+
+    #[test]
+    fn a_design_is_read_bare_or_as_the_json_export_writes_it() {
+        let bare = r#"{"vertices": [[0,0,0],[1,0,0],[1,1,0],[0,1,0]], "faces": [[0,1,2,3]]}"#;
+        let export = format!(r#"{{"config": {{}}, "metrics": {{}}, "mesh": {bare}}}"#);
+        for text in [bare, export.as_str()] {
+            let m = design_panels(text).unwrap();
+            assert_eq!((m.num_vertices(), m.num_faces()), (4, 1));
+        }
+    }
+
+    #[test]
+    fn a_bad_design_says_what_is_wrong() {
+        let cases = [
+            ("{", "not a Dupin design"),
+            (r#"{"config": {}}"#, "no `mesh`"),
+            (
+                r#"{"vertices": [[0,0,0]], "faces": [[0,1,2]]}"#,
+                "the design's mesh",
+            ),
+            (
+                r#"{"vertices": [[0,0,"x"]], "faces": []}"#,
+                "not a Dupin design",
+            ),
+        ];
+        for (text, want) in cases {
+            let e = design_panels(text).unwrap_err();
+            assert!(e.contains(want), "{text}: {e}");
+        }
     }
 }
