@@ -80,6 +80,8 @@ mod tests {
             "vendor/node_modules/rhino3dm/rhino3dm.module.js",
             "vendor/node_modules/rhino3dm/rhino3dm.wasm",
             "vendor/node_modules/rhino3dm/rhino3dm.d.ts",
+            "examples/conical-station.json",
+            "examples/scratch.json",
         ] {
             let p = web.join(f);
             std::fs::create_dir_all(p.parent().unwrap()).unwrap();
@@ -87,14 +89,19 @@ mod tests {
         }
         let out = tmp.join("dist");
         let files = copy(&web, &out).unwrap();
-        assert_eq!(files.len(), 7, "{files:?}");
+        assert_eq!(files.len(), 8, "{files:?}");
         for f in &files {
             assert_eq!(
                 std::fs::read_to_string(out.join(f)).unwrap(),
                 f.to_str().unwrap()
             );
         }
-        for absent in ["notes.md", "pkg/dupin_web.d.ts", "vendor/package.json"] {
+        for absent in [
+            "notes.md",
+            "pkg/dupin_web.d.ts",
+            "vendor/package.json",
+            "examples/scratch.json",
+        ] {
             assert!(!out.join(absent).exists(), "{absent}");
         }
         std::fs::remove_dir_all(web.join("pkg")).unwrap();
