@@ -326,7 +326,8 @@ struct PanelsJson {
     faces: Vec<Vec<u32>>,
 }
 
-/// The panels of a design file (see [`DesignJson`]) for a `Viewer`, flat and coloured by
+/// The panels of a design file (`{ vertices: [[x, y, z]], faces: [[i, ...]] }`, 0-based, bare or
+/// under `mesh` as the JSON export writes it) for a `Viewer`, flat and coloured by
 /// planarity as the page colours a run, with their edges: what the `<dupin-viewer>` element
 /// shows.
 ///
