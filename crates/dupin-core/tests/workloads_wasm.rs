@@ -1,0 +1,62 @@
+//! The workloads BENCHMARKS.md times natively and on wasm32 side by side (issue: wasm within
+//! 1.5x of native): hexagonal Delaunay of 16 000 seeded points (extended mode) and the
+//! planarisation of a 10 000-quad grid with seeded noise. Each test checks its result, so a
+//! timing never comes from a run that went wrong. Run natively with
+//! `cargo test --release -p dupin-core --test workloads_wasm`, on wasm32 in Node with
+//! `CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER=wasm-bindgen-test-runner cargo test --release
+//! -p dupin-core --target wasm32-unknown-unknown --test workloads_wasm`.
+
+#[cfg(target_arch = "wasm32")]
+use wasm_bindgen_test::wasm_bindgen_test as test;
+
+use dupin_core::conical::{PqOptions, pq_perturb};
+use dupin_core::hex_delaunay::{HexDelaunayMode, hex_delaunay, triangulation_quality};
+use dupin_core::mesh::{PolyMesh, max_planarity};
+use dupin_core::{Vec2, Vec3};
+
+/// A deterministic stream in [0, 1) (the same on every target; no RNG crate on wasm needed).
+fn lcg(seed: u64) -> impl FnMut() -> f64 {
+    let mut s = seed;
+    move || {
+        s = s
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+#[test]
+fn hex_delaunay_16k_points_extended() {
+    let mut r = lcg(16_000);
+    let points: Vec<Vec2> = (0..16_000).map(|_| Vec2::new(r(), r())).collect();
+    let t = hex_delaunay(&points, &[], HexDelaunayMode::Extended).unwrap();
+    let q = triangulation_quality(&t.vertices, &t.triangles);
+    assert!(
+        t.triangles.len() > 1_000_000,
+        "{} triangles",
+        t.triangles.len()
+    );
+    assert!(
+        q.min_angle_deg >= 43.89 && q.max_angle_deg <= 90.0 + 1e-6,
+        "{q:?}"
+    );
+}
+
+#[test]
+fn planarize_10k_quads() {
+    let n = 100;
+    let mut r = lcg(10_000);
+    let positions: Vec<Vec3> = (0..=n)
+        .flat_map(|j| (0..=n).map(move |i| (i, j)))
+        .map(|(i, j)| {
+            let (x, y) = (i as f64 * 0.05, j as f64 * 0.05);
+            Vec3::new(x, y, 0.3 * ((x - 2.5).powi(2) - (y - 2.5).powi(2)) / 20.0)
+        })
+        .map(|p| p + Vec3::new(0.0, 0.0, 0.004 * (r() - 0.5)))
+        .collect();
+    let mesh = PolyMesh::quad_grid(positions, n, n).unwrap();
+    assert!(max_planarity(&mesh) > 1e-4, "the input is not planar");
+    let out = pq_perturb(&mesh, PqOptions::default()).unwrap();
+    assert!(out.converged, "{:?}", out.reason);
+    assert!(max_planarity(&out.mesh) <= 1e-10);
+}
