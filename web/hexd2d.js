@@ -2,6 +2,7 @@
 // cells, the dual triangulation and its angle histogram all come from wasm (`HexDelaunayLab`);
 // this file handles clicks and drags and draws into 2D canvases.
 import { HexDelaunayLab, pageSchema } from './pkg/dupin_web.js';
+import { download as save } from './download.js';
 
 const VIEW = 3.2; // half-height of the shown world square when everything fits inside it
 const DOT = 4;    // radius of a drawn point, px
@@ -215,13 +216,6 @@ function pictureSvg() {
   }
   parts.push('</svg>');
   return parts.join('\n');
-}
-
-function save(name, blob) {
-  const url = URL.createObjectURL(blob);
-  const a = Object.assign(document.createElement('a'), { href: url, download: name });
-  a.click();
-  setTimeout(() => URL.revokeObjectURL(url), 1000);
 }
 
 /** The point within `reach` px of (px, py), nearest first, or -1. */

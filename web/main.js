@@ -8,6 +8,7 @@ import { FREE, IMPORTED, defaults, readHash, sessionConfig, useSchema, writeHash
 import { buildFields, clearFieldErrors, fillScenePicker, showFieldError } from './controls.js';
 import { drawHistogram, drawLegend, legendCaption, showMetrics, showProgress } from './metrics.js';
 import { SettingsHistory } from './undo.js';
+import { download } from './download.js';
 import { Solver } from './solver.js';
 import { initTeach, showPick } from './teach.js';
 import { initHexd2d } from './hexd2d.js';
@@ -472,12 +473,6 @@ function onError(e) {
 }
 
 // ---- downloads ---------------------------------------------------------------------------------
-function download(name, data, type) {
-  const url = URL.createObjectURL(data instanceof Blob ? data : new Blob([data], { type }));
-  const a = Object.assign(document.createElement('a'), { href: url, download: name });
-  a.click();
-  setTimeout(() => URL.revokeObjectURL(url), 1000);
-}
 
 const EXPORT_TYPES = { obj: 'text/plain', json: 'application/json', svg: 'image/svg+xml', dxf: 'application/dxf', csv: 'text/csv', glb: 'model/gltf-binary' };
 function onExport(m) {

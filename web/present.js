@@ -2,6 +2,7 @@
 // orbit, full screen and a 2x PNG. Rendering and geometry are wasm's (`Presenter`); this file
 // wires events and the frame loop.
 import { Presenter, torusPanels } from './pkg/dupin_web.js';
+import { download } from './download.js';
 
 let presenter = null;
 let panel, canvas, statusEl, frameEl, offsetBox;
@@ -173,10 +174,7 @@ export function initPresent(currentMesh) {
   });
   pngBtn.addEventListener('click', async () => {
     try {
-      const blob = await snapshotPng(2);
-      const url = URL.createObjectURL(blob);
-      Object.assign(el('a'), { href: url, download: 'dupin-presentation@2x.png' }).click();
-      setTimeout(() => URL.revokeObjectURL(url), 1000);
+      download('dupin-presentation@2x.png', await snapshotPng(2));
     } catch (e) { status(String(e.message ?? e), true); }
   });
   document.addEventListener('keydown', (e) => { if (open && e.key === 'Escape' && !document.fullscreenElement) closePresentation(); });

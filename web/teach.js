@@ -3,6 +3,7 @@
 // lesson is either at a surface point (u, v) picked in the inset, or at a mesh vertex clicked in
 // the 3D view (`showPick`, fed by `Session.pickVertex` in the worker).
 import { DupinLesson, surfaceCatalog } from './pkg/dupin_web.js';
+import { download as save } from './download.js';
 
 const SVGNS = 'http://www.w3.org/2000/svg';
 const el = (tag, attrs = {}, text) => {
@@ -276,13 +277,6 @@ async function insetPng(scale) {
   } finally {
     URL.revokeObjectURL(url);
   }
-}
-
-function save(name, blob) {
-  const url = URL.createObjectURL(blob);
-  const a = Object.assign(document.createElement('a'), { href: url, download: name });
-  a.click();
-  setTimeout(() => URL.revokeObjectURL(url), 1000);
 }
 
 /** Adds the Teach button and the inset panel to the page. */
