@@ -401,7 +401,6 @@ function setLayers(patch) {
 function reportError(message, field) {
   settled = true;
   dirty = true; // a refused first configuration still draws its (empty) frame: the page is ready
-
   if (field === 'offset-distance') { showLayerError(message); return; }
   if (!(field && showFieldError(fieldsBox, field, message))) showStatus(`${viewer.backend} · ${message}`, true);
 }
@@ -472,8 +471,7 @@ function onError(e) {
   updateButtons();
 }
 
-// ---- downloads ---------------------------------------------------------------------------------
-
+// ---- downloads (download.js) -------------------------------------------------------------------
 const EXPORT_TYPES = { obj: 'text/plain', json: 'application/json', svg: 'image/svg+xml', dxf: 'application/dxf', csv: 'text/csv', glb: 'model/gltf-binary' };
 function onExport(m) {
   if (m.kind === '3dm') {

@@ -61,8 +61,8 @@ let overhead = 0;
 // While playing (`batch`), once a state's metrics and mesh cost 30 ms or more, a state takes
 // one step for every 10 ms of that overhead, while their solve time stays under it (and 250 ms):
 // revealing a large triangulation takes steps of a hundredth of a millisecond whose states cost
-// 100 ms or more (190k triangles), so measuring and shipping every layer was nearly the whole
-// run (49 s of 55 at 96k faces). Layers still appear a few at a time, and runs whose states
+// 100 ms or more (190k triangles), so measuring and shipping every layer would be nearly the
+// whole run (49 of 55 s at 96k faces). Layers still appear a few at a time, and runs whose states
 // cost less (every scene of the papers: 2-20 ms) show every step.
 function stepOnce(batch = false) {
   const t0 = performance.now();

@@ -3,7 +3,7 @@
 // parse, colour modes change the picture and legend, and WebGL2 steps a scene too.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { byId, drag, exportText, metrics, openPage, pixelStats, shot, waitDone, waitSteps } from './harness.mjs';
+import { byId, drag, exportText, metrics, openPage, pixelStats, shot, waitDone, waitSteps, watchLongTasks } from './harness.mjs';
 
 // About 10k hexagons (BENCHMARKS.md: torus-bound at size 0.155), initialised by Dupin duality so
 // that the Gauss-Newton optimisation runs several iterations.
@@ -12,10 +12,7 @@ const BIG = '#scene=free&surface=torus&method=prescribed&size=0.155&init=dupin-d
 test('a 10k-face run in the worker leaves no main-thread task over 50 ms', async () => {
   const { browser, page, errors } = await openPage({ hash: BIG });
   try {
-    await page.evaluate(() => {
-      window.__long = [];
-      new PerformanceObserver((l) => window.__long.push(...l.getEntries().map((e) => e.duration))).observe({ type: 'longtask' });
-    });
+    await watchLongTasks(page);
     // The observer does see a main-thread task of 80 ms (so an empty list below means something).
     await page.evaluate(() => { setTimeout(() => { const t = performance.now(); while (performance.now() - t < 80); }, 0); });
     await page.waitForFunction(() => window.__long.length > 0);
@@ -47,10 +44,7 @@ const LARGEST = '#scene=free&surface=torus&method=prescribed&size=0.05&init=dupi
 test('the largest run the page admits plays with a progress bar and no main-thread stall', async () => {
   const { browser, page, errors } = await openPage({ hash: LARGEST });
   try {
-    await page.evaluate(() => {
-      window.__long = [];
-      new PerformanceObserver((l) => window.__long.push(...l.getEntries().map((e) => e.duration))).observe({ type: 'longtask' });
-    });
+    await watchLongTasks(page);
     const t0 = Date.now();
     await byId(page, 'play').click();
     // The bar appears after a second of playing, with the core's bound on the steps left.

@@ -65,20 +65,37 @@ export async function shot(page, name) {
   return png;
 }
 
+/** Defines `window.__dupinDecodePng(base64)` -> `{ w, h, d }` (RGBA bytes) in the page, once:
+ * PNGs are decoded by the browser, so the tests need no image library. */
+async function installDecoder(page) {
+  await page.evaluate(() => {
+    window.__dupinDecodePng ??= async (s) => {
+      const img = await createImageBitmap(await (await fetch(`data:image/png;base64,${s}`)).blob());
+      const c = new OffscreenCanvas(img.width, img.height);
+      const g = c.getContext('2d');
+      g.drawImage(img, 0, 0);
+      return { w: img.width, h: img.height, d: g.getImageData(0, 0, img.width, img.height).data };
+    };
+  });
+}
+
+/** Starts collecting the page's long tasks (over 50 ms) in `window.__long` (their durations). */
+export async function watchLongTasks(page) {
+  await page.evaluate(() => {
+    window.__long = [];
+    new PerformanceObserver((l) => window.__long.push(...l.getEntries().map((e) => e.duration))).observe({ type: 'longtask' });
+  });
+}
+
 /**
  * Pixel statistics of PNG `a` (and its difference from PNG `b`), decoded in the page:
  * `covered` is the fraction of pixels farther than 8 levels from the background, taken as the
  * most frequent colour.
  */
 export async function pixelStats(page, a, b = null) {
+  await installDecoder(page);
   return page.evaluate(async ([a64, b64]) => {
-    const decode = async (s) => {
-      const img = await createImageBitmap(await (await fetch(`data:image/png;base64,${s}`)).blob());
-      const c = new OffscreenCanvas(img.width, img.height);
-      const g = c.getContext('2d');
-      g.drawImage(img, 0, 0);
-      return g.getImageData(0, 0, img.width, img.height).data;
-    };
+    const decode = async (s) => (await window.__dupinDecodePng(s)).d;
     const p = await decode(a64);
     const counts = new Map();
     for (let i = 0; i < p.length; i += 4) {
@@ -162,15 +179,9 @@ export async function compareWithReference(page, actual, name) {
     writeFileSync(ref, actual);
   }
   const want = readFileSync(ref);
+  await installDecoder(page);
   return page.evaluate(async ([a64, b64]) => {
-    const decode = async (s) => {
-      const img = await createImageBitmap(await (await fetch(`data:image/png;base64,${s}`)).blob());
-      const c = new OffscreenCanvas(img.width, img.height);
-      const g = c.getContext('2d');
-      g.drawImage(img, 0, 0);
-      return { w: img.width, h: img.height, d: g.getImageData(0, 0, img.width, img.height).data };
-    };
-    const [p, q] = [await decode(a64), await decode(b64)];
+    const [p, q] = [await window.__dupinDecodePng(a64), await window.__dupinDecodePng(b64)];
     if (p.w !== q.w || p.h !== q.h) return { differing: 1, mean: 255, size: [p.w, p.h, q.w, q.h] };
     let differing = 0, sum = 0;
     for (let i = 0; i < p.d.length; i += 4) {
