@@ -204,10 +204,11 @@ test('JSON and SVG exports parse and match the face count; colour modes change p
 });
 
 test('WebGL2 fallback steps a scene in the worker', async () => {
-  const { browser, page, errors } = await openPage({ webgpu: false, hash: '#scene=sphere-spiral&steps=3' });
+  // Twelve layers in: a band wide enough to measure (three were a sliver of 1% of the view).
+  const { browser, page, errors } = await openPage({ webgpu: false, hash: '#scene=sphere-spiral&steps=12' });
   try {
     assert.equal((await byId(page, 'status').textContent()).trim(), 'WebGL2');
-    await waitSteps(page, 3);
+    await waitSteps(page, 12);
     const { covered } = await pixelStats(page, await shot(page, 'webgl2-sphere-spiral'));
     assert.ok(covered > 0.01, `only ${(covered * 100).toFixed(1)}% covered`);
     await byId(page, 'play').click();
