@@ -213,6 +213,10 @@ test('panels: a click anchors a vertex, which stays exactly where the file puts 
     await byId(page, 'import-clear-anchors').click();
     await page.waitForFunction(() => document.querySelector('[data-testid=import-anchors]')?.dataset.anchors === '0'
       && !/anchors=/.test(location.hash), null, { timeout: 60_000 });
+    // Clearing the anchors is a change like any other: Undo brings the anchor back.
+    await byId(page, 'undo').click();
+    await page.waitForFunction(() => document.querySelector('[data-testid=import-anchors]')?.dataset.anchors === '1'
+      && /anchors=60(&|$)/.test(location.hash), null, { timeout: 60_000 });
     assert.deepEqual(errors, []);
   } finally {
     await browser.close();
