@@ -58,15 +58,19 @@ let overhead = 0;
 // `timing` splits the worker's time per state: solver, metrics, render buffers (mesh) and the
 // previous post; `stepsInState` counts the steps the state took.
 //
-// While playing (`batch`), once a state's metrics and mesh cost 30 ms or more, a state takes
-// one step for every 10 ms of that overhead, while their solve time stays under it (and 250 ms):
-// revealing a large triangulation takes steps of a hundredth of a millisecond whose states cost
-// 100 ms or more (190k triangles), so measuring and shipping every layer would be nearly the
-// whole run (49 of 55 s at 96k faces). Layers still appear a few at a time, and runs whose states
-// cost less (every scene of the papers: 2-20 ms) show every step.
+// While playing (`batch`) a large mesh (BATCH_FACES or more) whose last state's metrics and
+// mesh cost 30 ms or more, a state takes one step for every 10 ms of that overhead, while their
+// solve time stays under it (and 250 ms): revealing a large triangulation takes steps of a
+// hundredth of a millisecond whose states cost 100 ms or more (190k triangles), so measuring and
+// shipping every layer would be nearly the whole run (49 of 55 s at 96k faces). Layers still
+// appear a few at a time. The face threshold, not the time alone, decides whether a run batches
+// at all, so every scene of the papers (at most about 10k faces) shows every step however
+// loaded the machine is.
+const BATCH_FACES = 50_000;
 function stepOnce(batch = false) {
   const t0 = performance.now();
-  const most = batch && overhead >= 30 ? Math.ceil(overhead / 10) : 1;
+  const large = (lastMetrics?.faces ?? 0) >= BATCH_FACES;
+  const most = batch && large && overhead >= 30 ? Math.ceil(overhead / 10) : 1;
   let k = 0;
   do {
     session.advance();
