@@ -68,6 +68,11 @@ pub fn run(args: ExportArgs) -> Result<(), CliError> {
             "--support adds the node and beam tables of a CSV: use it with --format csv".into(),
         ));
     }
+    if args.support == Some(0.0) {
+        return Err(CliError::Input(
+            "--support 0: the support structure needs a face distance other than 0".into(),
+        ));
+    }
     let mesh = read_mesh_file(&args.input)?;
     let (w, h) = args.sheet.unwrap_or(DEFAULT_SHEET_MM);
     let options = DxfOptions::default()

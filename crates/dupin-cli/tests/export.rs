@@ -241,4 +241,18 @@ fn csv_of_a_conical_mesh_lists_node_axes_and_planar_beams() {
     ]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--format csv"));
+    // A zero distance has no support structure: refused, not written as zero-length axes.
+    let out = dupin(&[
+        "export",
+        "--input",
+        i,
+        "--format",
+        "csv",
+        "--out",
+        o,
+        "--support",
+        "0",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("other than 0"));
 }
