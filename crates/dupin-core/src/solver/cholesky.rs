@@ -70,89 +70,20 @@ impl SparseCholesky {
         fwd: &[u32],
         limit: usize,
     ) -> Result<Self, SolverError> {
-        let n = upper.ncols();
-        let fwd = fwd.to_vec();
-        if fwd.len() != n {
-            return Err(SolverError::Factorization(
-                "the ordering has the wrong length".into(),
-            ));
-        }
-        let mut inv = vec![u32::MAX; n];
-        for (new, &old) in fwd.iter().enumerate() {
-            if old as usize >= n || inv[old as usize] != u32::MAX {
-                return Err(SolverError::Factorization(
-                    "the ordering is not a permutation".into(),
-                ));
-            }
-            inv[old as usize] = new as u32;
-        }
-        // The permuted entries (row >= col in the lower triangle): bucketed by row, then by
-        // column walking the rows in order, so every column comes out sorted (two counting
-        // sorts, no comparison sort).
-        let (col_ptr, row_idx) = (upper.col_ptr(), upper.row_idx());
-        let nnz = row_idx.len();
-        let entry = |k: usize, c: usize| {
-            let (i, j) = (inv[row_idx[k] as usize], inv[c]);
-            (i.max(j), i.min(j))
-        };
-        let mut row_ptr = vec![0u32; n + 1];
-        for c in 0..n {
-            for k in col_ptr[c] as usize..col_ptr[c + 1] as usize {
-                row_ptr[entry(k, c).0 as usize + 1] += 1;
-            }
-        }
-        prefix_sum(&mut row_ptr);
-        let mut by_row = vec![(0u32, 0u32); nnz];
-        let mut fill = row_ptr.clone();
-        for c in 0..n {
-            for k in col_ptr[c] as usize..col_ptr[c + 1] as usize {
-                let (row, col) = entry(k, c);
-                by_row[fill[row as usize] as usize] = (col, k as u32);
-                fill[row as usize] += 1;
-            }
-        }
-        let mut lower_ptr = vec![0u32; n + 1];
-        by_row
-            .iter()
-            .for_each(|&(col, _)| lower_ptr[col as usize + 1] += 1);
-        prefix_sum(&mut lower_ptr);
-        let mut fill = lower_ptr.clone();
-        let mut lower_row = vec![0u32; nnz];
-        let mut positions = vec![0u32; nnz];
-        for row in 0..n {
-            for &(col, k) in &by_row[row_ptr[row] as usize..row_ptr[row + 1] as usize] {
-                let at = fill[col as usize] as usize;
-                lower_row[at] = row as u32;
-                positions[k as usize] = at as u32;
-                fill[col as usize] += 1;
-            }
-        }
-        // faer's analysis takes the upper triangle: the transpose of `lower`, whose columns
-        // are the rows counted in `row_ptr`.
-        let upper_ptr = row_ptr;
-        let mut fill = upper_ptr.clone();
-        let mut upper_row = vec![0u32; nnz];
-        // Columns of `lower` in increasing order, so each column of the transpose is sorted.
-        for c in 0..n {
-            for &row in &lower_row[lower_ptr[c] as usize..lower_ptr[c + 1] as usize] {
-                upper_row[fill[row as usize] as usize] = c as u32;
-                fill[row as usize] += 1;
-            }
-        }
-        let lower = SymbolicSparseColMat::new_checked(n, n, lower_ptr, None, lower_row);
-        let permuted_upper = SymbolicSparseColMat::new_checked(n, n, upper_ptr, None, upper_row);
-        let symbolic = factorize_symbolic_cholesky(
-            permuted_upper.as_ref(),
-            Side::Upper,
-            SymmetricOrdering::Identity,
-            CholeskySymbolicParams {
-                // faer's automatic choice picks the simplicial kernel for mesh matrices,
-                // several times slower here.
-                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-                ..Default::default()
-            },
-        )
-        .map_err(|e| fe(&e))?;
+        Self::from_analysis(CholeskyAnalysis::new(upper, fwd)?, limit)
+    }
+
+    /// The factorisation of an analysis: refused when its factor needs more than `limit`
+    /// bytes, before the factor is allocated.
+    pub(crate) fn from_analysis(a: CholeskyAnalysis, limit: usize) -> Result<Self, SolverError> {
+        let CholeskyAnalysis {
+            fwd,
+            inv,
+            lower,
+            positions,
+            symbolic,
+        } = a;
+        let n = fwd.len();
         // The factor's size is known from the pattern: refuse before allocating it (an
         // allocation failure aborts the process, and in a browser kills the worker).
         let needed = symbolic
@@ -249,6 +180,123 @@ impl SparseCholesky {
                 "the solve produced non-finite values (singular matrix)".into(),
             ))
         }
+    }
+}
+
+/// The symbolic side of a [`SparseCholesky`]: the permuted pattern and faer's symbolic
+/// factorisation for one ordering, without the factor's storage, so that orderings can be
+/// compared by the size of their factor before one is allocated.
+pub(crate) struct CholeskyAnalysis {
+    fwd: Vec<u32>,
+    inv: Vec<u32>,
+    lower: SymbolicSparseColMat<u32>,
+    positions: Vec<u32>,
+    symbolic: SymbolicCholesky<u32>,
+}
+
+impl CholeskyAnalysis {
+    /// Entries of the factor L this ordering leads to (supernodal blocks included).
+    pub(crate) fn factor_len(&self) -> usize {
+        self.symbolic.len_val()
+    }
+
+    /// Analyses the upper-triangle pattern `upper` (square, sorted rows, diagonal included)
+    /// for the ordering `fwd` (`fwd[new] = old`). Fails on a malformed ordering or when faer
+    /// runs out of memory.
+    pub(crate) fn new(
+        upper: SymbolicSparseColMatRef<'_, u32>,
+        fwd: &[u32],
+    ) -> Result<Self, SolverError> {
+        let n = upper.ncols();
+        let fwd = fwd.to_vec();
+        if fwd.len() != n {
+            return Err(SolverError::Factorization(
+                "the ordering has the wrong length".into(),
+            ));
+        }
+        let mut inv = vec![u32::MAX; n];
+        for (new, &old) in fwd.iter().enumerate() {
+            if old as usize >= n || inv[old as usize] != u32::MAX {
+                return Err(SolverError::Factorization(
+                    "the ordering is not a permutation".into(),
+                ));
+            }
+            inv[old as usize] = new as u32;
+        }
+        // The permuted entries (row >= col in the lower triangle): bucketed by row, then by
+        // column walking the rows in order, so every column comes out sorted (two counting
+        // sorts, no comparison sort).
+        let (col_ptr, row_idx) = (upper.col_ptr(), upper.row_idx());
+        let nnz = row_idx.len();
+        let entry = |k: usize, c: usize| {
+            let (i, j) = (inv[row_idx[k] as usize], inv[c]);
+            (i.max(j), i.min(j))
+        };
+        let mut row_ptr = vec![0u32; n + 1];
+        for c in 0..n {
+            for k in col_ptr[c] as usize..col_ptr[c + 1] as usize {
+                row_ptr[entry(k, c).0 as usize + 1] += 1;
+            }
+        }
+        prefix_sum(&mut row_ptr);
+        let mut by_row = vec![(0u32, 0u32); nnz];
+        let mut fill = row_ptr.clone();
+        for c in 0..n {
+            for k in col_ptr[c] as usize..col_ptr[c + 1] as usize {
+                let (row, col) = entry(k, c);
+                by_row[fill[row as usize] as usize] = (col, k as u32);
+                fill[row as usize] += 1;
+            }
+        }
+        let mut lower_ptr = vec![0u32; n + 1];
+        by_row
+            .iter()
+            .for_each(|&(col, _)| lower_ptr[col as usize + 1] += 1);
+        prefix_sum(&mut lower_ptr);
+        let mut fill = lower_ptr.clone();
+        let mut lower_row = vec![0u32; nnz];
+        let mut positions = vec![0u32; nnz];
+        for row in 0..n {
+            for &(col, k) in &by_row[row_ptr[row] as usize..row_ptr[row + 1] as usize] {
+                let at = fill[col as usize] as usize;
+                lower_row[at] = row as u32;
+                positions[k as usize] = at as u32;
+                fill[col as usize] += 1;
+            }
+        }
+        // faer's analysis takes the upper triangle: the transpose of `lower`, whose columns
+        // are the rows counted in `row_ptr`.
+        let upper_ptr = row_ptr;
+        let mut fill = upper_ptr.clone();
+        let mut upper_row = vec![0u32; nnz];
+        // Columns of `lower` in increasing order, so each column of the transpose is sorted.
+        for c in 0..n {
+            for &row in &lower_row[lower_ptr[c] as usize..lower_ptr[c + 1] as usize] {
+                upper_row[fill[row as usize] as usize] = c as u32;
+                fill[row as usize] += 1;
+            }
+        }
+        let lower = SymbolicSparseColMat::new_checked(n, n, lower_ptr, None, lower_row);
+        let permuted_upper = SymbolicSparseColMat::new_checked(n, n, upper_ptr, None, upper_row);
+        let symbolic = factorize_symbolic_cholesky(
+            permuted_upper.as_ref(),
+            Side::Upper,
+            SymmetricOrdering::Identity,
+            CholeskySymbolicParams {
+                // faer's automatic choice picks the simplicial kernel for mesh matrices,
+                // several times slower here.
+                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                ..Default::default()
+            },
+        )
+        .map_err(|e| fe(&e))?;
+        Ok(CholeskyAnalysis {
+            fwd,
+            inv,
+            lower,
+            positions,
+            symbolic,
+        })
     }
 }
 

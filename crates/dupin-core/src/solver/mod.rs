@@ -22,6 +22,7 @@ mod block_normal;
 mod block_system;
 mod cholesky;
 mod gauss_newton;
+mod nested_dissection;
 mod pattern;
 mod sqp;
 
