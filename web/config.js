@@ -23,6 +23,8 @@ export function defaults() {
     imported: { name: null, as: null, unit: null, method: 'prescribed', init: SCHEMA.initialisations[0].name, size: null, bound: null, lambda: null, mu: null, mode: 'planar', fixBoundary: false, anchors: [], closeness: null, toleranceMm: null, read: null },
     free: { surface: 'torus', method: SCHEMA.methods[0].name, init: SCHEMA.initialisations[0].name, size: null, bound: null, lambda: null, mu: null },
     steps: 1,
+    // Committed vertex drags of a panel run, [vertex, x, y, z] each, replayed in order.
+    edits: [],
     color: SCHEMA.colorModes[0],
     panelEdge: 1.5,
     layers: { offset: false, support: false, distance: SCHEMA.offsetDistance },
@@ -59,6 +61,14 @@ export function readHash(hash, { scenes, catalog, torusParams }) {
     c.free.surface = surface.name;
     for (const p of surface.params) c.params[p.key] = h.has(`p.${p.key}`) ? num(h.get(`p.${p.key}`)) : p.default;
     readRunSettings(h, c.free);
+  }
+  // Vertex drags `edits=12:0.5,1,-0.25;40:...` (vertex:x,y,z, as many digits as round-trip).
+  if (c.scene !== 'torus') {
+    for (const e of (h.get('edits') ?? '').split(';').slice(0, 1000)) {
+      const m = /^(\d+):([^,]+),([^,]+),([^,]+)$/.exec(e);
+      const xyz = m ? [m[2], m[3], m[4]].map(Number) : [];
+      if (m && xyz.every(Number.isFinite)) c.edits.push([Number(m[1]), ...xyz]);
+    }
   }
   // The torus preview does not step (writeHash leaves its steps out).
   const steps = Number(h.get('steps'));
@@ -115,6 +125,7 @@ export function writeHash(c) {
     if (c.imported.closeness !== null) h.set('closeness', String(c.imported.closeness));
     if (c.imported.toleranceMm !== null) h.set('tol', String(c.imported.toleranceMm));
   }
+  if (c.scene !== 'torus' && c.edits.length) h.set('edits', c.edits.map(([v, x, y, z]) => `${v}:${x},${y},${z}`).join(';'));
   if (c.scene !== 'torus') h.set('steps', String(c.steps));
   if (c.color !== d.color) h.set('color', c.color);
   if (c.panelEdge !== 1.5) h.set('edge', String(c.panelEdge));

@@ -174,7 +174,7 @@ function load(next, { reframe = true, field = null, rebuild = false } = {}) {
   const cfg = sessionConfig(next);
   // A .3dm's own unit, unless the user picked one.
   if (file && opened.unit && !cfg.unit) cfg.unit = opened.unit;
-  solver.load(cfg, { steps: next.steps, mode: next.color, field, layers: next.layers, file });
+  solver.load(cfg, { steps: next.steps, mode: next.color, field, layers: next.layers, file, edits: next.edits });
   if (file) watchRead(candidate, opened.name);
   updateButtons();
 }
@@ -288,6 +288,10 @@ function applyState(s) {
   stepLog.push(entry);
   if (stepLog.length > 5000) stepLog.shift();
   schedulePanel(m, entry);
+  const canEdit = editable(m);
+  setProp($('edit-vertices'), 'hidden', !canEdit);
+  if (!canEdit && editMode) setEditMode(false);
+  dragStateArrived();
   if (playing) requestAnimationFrame(() => solver.post('ack'));
 }
 
@@ -548,6 +552,7 @@ function pickAt(x, y) {
 }
 
 function onPick(m) {
+  if (m.drag) { dragPicked(m); return; }
   if (m.panels) {
     if (m.error) { reportError(m.error, 'import-anchors'); return; }
     if (!m.pick) return; // a click beside the mesh
@@ -557,6 +562,7 @@ function onPick(m) {
     if (k >= 0) a.splice(k, 1); else a.push(m.pick.vertex);
     a.sort((x, y) => x - y);
     next.steps = 1;
+    next.edits = [];
     // The run restarts with the new anchors; fields show the count once it is accepted.
     load(next, { reframe: false, field: 'import-anchors', rebuild: true });
     return;
@@ -579,16 +585,122 @@ function placeMarker() {
   marker.style.top = `${canvas.offsetTop + (1 - p[1]) * 0.5 * canvas.clientHeight}px`;
 }
 
+// ---- dragging a vertex of a panel mesh (edit mode) ---------------------------------------------
+// A press on the mesh picks the panel corner under it (Session.pickPanelVertex, in the worker);
+// moving the pointer then drags that vertex in the plane through it facing the view. The worker
+// restarts the run with the vertex held (Session.dragVertex) and steps it while the pointer
+// moves, one state in flight at a time (the latest pointer position wins); on release the drag
+// is committed to the URL (`edits`), so Undo replays the drags before it, bit for bit.
+let editMode = false;
+let drag = null; // { id, x, y, origin, direction, vertex, point, start, inFlight, sent }
+
+/** Whether the run on show is a panel mesh whose vertices can be dragged (a PQ mesh scene or an
+ * opened panel mesh; not a P-Hex run, not a developable strip). */
+function editable(m) {
+  return !!m && m.level !== undefined && m.maxDeterminant === undefined;
+}
+
+function setEditMode(on) {
+  editMode = on;
+  setProp($('edit-vertices'), 'ariaPressed', on ? 'true' : 'false');
+  canvas.classList.toggle('editing', on);
+}
+
+function rayAt(x, y) {
+  const nx = (x / canvas.clientWidth) * 2 - 1, ny = 1 - (y / canvas.clientHeight) * 2;
+  const r = viewer.pickRay(nx, ny);
+  return { origin: Array.from(r.slice(0, 3)), direction: Array.from(r.slice(3, 6)) };
+}
+
+function dragStart(e) {
+  const r = canvas.getBoundingClientRect();
+  const x = e.clientX - r.left, y = e.clientY - r.top;
+  try {
+    const ray = rayAt(x, y);
+    drag = { id: e.pointerId, x, y, ...ray, vertex: null, point: null, start: true, inFlight: false, sent: null };
+    solver.post('pick', { origin: ray.origin, direction: ray.direction, panels: true, drag: true });
+  } catch (e2) { drag = null; reportError(e2.message ?? String(e2), 'edit-vertices'); }
+}
+
+function dragPicked(m) {
+  if (!drag) return;
+  if (m.error || !m.pick) { drag = null; if (m.error) reportError(m.error, 'edit-vertices'); return; }
+  drag.vertex = m.pick.vertex;
+  drag.point = m.pick.point;
+  sendDrag();
+}
+
+/** The pointer's point on the drag plane: through the picked vertex, normal to the press's
+ * view ray (null when the ray runs along the plane). */
+function dragPoint() {
+  const { origin: o, direction: d } = rayAt(drag.x, drag.y);
+  const n = drag.direction, p = drag.point;
+  const dn = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
+  if (Math.abs(dn) < 1e-9) return null;
+  const t = ((p[0] - o[0]) * n[0] + (p[1] - o[1]) * n[1] + (p[2] - o[2]) * n[2]) / dn;
+  return [o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]];
+}
+
+function sendDrag() {
+  if (!drag || drag.vertex === null || drag.inFlight) return;
+  let q;
+  try { q = dragPoint(); } catch { q = null; }
+  if (!q || (drag.sent && q.every((c, k) => c === drag.sent[k]))) return;
+  drag.inFlight = true;
+  drag.sent = q;
+  solver.post('drag', { vertex: drag.vertex, point: q, start: drag.start });
+  drag.start = false;
+}
+
+/** A state arrived: the next pointer position may go. */
+function dragStateArrived() {
+  if (!drag) return;
+  drag.inFlight = false;
+  sendDrag();
+}
+
+function dragEnd() {
+  const d = drag;
+  drag = null;
+  if (!d || d.vertex === null) return;
+  // The last position goes even if a state is still in flight (the worker takes them in order).
+  try {
+    const q = dragPointOf(d);
+    if (q && !(d.sent && q.every((c, k) => c === d.sent[k]))) {
+      solver.post('drag', { vertex: d.vertex, point: q, start: d.start });
+      d.sent = q;
+    }
+  } catch { /* the last sent position stands */ }
+  if (!d.sent) return;
+  config.edits = [...config.edits, [d.vertex, ...d.sent]];
+  welcome = false;
+  syncHash();
+}
+
+function dragPointOf(d) {
+  const keep = drag;
+  drag = d;
+  try { return dragPoint(); } finally { drag = keep; }
+}
+
 function wireInput() {
   const pointers = new Map();
   let pinch = 0;
   let down = null; // where a one-finger press started: a release near it is a click (pick)
   canvas.addEventListener('pointerdown', (e) => {
     canvas.setPointerCapture(e.pointerId);
+    if (editMode && pointers.size === 0 && running) { dragStart(e); return; }
     pointers.set(e.pointerId, e);
     down = pointers.size === 1 ? { id: e.pointerId, x: e.clientX, y: e.clientY, moved: false } : null;
   });
   canvas.addEventListener('pointermove', (e) => {
+    if (drag && drag.id === e.pointerId) {
+      const r = canvas.getBoundingClientRect();
+      drag.x = e.clientX - r.left;
+      drag.y = e.clientY - r.top;
+      sendDrag();
+      return;
+    }
     const prev = pointers.get(e.pointerId);
     if (!prev) return;
     if (down && Math.hypot(e.clientX - down.x, e.clientY - down.y) > 4) down.moved = true;
@@ -606,6 +718,7 @@ function wireInput() {
   });
   const up = (e) => { pointers.delete(e.pointerId); pinch = 0; };
   canvas.addEventListener('pointerup', (e) => {
+    if (drag && drag.id === e.pointerId) { dragEnd(); return; }
     const click = down && down.id === e.pointerId && !down.moved;
     down = null;
     up(e);
@@ -614,7 +727,7 @@ function wireInput() {
       pickAt(e.clientX - r.left, e.clientY - r.top);
     }
   });
-  canvas.addEventListener('pointercancel', up);
+  canvas.addEventListener('pointercancel', (e) => { if (drag && drag.id === e.pointerId) dragEnd(); up(e); });
   canvas.addEventListener('wheel', (e) => { e.preventDefault(); viewer.zoom(Math.exp(e.deltaY * 0.001)); cameraMoved(); }, { passive: false });
 }
 
@@ -654,6 +767,7 @@ function rebuildFields() {
       const next = structuredClone(config);
       apply(next);
       next.steps = 1;
+      next.edits = [];
       next.camera = null;
       if (rebuild) { config = next; rebuildFields(); }
       load(next, { reframe: true, field });
@@ -751,6 +865,7 @@ async function main() {
   });
   $('stop').addEventListener('click', stop);
   $('undo').addEventListener('click', () => undoRedo(false));
+  $('edit-vertices').addEventListener('click', () => setEditMode(!editMode));
   $('redo').addEventListener('click', () => undoRedo(true));
   // Ctrl+Z, Ctrl+Shift+Z and Ctrl+Y (Cmd on a Mac), except in a text field, which keeps its own.
   document.addEventListener('keydown', (e) => {
@@ -761,7 +876,7 @@ async function main() {
     e.preventDefault();
     undoRedo(key === 'y' || e.shiftKey);
   });
-  $('reset').addEventListener('click', () => { welcome = false; if (running) load({ ...config, steps: 1 }, { reframe: true }); });
+  $('reset').addEventListener('click', () => { welcome = false; if (running) load({ ...config, steps: 1, edits: [] }, { reframe: true }); });
   $('color-mode').addEventListener('change', (e) => setColorMode(e.target.value));
   $('panel-edge').addEventListener('change', (e) => {
     const v = Number(e.target.value);

@@ -52,10 +52,11 @@ export class Solver {
   /** Starts `config` (a Session config) and replays `steps` steps; `field` names the input
    * that caused the load (bad configurations report back to it); `layers` are the offset and
    * support layers to draw where the run has them; `file` ({ name, bytes }) opens a design
-   * with `config` as its import options (Session.fromFile). */
-  load(config, { steps = 1, mode, field = null, layers = null, file = null } = {}) {
+   * with `config` as its import options (Session.fromFile); `edits` ([vertex, x, y, z] each)
+   * are vertex drags replayed after the steps (Session.dragVertex), each run to its end. */
+  load(config, { steps = 1, mode, field = null, layers = null, file = null, edits = [] } = {}) {
     this.gen += 1;
-    this.worker.postMessage({ type: 'load', gen: this.gen, config, steps, mode, field, layers, file });
+    this.worker.postMessage({ type: 'load', gen: this.gen, config, steps, mode, field, layers, file, edits });
     return this.gen;
   }
 

@@ -1,7 +1,9 @@
 // The solver thread: a module worker that owns the `Session` (state and geometry in Rust) so
 // the page's thread only draws. Protocol (all messages carry the load generation `gen`; stale
 // ones are dropped on both sides):
-//   in:  load {config, steps, mode, layers, file?} (file {name, bytes}: Session.fromFile) | step | play | pause | ack | mode {mode}
+//   in:  load {config, steps, mode, layers, file?, edits?} (file {name, bytes}: Session.fromFile; edits: drags to replay)
+//        | step | play | pause | ack | mode {mode}
+//        | drag {vertex, point, start} (Session.dragVertex; start: a new drag)
 //        | layers {layers} (offset/support, Session.setLayers) | export {kind, panelEdge} (obj, json, svg, dxf, csv, glb, 3dm)
 //        | pick {origin, direction, panels} (a view ray; panels: Session.pickPanelVertex)
 //        | fault {kind} (debugFault: a deliberate trap or out-of-memory, for recovery tests)
@@ -18,6 +20,7 @@ let mode = null; // colour mode; null: Session.mesh's default
 let playing = false;
 let lastMetrics = null;
 let layers = null; // the page's offset/support settings, applied where the run has an offset
+let dragRun = false; // the run was restarted by a drag: each state takes DRAG_FRAME_MS of steps
 
 // Sets the layers on the session where it has an offset layer (else they stay off and the
 // page shows Session.offsetUnavailable's reason).
@@ -67,7 +70,10 @@ let overhead = 0;
 // at all, so every scene of the papers (at most about 10k faces) shows every step however
 // loaded the machine is.
 const BATCH_FACES = 50_000;
-function stepOnce(batch = false) {
+// A drag's state takes as many steps as fit in this (the rest of a 50 ms frame draws it).
+const DRAG_FRAME_MS = 30;
+// `budget`: keep stepping for that many milliseconds (a drag).
+function stepOnce(batch = false, budget = 0) {
   const t0 = performance.now();
   const large = (lastMetrics?.faces ?? 0) >= BATCH_FACES;
   const most = batch && large && overhead >= 30 ? Math.ceil(overhead / 10) : 1;
@@ -75,7 +81,7 @@ function stepOnce(batch = false) {
   do {
     session.advance();
     k += 1;
-  } while (k < most && !session.done() && performance.now() - t0 < Math.min(overhead, 250));
+  } while (!session.done() && ((k < most && performance.now() - t0 < Math.min(overhead, 250)) || performance.now() - t0 < budget));
   const t1 = performance.now();
   const m = session.metrics();
   const t2 = performance.now();
@@ -112,6 +118,7 @@ const handlers = {
     mode = msg.mode ?? mode;
     layers = msg.layers ?? null;
     playing = false;
+    dragRun = false;
     steps = 0;
     overhead = 0;
     try { applyLayers(); } catch (e) { layers = null; fail(e, 'offset-distance'); }
@@ -119,6 +126,10 @@ const handlers = {
       // Replays `steps` steps (a restored URL); the first step is always taken.
       const target = Math.max(1, msg.steps ?? 1);
       while (steps < target && !session.done()) stepOnce();
+      // Committed drags, as the page made them: each starts from the run so far finished.
+      const edits = msg.edits ?? [];
+      for (const [v, x, y, z] of edits) session.dragVertex(v, x, y, z, true);
+      if (edits.length) while (!session.done()) stepOnce();
       send();
     } catch (e) { fail(e); }
   },
@@ -133,6 +144,22 @@ const handlers = {
     try { stepOnce(true); send(); } catch (e) { fail(e); }
   },
   pause() { playing = false; },
+  // A vertex drag: the run restarts from the mesh committed when the drag began, the vertex
+  // held at `point`; steps for up to DRAG_FRAME_MS, then the state, then (playing) the ack loop
+  // finishes the run.
+  drag(msg) {
+    if (!session) return;
+    try {
+      session.dragVertex(msg.vertex, msg.point[0], msg.point[1], msg.point[2], !!msg.start);
+    } catch (e) {
+      if (e instanceof WebAssembly.RuntimeError) { fail(e); return; }
+      postMessage({ type: 'error', gen, message: e?.message ?? String(e), field: 'edit-vertices' });
+      return;
+    }
+    playing = true;
+    dragRun = true;
+    try { stepOnce(false, DRAG_FRAME_MS); send(); } catch (e) { fail(e); }
+  },
   fault(msg) {
     try { debugFault(msg.kind); } catch (e) { fail(e); }
   },
@@ -142,7 +169,7 @@ const handlers = {
     if (msg.gen !== gen || !playing || !session || session.done()) return;
     setTimeout(() => {
       if (!playing || !session || session.done()) return;
-      try { stepOnce(true); send(); } catch (e) { fail(e); }
+      try { stepOnce(true, dragRun ? DRAG_FRAME_MS : 0); send(); } catch (e) { fail(e); }
     }, 0);
   },
   layers(msg) {
@@ -160,8 +187,8 @@ const handlers = {
     try {
       // A panel mesh picks its design vertices (anchors); P-Hex its triangulation's stars.
       const pick = msg.panels ? session.pickPanelVertex(msg.origin, msg.direction) : session.pickVertex(msg.origin, msg.direction);
-      postMessage({ type: 'pick', gen, panels: !!msg.panels, pick });
-    } catch (e) { postMessage({ type: 'pick', gen, error: e?.message ?? String(e) }); }
+      postMessage({ type: 'pick', gen, panels: !!msg.panels, drag: !!msg.drag, pick });
+    } catch (e) { postMessage({ type: 'pick', gen, drag: !!msg.drag, error: e?.message ?? String(e) }); }
   },
   export(msg) {
     if (!session) return;

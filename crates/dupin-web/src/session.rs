@@ -753,6 +753,38 @@ impl Session {
         })
     }
 
+    /// Drags `vertex` of a panel mesh (a PQ scene or an opened panel mesh) to `(x, y, z)`:
+    /// the vertex is held there (an anchor from now on) and the perturbation restarts, one
+    /// iteration a step, from the mesh committed when the drag began (`start`: a new drag,
+    /// which first finishes the running perturbation and commits its result). So every move
+    /// of a drag starts from the same mesh and replaying the committed drags rebuilds a mesh
+    /// bit for bit. Throws for a P-Hex run, a developable strip, a vertex outside the mesh or
+    /// a position that is not finite, leaving the run as it was.
+    #[wasm_bindgen(js_name = dragVertex)]
+    pub fn drag_vertex(
+        &mut self,
+        vertex: usize,
+        x: f64,
+        y: f64,
+        z: f64,
+        start: bool,
+    ) -> Result<(), JsError> {
+        let Run::Pq { stepper, started } = &mut self.run else {
+            return Err(JsError::new(
+                "dragging is for a panel mesh: a P-Hex run follows its surface, not its vertices",
+            ));
+        };
+        if start {
+            stepper.commit().map_err(err)?;
+        }
+        stepper
+            .hold_vertex(vertex, dupin_core::Vec3::new(x, y, z))
+            .map_err(err)?;
+        *started = true;
+        self.per_face = None;
+        Ok(())
+    }
+
     /// The current mesh for the viewer: flat panels coloured by `mode` (`planarity`: blue
     /// planar, through white, to red at 1e-2 and above, log scale; `convexity`; `regularity`:
     /// the P-Hex paper's section 4.2 deviation from the affine (quasi-)regular hexagon) and
@@ -893,8 +925,11 @@ impl Session {
             }
         };
         let mut data = MeshData::panels(m.clone(), &colors);
-        if let Some(design) = &self.design {
-            data.add_lines(&anchor_crosses(&m, &design.anchors));
+        // The held vertices of a panel mesh: the opened design's anchors and every dragged one.
+        if let Run::Pq { stepper, .. } = &self.run
+            && !stepper.anchors().is_empty()
+        {
+            data.add_lines(&anchor_crosses(&m, stepper.anchors()));
         }
         if let Some((offset, beams, segments)) = self.layer_meshes(&m)? {
             if let Some(offset) = offset {
@@ -1247,6 +1282,40 @@ mod tests {
             layers: LayerConfig::default(),
             design: None,
         }
+    }
+
+    /// A drag on the finished `conical-station`: the run restarts from the committed mesh,
+    /// the dragged vertex is held where it was put and drawn as an anchor, and the run ends
+    /// planar again.
+    #[test]
+    fn a_drag_restarts_the_run_with_the_vertex_held() {
+        let mut s = pq_session("conical-station");
+        while !s.done() {
+            s.advance().unwrap();
+        }
+        let before = s.current_mesh().unwrap();
+        let v = 40;
+        let p = before.positions[v] + dupin_core::Vec3::new(0.0, 0.0, 0.05);
+        s.drag_vertex(v, p.x, p.y, p.z, true).unwrap();
+        assert!(!s.done(), "the drag restarts the run");
+        let t0 = std::time::Instant::now();
+        let mut steps = 0;
+        while !s.done() {
+            s.advance().unwrap();
+            steps += 1;
+        }
+        eprintln!(
+            "{} faces: replanarised in {steps} steps, {:?}",
+            before.num_faces(),
+            t0.elapsed()
+        );
+        let after = s.current_mesh().unwrap();
+        assert_eq!(after.positions[v], p);
+        let m = s.metrics_struct();
+        assert_eq!(m.phase, "done");
+        assert!(m.max_planarity <= 1e-9, "{}", m.max_planarity);
+        let crosses = anchor_crosses(&after, &[v]);
+        assert!(!crosses.is_empty());
     }
 
     /// A PQ scene steps level by level: the control mesh first, then one perturbation

@@ -20,6 +20,7 @@ mod circular;
 mod cones;
 mod developable_strip;
 mod discrete_terms;
+mod live_edit;
 mod offset;
 mod perturbation;
 mod principal_quads;

@@ -23,6 +23,9 @@ pub enum PqSceneError {
     /// No scene has this name.
     #[error("unknown PQ scene `{0}` (see --list-scenes)")]
     UnknownScene(String),
+    /// A live edit that cannot be made (the message says why).
+    #[error("{0}")]
+    Edit(String),
     /// The perturbation rejected a mesh of the scene.
     #[error(transparent)]
     Pq(#[from] PqError),
@@ -153,7 +156,7 @@ pub struct PqSceneStepInfo {
 
 /// The refinement a stepper applies.
 #[derive(Debug, Clone)]
-enum Target {
+pub(super) enum Target {
     Mesh(MeshRule),
     /// The current strip (the perturbation runs on its cut-open mesh).
     Strip {
@@ -164,20 +167,25 @@ enum Target {
 
 /// A PQ scene that can be stepped and watched (see the module documentation).
 pub struct PqSceneStepper {
-    target: Target,
-    options: PqOptions,
-    levels: usize,
-    level: usize,
-    phase: PqScenePhase,
+    pub(super) target: Target,
+    pub(super) options: PqOptions,
+    pub(super) levels: usize,
+    pub(super) level: usize,
+    pub(super) phase: PqScenePhase,
     /// The running perturbation; `None` once it finished (the next step subdivides or the
     /// run is done).
-    perturbation: Option<PqPerturbation>,
-    mesh: PolyMesh,
+    pub(super) perturbation: Option<PqPerturbation>,
+    pub(super) mesh: PolyMesh,
     /// Iterations of the finished perturbations.
     done_iterations: usize,
     /// Iterations of the running perturbation.
-    running_iterations: usize,
-    converged: bool,
+    pub(super) running_iterations: usize,
+    pub(super) converged: bool,
+    /// The mesh live edits start from ([`PqSceneStepper::commit`]), `None` before the first.
+    pub(super) edit_base: Option<PolyMesh>,
+    /// The stages still to come of the running live edit: its vertex and the positions it is
+    /// held at next, the last one first.
+    pub(super) edit_stages: Option<(usize, Vec<crate::Vec3>)>,
 }
 
 /// Why a finished PQ scene misses what it was asked (a perturbation level that did not reach
@@ -233,6 +241,8 @@ impl PqSceneStepper {
             done_iterations: 0,
             running_iterations: 0,
             converged: true,
+            edit_base: None,
+            edit_stages: None,
         })
     }
 
@@ -260,6 +270,8 @@ impl PqSceneStepper {
             done_iterations: 0,
             running_iterations: 0,
             converged: true,
+            edit_base: None,
+            edit_stages: None,
         })
     }
 
@@ -298,9 +310,9 @@ impl PqSceneStepper {
 
     /// Ends a finished perturbation: its result becomes the current mesh, and after the last
     /// level the run is done.
-    fn settle(&mut self) {
+    fn settle(&mut self) -> Result<(), PqSceneError> {
         if !self.perturbation.as_ref().is_some_and(|p| p.is_done()) {
-            return;
+            return Ok(());
         }
         let Ok(r) = self
             .perturbation
@@ -311,9 +323,19 @@ impl PqSceneStepper {
         self.running_iterations = 0;
         self.converged &= r.converged;
         self.show(r.mesh);
+        // A live edit moves its vertex in stages (live_edit.rs): the next one starts here,
+        // unless this one missed the tolerance (the edit then ends short of its target, as a
+        // run that did not converge).
+        if !r.converged {
+            self.edit_stages = None;
+        }
+        if self.next_edit_stage()? {
+            return Ok(());
+        }
         if self.level == self.levels {
             self.phase = PqScenePhase::Done;
         }
+        Ok(())
     }
 
     /// Takes the positions of the perturbation's mesh (for strips, of the cut-open mesh).
@@ -333,7 +355,7 @@ impl PqSceneStepper {
     /// One perturbation iteration or one subdivision, unmeasured; `show` copies a running
     /// perturbation's mesh out for display.
     fn advance(&mut self, show: bool) -> Result<(), PqSceneError> {
-        self.settle();
+        self.settle()?;
         if self.phase == PqScenePhase::Done {
             return Ok(());
         }
@@ -345,7 +367,7 @@ impl PqSceneStepper {
                 let m = p.mesh().clone();
                 self.show(m);
             }
-            self.settle();
+            self.settle()?;
         } else {
             self.level += 1;
             self.phase = PqScenePhase::Subdivide;
@@ -407,7 +429,12 @@ impl Stepper for PqSceneStepper {
             .as_ref()
             .and_then(|p| p.steps_left_at_most())
             .unwrap_or(0);
-        Some(running + (self.levels - self.level) * (1 + self.options.max_iterations))
+        let stages = self.edit_stages.as_ref().map_or(0, |(_, path)| path.len());
+        Some(
+            running
+                + stages * self.options.max_iterations
+                + (self.levels - self.level) * (1 + self.options.max_iterations),
+        )
     }
 
     /// The current state and its measures (computed on the current mesh).
