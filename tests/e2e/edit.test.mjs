@@ -3,7 +3,7 @@
 // gives back the mesh before the drag and Redo the dragged one, both bit for bit.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { byId, exportText, metrics, openPage, waitDone } from './harness.mjs';
+import { byId, dragImportedGrid, exportText, metrics, openPage, waitDone } from './harness.mjs';
 
 // The drag, in pixels: about half an edge of the finished scene at the default view.
 const DX = 10, DY = 6;
@@ -70,6 +70,37 @@ test('dragging a vertex of conical-station keeps the panels planar, holds the ve
     await page.waitForFunction(() => location.hash.includes('edits='));
     await waitDone(page);
     assert.equal(await exportText(page, 'export-obj'), after, 'redo replays the drag to the same mesh');
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
+
+test('dragging a vertex of an opened 1 024-quad mesh: planar again, the vertex under the pointer, undo bit for bit', async () => {
+  const { browser, page, errors } = await openPage();
+  try {
+    const r = await dragImportedGrid(page, 32);
+    console.log(`imported 32 x 32: ${r.perSecond.toFixed(1)} states/s while dragging; ${r.settle.phase} at max planarity ${r.settle.maxPlanarity} ${r.settle.ms.toFixed(0)} ms after release`);
+    assert.equal(r.settle.phase, 'done');
+    assert.ok(r.settle.maxPlanarity <= 1e-9, r.settle.maxPlanarity);
+    const [v, ...xyz] = (await edits(page)).split(/[:,]/).map(Number);
+    assert.equal(v, r.middle, 'the vertex under the pointer was dragged');
+    const q = await page.evaluate(([x, y, z]) => {
+      const p = window.dupin.viewer.project(x, y, z);
+      const c = document.querySelector('[data-testid=canvas]').getBoundingClientRect();
+      return [c.left + (p[0] + 1) * 0.5 * c.width, c.top + (1 - p[1]) * 0.5 * c.height];
+    }, xyz);
+    assert.ok(Math.hypot(q[0] - r.pointer[0], q[1] - r.pointer[1]) < 1.5, `${q} vs ${r.pointer}`);
+    const after = await exportText(page, 'export-obj');
+    await byId(page, 'undo').click();
+    await page.waitForFunction(() => !location.hash.includes('edits='));
+    await waitDone(page);
+    const before = await exportText(page, 'export-obj');
+    assert.notEqual(before, after);
+    await byId(page, 'redo').click();
+    await page.waitForFunction(() => location.hash.includes('edits='));
+    await waitDone(page);
+    assert.equal(await exportText(page, 'export-obj'), after, 'redo replays the drag bit for bit');
     assert.deepEqual(errors, []);
   } finally {
     await browser.close();

@@ -193,3 +193,54 @@ export async function compareWithReference(page, actual, name) {
     return { differing: differing / n, mean: sum / n };
   }, [actual.toString('base64'), want.toString('base64')]);
 }
+
+/** An n x n noisy quad grid, 2 m spacing, +-1 mm noise, as OBJ text. */
+export function gridObj(n) {
+  let seed = 11;
+  const rnd = () => { seed = (seed * 1103515245 + 12345) % 2147483648; return seed / 2147483648; };
+  let obj = '';
+  for (let i = 0; i <= n; i++) for (let j = 0; j <= n; j++) obj += `v ${2 * i} ${2 * j} ${(rnd() - 0.5) * 0.002}\n`;
+  const id = (i, j) => i * (n + 1) + j + 1;
+  for (let i = 0; i < n; i++) for (let j = 0; j < n; j++) obj += `f ${id(i, j)} ${id(i + 1, j)} ${id(i + 1, j + 1)} ${id(i, j + 1)}\n`;
+  return obj;
+}
+
+/**
+ * Opens an n x n quad grid as panels, planarises it, drags its middle vertex by (dx, dy) pixels
+ * in `moves` pointer moves and measures: states per second while dragging, and the time from
+ * the pointer's release to the first state that is done (page clock, state arrival).
+ */
+export async function dragImportedGrid(page, n, { dx = 12, dy = -8, moves = 20 } = {}) {
+  const text = gridObj(n);
+  await byId(page, 'import-file').setInputFiles({ name: 'grid.obj', mimeType: 'text/plain', buffer: Buffer.from(text) });
+  await page.waitForFunction(() => document.querySelector('[data-testid=status]').textContent.includes('grid.obj · panels'), null, { timeout: 120_000 });
+  await byId(page, 'play').click();
+  await waitDone(page, 300_000);
+  const middle = (n / 2) * (n + 1) + n / 2;
+  const p = text.split('\n').filter((l) => l.startsWith('v '))[middle].split(' ').slice(1).map(Number);
+  const at = await page.evaluate(([x, y, z]) => {
+    const q = window.dupin.viewer.project(x, y, z);
+    const r = document.querySelector('[data-testid=canvas]').getBoundingClientRect();
+    window.__up = null;
+    document.querySelector('[data-testid=canvas]').addEventListener('pointerup', () => { window.__up = performance.now(); }, { once: true });
+    return { x: r.left + (q[0] + 1) / 2 * r.width, y: r.top + (1 - q[1]) / 2 * r.height };
+  }, p);
+  await byId(page, 'edit-vertices').click();
+  const s0 = await page.evaluate(() => window.dupin.stepLog.length);
+  const t0 = Date.now();
+  await page.mouse.move(at.x, at.y);
+  await page.mouse.down();
+  for (let i = 1; i <= moves; i++) {
+    await page.mouse.move(at.x + (dx * i) / moves, at.y + (dy * i) / moves);
+    await page.waitForTimeout(25);
+  }
+  const seconds = (Date.now() - t0) / 1000;
+  const states = (await page.evaluate(() => window.dupin.stepLog.length)) - s0;
+  await page.mouse.up();
+  await page.waitForFunction(() => window.__up !== null && window.dupin.stepLog.some((e) => e.at > window.__up && e.phase !== 'perturb'), null, { timeout: 300_000 });
+  const settle = await page.evaluate(() => {
+    const e = window.dupin.stepLog.find((x) => x.at > window.__up && x.phase !== 'perturb');
+    return { ms: e.at - window.__up, phase: e.phase, maxPlanarity: e.maxPlanarity };
+  });
+  return { middle, pointer: [at.x + dx, at.y + dy], perSecond: states / seconds, settle };
+}
