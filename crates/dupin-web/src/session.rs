@@ -1078,7 +1078,11 @@ impl Session {
                 } = stepper.metrics();
                 let reason = stepper
                     .is_done()
-                    .then(|| pq_scene_shortfall(stepper.converged(), &stepper.metrics().measures))
+                    .then(|| {
+                        stepper.edit_shortfall().map(String::from).or_else(|| {
+                            pq_scene_shortfall(stepper.converged(), &stepper.metrics().measures)
+                        })
+                    })
                     .flatten();
                 Metrics {
                     // Before the first step nothing is shown yet.

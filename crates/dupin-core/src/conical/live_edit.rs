@@ -66,6 +66,12 @@ impl PqSceneStepper {
         Ok(())
     }
 
+    /// Why the last live edit stopped short of where its vertex was dragged (a stage that
+    /// did not reach the tolerance), or `None`.
+    pub fn edit_shortfall(&self) -> Option<&str> {
+        self.edit_shortfall.as_deref()
+    }
+
     /// The anchored vertices: the options' and every edited one.
     pub fn anchors(&self) -> &[usize] {
         &self.options.fixed_vertices
@@ -97,6 +103,7 @@ impl PqSceneStepper {
             )));
         }
         let mut path = stages(base, vertex, base.positions[vertex], position);
+        let total = path.len();
         let first = path.pop().expect("at least one stage");
         let mut mesh = base.clone();
         mesh.positions[vertex] = first;
@@ -109,7 +116,8 @@ impl PqSceneStepper {
         self.options = options;
         self.perturbation = Some(perturbation);
         self.mesh = mesh;
-        self.edit_stages = Some((vertex, path));
+        self.edit_stages = Some((vertex, path, total));
+        self.edit_shortfall = None;
         self.levels = self.level;
         self.phase = PqScenePhase::Perturb;
         self.running_iterations = 0;
@@ -120,7 +128,7 @@ impl PqSceneStepper {
     /// Starts the next stage of the running live edit from the current mesh; false when
     /// there is none (the edit is finished).
     pub(super) fn next_edit_stage(&mut self) -> Result<bool, PqSceneError> {
-        let Some((vertex, path)) = self.edit_stages.as_mut() else {
+        let Some((vertex, path, _)) = self.edit_stages.as_mut() else {
             return Ok(false);
         };
         let Some(next) = path.pop() else {
@@ -229,6 +237,27 @@ mod tests {
             assert_eq!(t.mesh().positions[v], target);
             assert!(max_planarity(t.mesh()) <= 1e-9);
         }
+    }
+
+    /// A drag the perturbation cannot follow (a vertex pulled ten edge lengths out of the
+    /// surface) ends not converged, and says which of its stages stopped it.
+    #[test]
+    fn a_drag_too_far_says_so() {
+        let mut s = pq_scene_stepper("conical-station").unwrap();
+        s.commit().unwrap();
+        let p = s.mesh().positions[166] + crate::Vec3::new(0.0, 0.0, 1.8);
+        s.hold_vertex(166, p).unwrap();
+        s.run_to_end().unwrap();
+        assert!(!s.converged());
+        let why = s.edit_shortfall().expect("a reason");
+        assert!(
+            why.contains("vertex 166") && why.contains("stage 10 of 40"),
+            "{why}"
+        );
+        assert_ne!(s.mesh().positions[166], p);
+        // The next drag starts afresh.
+        s.hold_vertex(166, s.mesh().positions[166]).unwrap();
+        assert!(s.edit_shortfall().is_none());
     }
 
     /// Edits that cannot be made are refused and leave the stepper as it was.

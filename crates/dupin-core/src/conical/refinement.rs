@@ -184,8 +184,10 @@ pub struct PqSceneStepper {
     /// The mesh live edits start from ([`PqSceneStepper::commit`]), `None` before the first.
     pub(super) edit_base: Option<PolyMesh>,
     /// The stages still to come of the running live edit: its vertex and the positions it is
-    /// held at next, the last one first.
-    pub(super) edit_stages: Option<(usize, Vec<crate::Vec3>)>,
+    /// held at next, the last one first, and how many stages the edit has.
+    pub(super) edit_stages: Option<(usize, Vec<crate::Vec3>, usize)>,
+    /// Why the last live edit stopped short of its target.
+    pub(super) edit_shortfall: Option<String>,
 }
 
 /// Why a finished PQ scene misses what it was asked (a perturbation level that did not reach
@@ -243,6 +245,7 @@ impl PqSceneStepper {
             converged: true,
             edit_base: None,
             edit_stages: None,
+            edit_shortfall: None,
         })
     }
 
@@ -272,6 +275,7 @@ impl PqSceneStepper {
             converged: true,
             edit_base: None,
             edit_stages: None,
+            edit_shortfall: None,
         })
     }
 
@@ -326,8 +330,15 @@ impl PqSceneStepper {
         // A live edit moves its vertex in stages (live_edit.rs): the next one starts here,
         // unless this one missed the tolerance (the edit then ends short of its target, as a
         // run that did not converge).
-        if !r.converged {
-            self.edit_stages = None;
+        if !r.converged
+            && let Some((vertex, path, total)) = self.edit_stages.take()
+        {
+            self.edit_shortfall = Some(format!(
+                "the drag of vertex {vertex} was not followed to the pointer: stage {} of {total} \
+                 did not reach the tolerance, and the vertex stays where that stage put it \
+                 (drag a shorter way at a time)",
+                total - path.len()
+            ));
         }
         if self.next_edit_stage()? {
             return Ok(());
@@ -429,7 +440,10 @@ impl Stepper for PqSceneStepper {
             .as_ref()
             .and_then(|p| p.steps_left_at_most())
             .unwrap_or(0);
-        let stages = self.edit_stages.as_ref().map_or(0, |(_, path)| path.len());
+        let stages = self
+            .edit_stages
+            .as_ref()
+            .map_or(0, |(_, path, _)| path.len());
         Some(
             running
                 + stages * self.options.max_iterations
