@@ -67,7 +67,8 @@ export function readHash(hash, { scenes, catalog, torusParams }) {
     for (const e of (h.get('edits') ?? '').split(';').slice(0, 1000)) {
       const m = /^(\d+):([^,]+),([^,]+),([^,]+)$/.exec(e);
       const xyz = m ? [m[2], m[3], m[4]].map(Number) : [];
-      if (m && xyz.every(Number.isFinite)) c.edits.push([Number(m[1]), ...xyz]);
+      // Vertex numbers past 2^31 would wrap crossing into wasm: dropped, as any malformed entry.
+      if (m && Number(m[1]) < 2 ** 31 && xyz.every(Number.isFinite)) c.edits.push([Number(m[1]), ...xyz]);
     }
   }
   // The torus preview does not step (writeHash leaves its steps out).
