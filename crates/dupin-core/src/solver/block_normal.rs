@@ -25,11 +25,9 @@
 use super::SolverError;
 use super::block_system::{BlockLayout, BlockSystem, MAX_BLOCK};
 use super::cholesky::{CholeskyAnalysis, SparseCholesky};
-use super::nested_dissection::{Graph, nested_dissection};
+use super::nested_dissection::{Graph, amd_ordering, nested_dissection};
 use super::pattern::csc_pattern;
-use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::SymbolicSparseColMat;
-use faer::sparse::linalg::amd;
 use nalgebra::{Matrix4, Vector4};
 
 const NONE: u32 = u32::MAX;
@@ -191,22 +189,7 @@ impl Structure {
 /// pattern (each block's unknowns are then numbered together, so the scalar factor follows
 /// the block one).
 fn block_ordering(nk: usize, pattern: &SymbolicSparseColMat<u32>) -> Result<Vec<u32>, SolverError> {
-    let fe = |e: &dyn std::fmt::Debug| SolverError::Factorization(format!("{e:?}"));
-    let mut perm = vec![0u32; nk];
-    let mut perm_inv = vec![0u32; nk];
-    let mut mem = MemBuffer::try_new(amd::order_maybe_unsorted_scratch::<u32>(
-        nk,
-        pattern.row_idx().len(),
-    ))
-    .map_err(|e| fe(&e))?;
-    amd::order_maybe_unsorted(
-        &mut perm,
-        &mut perm_inv,
-        pattern.as_ref(),
-        amd::Control::default(),
-        MemStack::new(&mut mem),
-    )
-    .map_err(|e| fe(&e))?;
+    let perm = amd_ordering(pattern)?;
     if nk < DISSECTION_FROM {
         return Ok(perm);
     }

@@ -19,6 +19,7 @@
 //! Written by hand: faer offers AMD and COLAMD only, METIS is C (and not for wasm32 here),
 //! and no maintained pure-Rust nested dissection exists.
 
+use super::SolverError;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::SymbolicSparseColMat;
 use faer::sparse::linalg::amd;
@@ -178,26 +179,33 @@ fn order_leaf(g: &Graph, s: &mut Scratch, nodes: &[u32], out: &mut Vec<u32>) {
         s.level[v as usize] = UNSEEN;
     }
     let n = nodes.len();
-    let nnz = rows.len();
     let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows);
+    match amd_ordering(&pattern) {
+        Ok(perm) => out.extend(perm.iter().map(|&k| nodes[k as usize])),
+        Err(_) => out.extend_from_slice(nodes),
+    }
+}
+
+/// faer's AMD ordering (`perm[new] = old`) of a square pattern (upper triangle or both).
+pub(crate) fn amd_ordering(pattern: &SymbolicSparseColMat<u32>) -> Result<Vec<u32>, SolverError> {
+    let fe = |e: &dyn std::fmt::Debug| SolverError::Factorization(format!("{e:?}"));
+    let n = pattern.ncols();
     let mut perm = vec![0u32; n];
     let mut perm_inv = vec![0u32; n];
-    let ordered = MemBuffer::try_new(amd::order_maybe_unsorted_scratch::<u32>(n, nnz))
-        .ok()
-        .and_then(|mut mem| {
-            amd::order_maybe_unsorted(
-                &mut perm,
-                &mut perm_inv,
-                pattern.as_ref(),
-                amd::Control::default(),
-                MemStack::new(&mut mem),
-            )
-            .ok()
-        });
-    match ordered {
-        Some(_) => out.extend(perm.iter().map(|&k| nodes[k as usize])),
-        None => out.extend_from_slice(nodes),
-    }
+    let mut mem = MemBuffer::try_new(amd::order_maybe_unsorted_scratch::<u32>(
+        n,
+        pattern.row_idx().len(),
+    ))
+    .map_err(|e| fe(&e))?;
+    amd::order_maybe_unsorted(
+        &mut perm,
+        &mut perm_inv,
+        pattern.as_ref(),
+        amd::Control::default(),
+        MemStack::new(&mut mem),
+    )
+    .map_err(|e| fe(&e))?;
+    Ok(perm)
 }
 
 /// The nested dissection ordering of `g`: `perm[new] = old`.
@@ -423,20 +431,7 @@ mod tests {
         let g = Graph::from_upper_pairs(n, pairs.iter().copied());
         let nd = nested_dissection(&g);
         let identity: Vec<u32> = (0..n as u32).collect();
-        let mut perm = vec![0u32; n];
-        let mut perm_inv = vec![0u32; n];
-        let mut mem = MemBuffer::new(amd::order_maybe_unsorted_scratch::<u32>(
-            n,
-            pattern.row_idx().len(),
-        ));
-        amd::order_maybe_unsorted(
-            &mut perm,
-            &mut perm_inv,
-            pattern.as_ref(),
-            amd::Control::default(),
-            MemStack::new(&mut mem),
-        )
-        .unwrap();
+        let perm = amd_ordering(&pattern).unwrap();
         let len = |p: &[u32]| {
             crate::solver::cholesky::CholeskyAnalysis::new(pattern.as_ref(), p)
                 .unwrap()
