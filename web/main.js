@@ -3,12 +3,13 @@
 // DOM events, the URL hash and the frame loop; the pieces are small modules:
 //   config.js (configuration <-> hash), controls.js (picker and fields), metrics.js (panel,
 //   histogram, legend), solver.js (worker client). Other tabs plug in through `window.dupin`.
-import init, { MeshData, Viewer, colorLegend, freeDefaults, pageSchema, sceneDescription, sceneNames, surfaceCatalog, torusMesh } from './pkg/dupin_web.js';
+import init, { MeshData, Viewer, colorLegend, dupinVersion, freeDefaults, pageSchema, sceneDescription, sceneNames, surfaceCatalog, torusMesh } from './pkg/dupin_web.js';
 import { FREE, IMPORTED, defaults, readHash, sessionConfig, useSchema, writeHash } from './config.js';
 import { buildFields, clearFieldErrors, fillScenePicker, showFieldError } from './controls.js';
 import { drawHistogram, drawLegend, legendCaption, showMetrics, showProgress } from './metrics.js';
 import { SettingsHistory } from './undo.js';
 import { download } from './download.js';
+import { presentationFile } from './share.js';
 import { Solver } from './solver.js';
 import { initTeach, showPick } from './teach.js';
 import { initHexd2d } from './hexd2d.js';
@@ -38,6 +39,7 @@ let userMoved = false;
 let pendingCamera = null; // camera from a restored URL, applied with the first mesh
 let ctx = null;           // { scenes, catalog, defaults }
 let lastMetrics = null;   // metrics on screen (redrawn when the panel edge changes)
+let lastLayers = null;    // offset and beam layers on show: { unavailable, info } (showLayers)
 let pickedPoint = null;   // 3D point of the vertex clicked for the teaching inset (marked)
 const marker = document.createElement('div');
 const stepLog = [];      // per-step { phase, faces, ms } for benchmarks (window.dupin.stepLog)
@@ -123,7 +125,7 @@ function updateButtons() {
   setProp($('reset'), 'disabled', !running);
   setProp($('stop'), 'disabled', !candidate && (!running || done));
   setProp($('play'), 'textContent', playing ? 'Pause' : 'Play');
-  for (const id of ['export-json', 'export-svg', 'export-dxf', 'export-csv', 'export-glb', 'export-3dm']) setProp($(id), 'disabled', !running);
+  for (const id of ['export-json', 'export-svg', 'export-dxf', 'export-csv', 'export-glb', 'export-3dm', 'share-presentation']) setProp($(id), 'disabled', !running);
 }
 
 // ---- loading a configuration -----------------------------------------------------------------
@@ -379,6 +381,7 @@ function showPanel() {
 /** Enables the layer toggles where the run has an offset, else shows why not; `info` is
  * Session.layerInfo (measures of the layers on show). */
 function showLayers({ unavailable, info }) {
+  lastLayers = { unavailable, info };
   // Called per worker state: writes only what changed (see setProp).
   for (const id of ['toggle-offset', 'toggle-support', 'offset-distance']) setProp($(id), 'disabled', !!unavailable);
   setProp($('offset-reason'), 'textContent', unavailable ?? '');
@@ -478,6 +481,16 @@ function onError(e) {
 // ---- downloads (download.js) -------------------------------------------------------------------
 const EXPORT_TYPES = { obj: 'text/plain', json: 'application/json', svg: 'image/svg+xml', dxf: 'application/dxf', csv: 'text/csv', glb: 'model/gltf-binary' };
 function onExport(m) {
+  if (m.kind === 'share') {
+    const name = exportName();
+    // The offset and beam figures of the layers on show (a conical scene's), for the certificate.
+    const layers = config.layers.offset && lastLayers?.info ? lastLayers : null;
+    presentationFile(m.text, Array.from(viewer.camera()), {
+      layers, panelEdge: config.panelEdge, title: name, version: dupinVersion(),
+    }).then((html) => download(`${name}-presentation.html`, html, 'text/html'))
+      .catch((e) => showStatus(`${viewer.backend} · presentation not written: ${e.message ?? e}`, true));
+    return;
+  }
   if (m.kind === '3dm') {
     // The panels from the solver, written by rhino3dm in its worker.
     const name = exportName();
@@ -906,6 +919,7 @@ async function main() {
   });
   $('export-json').addEventListener('click', () => solver.post('export', { kind: 'json' }));
   $('export-svg').addEventListener('click', () => solver.post('export', { kind: 'svg', panelEdge: config.panelEdge }));
+  $('share-presentation').addEventListener('click', () => solver.post('export', { kind: 'share' }));
   for (const kind of ['dxf', 'csv', 'glb', '3dm']) $(`export-${kind}`).addEventListener('click', () => solver.post('export', { kind, panelEdge: config.panelEdge }));
   $('screenshot').addEventListener('click', async () => {
     try { download(`${config.scene}@2x.png`, await snapshotPng(2)); } catch (e) { showStatus(`${viewer.backend} · ${e.message ?? e}`, true); }

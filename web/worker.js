@@ -196,6 +196,7 @@ const handlers = {
       const exports = {
         obj: () => session.exportObj(),
         json: () => session.exportJson(),
+        share: () => session.exportJson(), // for the presentation file (share.js)
         svg: () => session.exportSvg(msg.panelEdge),
         dxf: () => session.exportDxf(msg.panelEdge),
         csv: () => session.exportCsv(msg.panelEdge),

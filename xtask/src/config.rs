@@ -21,6 +21,8 @@ struct Build {
     features: String,
     #[serde(rename = "wasm-opt", default)]
     wasm_opt: Vec<String>,
+    #[serde(rename = "viewer-out-dir")]
+    viewer_out_dir: String,
 }
 
 #[derive(Deserialize)]
@@ -60,29 +62,67 @@ impl WebBuild {
         root().join(&self.file.build.out_dir)
     }
 
-    /// `wasm-pack build` with the configured flags.
+    /// Where the viewer-only package lands, absolute.
+    pub fn viewer_out_dir(&self) -> std::path::PathBuf {
+        root().join(&self.file.build.viewer_out_dir)
+    }
+
+    /// `wasm-pack build` with the configured flags: the configurator's module, then the
+    /// viewer-only one (the same crate without its default `configurator` feature, as a classic
+    /// script a shared presentation file inlines), each through wasm-opt.
     pub fn build(&self) -> Result<()> {
+        let b = &self.file.build;
+        let features = b.features.trim();
+        self.wasm_pack(&b.target, &self.out_dir(), "dupin_web", |cmd| {
+            if !features.is_empty() {
+                cmd.args(["--features", features]);
+            }
+        })?;
+        self.optimise(&self.out_dir().join("dupin_web_bg.wasm"))?;
+        self.wasm_pack(
+            "no-modules",
+            &self.viewer_out_dir(),
+            "dupin_viewer",
+            |cmd| {
+                cmd.args(["--", "--no-default-features"]);
+            },
+        )?;
+        self.optimise(&self.viewer_out_dir().join("dupin_viewer_bg.wasm"))
+    }
+
+    fn wasm_pack(
+        &self,
+        target: &str,
+        out_dir: &std::path::Path,
+        out_name: &str,
+        extra: impl FnOnce(&mut Command),
+    ) -> Result<()> {
         let b = &self.file.build;
         let mut cmd = Command::new("wasm-pack");
         cmd.current_dir(root())
-            .args(["build", &b.krate, "--target", &b.target, "--out-dir"])
-            .arg(self.out_dir());
+            .args([
+                "build",
+                &b.krate,
+                "--target",
+                target,
+                "--out-name",
+                out_name,
+            ])
+            .arg("--out-dir")
+            .arg(out_dir);
         if ["release", "dev", "profiling"].contains(&b.profile.as_str()) {
             cmd.arg(format!("--{}", b.profile));
         } else {
             cmd.args(["--profile", &b.profile]);
         }
         cmd.arg("--no-pack");
-        if !b.features.trim().is_empty() {
-            cmd.args(["--features", b.features.trim()]);
-        }
-        run(&mut cmd)?;
-        self.optimise()
+        extra(&mut cmd);
+        run(&mut cmd)
     }
 
-    /// Runs wasm-opt with the configured flags on the module, in place; a note instead when
+    /// Runs wasm-opt with the configured flags on `module`, in place; a note instead when
     /// wasm-opt is not installed (the module works, only larger).
-    fn optimise(&self) -> Result<()> {
+    fn optimise(&self, module: &std::path::Path) -> Result<()> {
         let flags = &self.file.build.wasm_opt;
         if flags.is_empty() {
             return Ok(());
@@ -95,8 +135,7 @@ impl WebBuild {
             );
             return Ok(());
         }
-        let module = self.out_dir().join("dupin_web_bg.wasm");
-        let input = std::fs::read(&module).map_err(|e| format!("{}: {e}", module.display()))?;
+        let input = std::fs::read(module).map_err(|e| format!("{}: {e}", module.display()))?;
         // wasm-opt takes over a minute: its output is kept per input and flags, so an
         // unchanged module is not optimised again.
         let key = {
@@ -113,17 +152,18 @@ impl WebBuild {
             run(Command::new("node")
                 .arg(&wasm_opt)
                 .args(flags)
-                .arg(&module)
+                .arg(module)
                 .arg("-o")
                 .arg(&optimised))?;
             std::fs::rename(&optimised, &cached)
                 .map_err(|e| format!("{}: {e}", cached.display()))?;
         }
-        std::fs::copy(&cached, &module).map_err(|e| format!("{}: {e}", module.display()))?;
-        let after = std::fs::metadata(&module).map_err(|e| format!("{}: {e}", module.display()))?;
+        std::fs::copy(&cached, module).map_err(|e| format!("{}: {e}", module.display()))?;
+        let after = std::fs::metadata(module).map_err(|e| format!("{}: {e}", module.display()))?;
         println!(
-            "build-web: wasm-opt {}: {:.2} MB -> {:.2} MB",
+            "build-web: wasm-opt {} {}: {:.2} MB -> {:.2} MB",
             flags.join(" "),
+            module.display(),
             input.len() as f64 / 1e6,
             after.len() as f64 / 1e6
         );

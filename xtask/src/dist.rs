@@ -14,6 +14,9 @@ use std::path::{Path, PathBuf};
 const FILES: &[&str] = &[
     "pkg/dupin_web.js",
     "pkg/dupin_web_bg.wasm",
+    // Fetched by the page when it writes a shared presentation file.
+    "pkg-viewer/dupin_viewer.js",
+    "pkg-viewer/dupin_viewer_bg.wasm",
     "vendor/node_modules/rhino3dm/rhino3dm.module.js",
     "vendor/node_modules/rhino3dm/rhino3dm.wasm",
     // The design `viewer-example.html` embeds with `<dupin-viewer>`.
@@ -76,6 +79,8 @@ mod tests {
             "pkg/dupin_web.js",
             "pkg/dupin_web_bg.wasm",
             "pkg/dupin_web.d.ts",
+            "pkg-viewer/dupin_viewer.js",
+            "pkg-viewer/dupin_viewer_bg.wasm",
             "vendor/package.json",
             "vendor/node_modules/rhino3dm/rhino3dm.module.js",
             "vendor/node_modules/rhino3dm/rhino3dm.wasm",
@@ -89,7 +94,7 @@ mod tests {
         }
         let out = tmp.join("dist");
         let files = copy(&web, &out).unwrap();
-        assert_eq!(files.len(), 8, "{files:?}");
+        assert_eq!(files.len(), 10, "{files:?}");
         for f in &files {
             assert_eq!(
                 std::fs::read_to_string(out.join(f)).unwrap(),

@@ -39,8 +39,17 @@ pub(crate) fn project(cam: &OrbitCamera, aspect: f32, p: G3) -> Option<[f32; 3]>
     (c.w > 0.0).then(|| [c.x / c.w, c.y / c.w, c.z / c.w])
 }
 
-/// The orbit camera of `Viewer::camera`'s six numbers (target, distance, yaw, pitch).
-// Used by the wasm-only `Viewer` (and the tests).
+/// An orbit camera as six numbers: target x, y, z, distance, yaw, pitch (the URL hash's and a
+/// shared presentation's camera).
+#[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
+pub(crate) fn camera_numbers(c: &OrbitCamera) -> Vec<f32> {
+    vec![
+        c.target.x, c.target.y, c.target.z, c.distance, c.yaw, c.pitch,
+    ]
+}
+
+/// The orbit camera of [`camera_numbers`]' six numbers (target, distance, yaw, pitch).
+// Used by the wasm-only `Viewer` and `Presenter` (and the tests).
 #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
 pub(crate) fn camera_from(v: &[f32]) -> Result<OrbitCamera, String> {
     if v.len() != 6 || !v.iter().all(|x| x.is_finite()) || v[3] <= 0.0 {
@@ -189,6 +198,12 @@ mod tests {
         }
         assert!(camera_from(&[0.0; 5]).is_err());
         assert!(camera_from(&[0.0, 0.0, 0.0, -1.0, 0.0, 0.0]).is_err());
+    }
+
+    #[test]
+    fn camera_numbers_round_trip() {
+        let v = [0.3, -0.2, 0.1, 4.0, -0.9, 0.55];
+        assert_eq!(camera_numbers(&camera_from(&v).unwrap()), v);
     }
 
     /// Clicking the projection of an interior vertex picks that vertex, with its six

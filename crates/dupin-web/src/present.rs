@@ -227,6 +227,21 @@ mod canvas {
             self.canvas.camera.zoom(factor);
         }
 
+        /// The camera as `[target x, y, z, distance, yaw, pitch]`, as `Viewer.camera` gives it.
+        pub fn camera(&self) -> Vec<f32> {
+            crate::pick::camera_numbers(&self.canvas.camera)
+        }
+
+        /// Sets the camera from six numbers as [`Presenter::camera`] gives them (a shared
+        /// presentation opens on the view it was shared from). Throws for a wrong length,
+        /// non-finite values or a distance that is not positive.
+        #[wasm_bindgen(js_name = setCamera)]
+        pub fn set_camera(&mut self, v: Vec<f32>) -> Result<(), JsError> {
+            self.canvas.camera = crate::pick::camera_from(&v).map_err(crate::js::err)?;
+            self.velocity = (0.0, 0.0);
+            Ok(())
+        }
+
         /// Adapts to a new canvas size in device pixels.
         pub fn resize(&mut self, width: u32, height: u32) {
             self.canvas.resize(width, height);

@@ -55,10 +55,7 @@ impl Viewer {
 
     /// The camera as `[target x, y, z, distance, yaw, pitch]` (for the URL hash).
     pub fn camera(&self) -> Vec<f32> {
-        let c = &self.canvas.camera;
-        vec![
-            c.target.x, c.target.y, c.target.z, c.distance, c.yaw, c.pitch,
-        ]
+        crate::pick::camera_numbers(&self.canvas.camera)
     }
 
     /// Sets the camera from [`Viewer::camera`]'s six numbers. Throws for a wrong length,

@@ -1,0 +1,102 @@
+// Share presentation: the page writes ONE HTML file that, opened from disk (file://) with the
+// network off and every request outside the file refused, shows the panels (pixels that are not
+// background) and a quality certificate whose figures are the page's.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { readFileSync, statSync, writeFileSync } from 'node:fs';
+import { join } from 'node:path';
+import { SHOTS, byId, gridObj, metrics, openPage, pixelStats, waitDone } from './harness.mjs';
+
+/** Clicks Share and returns the written file's path and text. */
+async function share(page) {
+  const [download] = await Promise.all([page.waitForEvent('download', { timeout: 120_000 }), byId(page, 'share-presentation').click()]);
+  // Saved under its own name (the browser opens a file by its extension), kept in target/e2e.
+  const path = join(SHOTS, download.suggestedFilename());
+  await download.saveAs(path);
+  return { path, name: download.suggestedFilename(), text: readFileSync(path, 'utf8'), bytes: statSync(path).size };
+}
+
+/** Opens `path` from disk in a fresh, offline context of `browser`; returns the page, its
+ * certificate rows and the requests it tried beyond the file itself. */
+async function openOffline(browser, path) {
+  const context = await browser.newContext({ viewport: { width: 960, height: 640 } });
+  await context.setOffline(true);
+  const outside = [];
+  await context.route('**/*', (route) => {
+    const u = route.request().url();
+    if (u.startsWith('file:')) return route.continue();
+    outside.push(u);
+    return route.abort();
+  });
+  const page = await context.newPage();
+  const errors = [];
+  page.on('pageerror', (e) => errors.push(String(e)));
+  await page.goto(`file://${path}`);
+  await page.waitForFunction(() => document.body.dataset.state !== 'loading', null, { timeout: 60_000 });
+  const state = await page.evaluate(() => document.body.dataset.state);
+  const status = await byId(page, 'presentation-status').textContent();
+  assert.equal(state, 'ready', status);
+  const rows = await page.evaluate(() => Object.fromEntries([...document.querySelectorAll('[data-testid=certificate] dd')].map((d) => [d.dataset.row, d.textContent])));
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  const url = await page.evaluate(() => window.dupinPresentation.snapshotDataUrl(1));
+  const png = Buffer.from(url.slice(url.indexOf(',') + 1), 'base64');
+  writeFileSync(`${path}.png`, png);
+  await page.screenshot({ path: `${path}.page.png` });
+  const px = await pixelStats(page, png);
+  return { context, page, rows, status, outside, errors, px };
+}
+
+test('a shared presentation of conical-station opens offline from disk with its panels and certificate', async () => {
+  const { browser, page, errors } = await openPage({ hash: '#scene=conical-station' });
+  try {
+    await byId(page, 'play').click();
+    await waitDone(page);
+    await byId(page, 'toggle-offset').check();
+    await page.waitForFunction(() => document.querySelector('[data-testid=layer-info]').dataset.beamPlanarity !== undefined);
+    const m = await metrics(page);
+    const file = await share(page);
+    assert.equal(file.name, 'conical-station-presentation.html');
+    assert.ok(!/<(script|img|iframe)[^>]+src=|<link[^>]+href=/i.test(file.text), 'the file loads nothing beside itself');
+    const v = await openOffline(browser, file.path);
+    assert.deepEqual(v.outside, [], 'no request leaves the file');
+    assert.deepEqual(v.errors, []);
+    assert.ok(v.px.covered > 0.05, `the design is drawn: ${JSON.stringify(v.px)}`);
+    assert.match(v.rows.panels, new RegExp(`^${m.faces} \\(${m.faces} quads\\)`));
+    // Planarity in mm at the page's 1.5 m panel edge, as the metrics panel states it.
+    const mm = Number(v.rows['max-planarity'].split(' ')[0]);
+    assert.ok(Math.abs(mm - m.maxPlanarity * 1.5 * 1000) <= 1e-3 * Math.max(mm, 1e-12) + 1e-15, `${v.rows['max-planarity']} vs ${m.maxPlanarity}`);
+    assert.equal(v.rows.status, 'finished');
+    assert.match(v.rows['support-beams'], /^\d+, planarity /);
+    assert.match(v.rows.computed, /^\d{4}-\d\d-\d\d · Dupin \d+\.\d+\.\d+$/);
+    assert.match(v.status, /panels/);
+    await v.context.close();
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
+
+test('a presentation of an opened 10 000-panel design stays within 3 MB and opens offline', async () => {
+  const { browser, page, errors } = await openPage();
+  try {
+    await byId(page, 'import-file').setInputFiles({ name: 'roof.obj', mimeType: 'text/plain', buffer: Buffer.from(gridObj(100)) });
+    await page.waitForFunction(() => document.querySelector('[data-testid=status]').textContent.includes('roof.obj · panels'), null, { timeout: 120_000 });
+    await byId(page, 'play').click();
+    await waitDone(page, 300_000);
+    const t0 = Date.now();
+    const file = await share(page);
+    const seconds = (Date.now() - t0) / 1000;
+    console.log(`presentation of 10 000 panels: ${(file.bytes / 1e6).toFixed(2)} MB, written in ${seconds.toFixed(2)} s`);
+    assert.ok(file.bytes <= 3e6, `${file.bytes} bytes`);
+    const v = await openOffline(browser, file.path);
+    assert.deepEqual(v.outside, []);
+    assert.deepEqual(v.errors, []);
+    assert.ok(v.px.covered > 0.05, JSON.stringify(v.px));
+    assert.match(v.rows.panels, /^10000 \(10000 quads\)/);
+    assert.match(v.rows['moved-from-design'], /^max \d/);
+    await v.context.close();
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
