@@ -3,7 +3,8 @@
 // classic script, not a module: a file opened from disk cannot import modules. It reads the
 // blocks share.js wrote (certificate, camera, gzip+base64 design and wasm), fills in the
 // certificate, and draws the panels with the module's `Presenter`: drag to orbit (it coasts),
-// wheel to zoom. `document.body.dataset.state` is `loading`, `ready` or `error`, and
+// wheel to zoom. `document.body.dataset.state` is `loading`, `ready` (with `readyMs`, from
+// navigation to the first drawn view) or `error`, and
 // `window.dupinPresentation.snapshotDataUrl()` reads the view back (for tests).
 /* global wasm_bindgen */
 (async () => {
@@ -83,6 +84,7 @@
       },
     };
     say(`${info.panels} panels · ${info.beams} beams · ${presenter.backend}${info.offsetError ? ` · ${info.offsetError}` : ''}`, !!info.offsetError);
+    document.body.dataset.readyMs = performance.now().toFixed(0);
     document.body.dataset.state = 'ready';
   } catch (e) {
     say(`This presentation cannot be shown here: ${e?.message ?? e}. It needs a current browser with WebGPU or WebGL2.`, true);

@@ -5,6 +5,7 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync, statSync, writeFileSync } from 'node:fs';
 import { join } from 'node:path';
+import { pathToFileURL } from 'node:url';
 import { SHOTS, byId, gridObj, metrics, openPage, pixelStats, waitDone } from './harness.mjs';
 
 /** Clicks Share and returns the written file's path and text. */
@@ -31,11 +32,12 @@ async function openOffline(browser, path) {
   const page = await context.newPage();
   const errors = [];
   page.on('pageerror', (e) => errors.push(String(e)));
-  await page.goto(`file://${path}`);
+  await page.goto(pathToFileURL(path).href);
   await page.waitForFunction(() => document.body.dataset.state !== 'loading', null, { timeout: 60_000 });
   const state = await page.evaluate(() => document.body.dataset.state);
   const status = await byId(page, 'presentation-status').textContent();
   assert.equal(state, 'ready', status);
+  console.log(`${path.split('/').pop()}: ready ${await page.evaluate(() => document.body.dataset.readyMs)} ms after navigation`);
   const rows = await page.evaluate(() => Object.fromEntries([...document.querySelectorAll('[data-testid=certificate] dd')].map((d) => [d.dataset.row, d.textContent])));
   await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
   const url = await page.evaluate(() => window.dupinPresentation.snapshotDataUrl(1));
@@ -79,8 +81,9 @@ test('a shared presentation of conical-station opens offline from disk with its 
 test('a presentation of an opened 10 000-panel design stays within 3 MB and opens offline', async () => {
   const { browser, page, errors } = await openPage();
   try {
-    await byId(page, 'import-file').setInputFiles({ name: 'roof.obj', mimeType: 'text/plain', buffer: Buffer.from(gridObj(100)) });
-    await page.waitForFunction(() => document.querySelector('[data-testid=status]').textContent.includes('roof.obj · panels'), null, { timeout: 120_000 });
+    // A name with markup in it: shown as text, never as HTML.
+    await byId(page, 'import-file').setInputFiles({ name: 'roof <i>&.obj', mimeType: 'text/plain', buffer: Buffer.from(gridObj(100)) });
+    await page.waitForFunction(() => document.querySelector('[data-testid=status]').textContent.includes('roof <i>&.obj · panels'), null, { timeout: 120_000 });
     await byId(page, 'play').click();
     await waitDone(page, 300_000);
     const t0 = Date.now();
@@ -94,9 +97,37 @@ test('a presentation of an opened 10 000-panel design stays within 3 MB and open
     assert.ok(v.px.covered > 0.05, JSON.stringify(v.px));
     assert.match(v.rows.panels, /^10000 \(10000 quads\)/);
     assert.match(v.rows['moved-from-design'], /^max \d/);
+    assert.equal(v.rows.design, 'roof <i>&');
+    assert.equal(await v.page.locator('h1').textContent(), 'roof <i>&');
+    assert.equal(await v.page.locator('i').count(), 0);
+    assert.equal(await v.page.title(), 'roof <i>& · Dupin presentation');
     await v.context.close();
     assert.deepEqual(errors, []);
   } finally {
     await browser.close();
   }
+});
+
+test('the certificate states a warning loudly and measures panels in real units', async () => {
+  const { certificate, panelSizes } = await import('../../web/share.js');
+  // A 2 x 1 model-unit quad and a unit triangle; 2 m per model unit.
+  const mesh = { vertices: [[0, 0, 0], [2, 0, 0], [2, 1, 0], [0, 1, 0], [0, 0, 1]], faces: [[0, 1, 2, 3], [0, 1, 4]] };
+  const s = panelSizes(mesh, 2);
+  assert.deepEqual(s.sizes, { 3: 1, 4: 1 });
+  assert.equal(s.edges[0], 2);
+  assert.ok(Math.abs(s.edges[2] - 2 * Math.hypot(2, 1)) < 1e-12);
+  assert.ok(Math.abs(s.areas[1] - 8) < 1e-12 && Math.abs(s.areas[0] - 4) < 1e-12, String(s.areas));
+  const metrics = { phase: 'warning', reason: '3 invalid faces', maxPlanarity: 1e-3, invalidFaces: 3, extent: [2, 1, 1], meanEdge: 1.5, meanEdgeM: 3 };
+  const c = certificate({ mesh, metrics }, { layers: null, panelEdge: 1.5, title: '<b>roof</b>', version: '0.1.0', date: new Date('2026-12-05T12:00:00Z') });
+  const rows = Object.fromEntries(c.rows);
+  assert.equal(c.warning, '3 invalid faces');
+  assert.equal(rows.status, 'WARNING: 3 invalid faces');
+  assert.equal(rows['overall size'], '4.00 × 2.00 × 2.00 m');
+  assert.equal(rows['max planarity'], '3.00 mm (1.0e-3 of a mean edge)');
+  assert.equal(rows.computed, '2026-12-05 · Dupin 0.1.0');
+  // Names are data: the viewer writes rows as text, and the file escapes the title.
+  assert.equal(rows.design, '<b>roof</b>');
+  const done = certificate({ mesh, metrics: { ...metrics, phase: 'done', reason: undefined } }, { layers: null, panelEdge: 1.5, title: 'x', version: '0.1.0' });
+  assert.equal(Object.fromEntries(done.rows).status, 'finished');
+  assert.equal(done.warning, null);
 });

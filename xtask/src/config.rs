@@ -23,6 +23,10 @@ struct Build {
     wasm_opt: Vec<String>,
     #[serde(rename = "viewer-out-dir")]
     viewer_out_dir: String,
+    #[serde(rename = "viewer-profile")]
+    viewer_profile: String,
+    #[serde(rename = "viewer-wasm-opt", default)]
+    viewer_wasm_opt: Vec<String>,
 }
 
 #[derive(Deserialize)]
@@ -44,15 +48,16 @@ impl WebBuild {
         let text =
             std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
         let file: File = toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
-        let p = file.build.profile.as_str();
-        if p.is_empty()
-            || !p
-                .chars()
-                .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
-        {
-            return Err(format!(
-                "wasm-pack.toml: profile must be release, dev, profiling or a Cargo profile name, not `{p}`"
-            ));
+        for p in [&file.build.profile, &file.build.viewer_profile] {
+            if p.is_empty()
+                || !p
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+            {
+                return Err(format!(
+                    "wasm-pack.toml: a profile must be release, dev, profiling or a Cargo profile name, not `{p}`"
+                ));
+            }
         }
         Ok(WebBuild { file })
     }
@@ -73,26 +78,33 @@ impl WebBuild {
     pub fn build(&self) -> Result<()> {
         let b = &self.file.build;
         let features = b.features.trim();
-        self.wasm_pack(&b.target, &self.out_dir(), "dupin_web", |cmd| {
+        self.wasm_pack(&b.target, &b.profile, &self.out_dir(), "dupin_web", |cmd| {
             if !features.is_empty() {
                 cmd.args(["--features", features]);
             }
         })?;
-        self.optimise(&self.out_dir().join("dupin_web_bg.wasm"))?;
+        self.optimise(&self.out_dir().join("dupin_web_bg.wasm"), &b.wasm_opt)?;
         self.wasm_pack(
             "no-modules",
+            &b.viewer_profile,
             &self.viewer_out_dir(),
             "dupin_viewer",
             |cmd| {
                 cmd.args(["--", "--no-default-features"]);
             },
         )?;
-        self.optimise(&self.viewer_out_dir().join("dupin_viewer_bg.wasm"))
+        self.optimise(
+            &self.viewer_out_dir().join("dupin_viewer_bg.wasm"),
+            &b.viewer_wasm_opt,
+        )
     }
 
+    /// One `wasm-pack build` of the crate for `target` with Cargo profile `profile`, written to
+    /// `out_dir` as `out_name`; `extra` adds flags (after `--`, Cargo's).
     fn wasm_pack(
         &self,
         target: &str,
+        profile: &str,
         out_dir: &std::path::Path,
         out_name: &str,
         extra: impl FnOnce(&mut Command),
@@ -110,20 +122,19 @@ impl WebBuild {
             ])
             .arg("--out-dir")
             .arg(out_dir);
-        if ["release", "dev", "profiling"].contains(&b.profile.as_str()) {
-            cmd.arg(format!("--{}", b.profile));
+        if ["release", "dev", "profiling"].contains(&profile) {
+            cmd.arg(format!("--{profile}"));
         } else {
-            cmd.args(["--profile", &b.profile]);
+            cmd.args(["--profile", profile]);
         }
         cmd.arg("--no-pack");
         extra(&mut cmd);
         run(&mut cmd)
     }
 
-    /// Runs wasm-opt with the configured flags on `module`, in place; a note instead when
-    /// wasm-opt is not installed (the module works, only larger).
-    fn optimise(&self, module: &std::path::Path) -> Result<()> {
-        let flags = &self.file.build.wasm_opt;
+    /// Runs wasm-opt with `flags` on `module`, in place; a note instead when wasm-opt is not
+    /// installed (the module works, only larger).
+    fn optimise(&self, module: &std::path::Path, flags: &[String]) -> Result<()> {
         if flags.is_empty() {
             return Ok(());
         }
