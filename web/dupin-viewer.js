@@ -1,16 +1,33 @@
 // <dupin-viewer src="design.json">: a Dupin design embedded in any web page, read-only. The
-// element loads Dupin's wasm module (once per page), fetches `src` (a design as the page's JSON
-// export writes it, or a bare { vertices, faces }), and draws its panels coloured by planarity
-// with WebGPU, or WebGL2 where WebGPU is missing. Drag to orbit, wheel to zoom.
+// element loads Dupin's viewer-only wasm module (`pkg-viewer/` beside this file, once per page:
+// the renderer without the solvers, under half the configurator's size), fetches `src` (a design
+// as the page's JSON export writes it, or a bare { vertices, faces }), and draws its panels
+// coloured by planarity with WebGPU, or WebGL2 where WebGPU is missing. Drag to orbit, wheel to
+// zoom. The module's glue is a classic script that defines the global `wasm_bindgen`.
 //
 //   <script type="module" src="dupin-viewer.js"></script>
 //   <dupin-viewer src="examples/conical-station.json" style="width: 640px; height: 400px"></dupin-viewer>
 //
 // State for scripts and tests: `data-state` is `loading`, `ready` or `error`; a `load` event
 // carries { faces, backend }, an `error` event { message } (the message is also shown inside).
-import init, { Viewer, designMesh } from './pkg/dupin_web.js';
+/* global wasm_bindgen */
+const PKG = new URL('pkg-viewer/', import.meta.url);
+let wasm = null; // one module for every element of the page: resolves to its exports
 
-let wasm = null; // one module for every element of the page
+/** Loads the viewer-only module: its glue as a script element, then its wasm. */
+function loadModule() {
+  return new Promise((resolve, reject) => {
+    const script = document.createElement('script');
+    script.src = new URL('dupin_viewer.js', PKG).href;
+    script.onload = resolve;
+    script.onerror = () => reject(new Error(`${script.src}: not loaded`));
+    document.head.append(script);
+  }).then(async () => {
+    // A global lexical binding of the classic script (`let`), not a property of globalThis.
+    await wasm_bindgen({ module_or_path: new URL('dupin_viewer_bg.wasm', PKG) });
+    return wasm_bindgen;
+  });
+}
 let sheet = null; // one style sheet for every element
 
 const STYLE = `
@@ -57,8 +74,9 @@ class DupinViewer extends HTMLElement {
     this.dataset.state = 'loading';
     this.say(`loading ${src}…`);
     try {
-      wasm ??= init();
-      await wasm;
+      wasm ??= loadModule();
+      // A failed load is tried again by the next element or `src`.
+      const { Viewer, designMesh } = await wasm.catch((e) => { wasm = null; throw e; });
       const response = await fetch(src);
       if (!response.ok) throw new Error(`${src}: HTTP ${response.status}`);
       const mesh = designMesh(await response.text());
