@@ -1,6 +1,7 @@
 //! The workloads BENCHMARKS.md times natively and on wasm32 side by side (issue: wasm within
-//! 1.5x of native): hexagonal Delaunay of 16 000 seeded points (extended mode) and the
-//! planarisation of a 10 000-quad grid with seeded noise. Each test checks its result, so a
+//! 1.5x of native): hexagonal Delaunay of 16 000 seeded points (extended mode), the
+//! planarisation of a 10 000-quad grid with seeded noise, and reading a 1M-triangle OBJ and
+//! GLB (timed inside the test, the file's writing left out). Each test checks its result, so a
 //! timing never comes from a run that went wrong. Run natively with
 //! `cargo test --release -p dupin-core --test workloads_wasm`, on wasm32 in Node with
 //! `CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER=wasm-bindgen-test-runner cargo test --release
@@ -10,8 +11,11 @@
 use wasm_bindgen_test::wasm_bindgen_test as test;
 
 use dupin_core::conical::{PqOptions, pq_perturb};
+use dupin_core::fabrication::{GlbLayer, LengthUnit, panels_glb};
 use dupin_core::hex_delaunay::{HexDelaunayMode, hex_delaunay, triangulation_quality};
+use dupin_core::mesh::io::{ImportOptions, read_mesh, write_obj};
 use dupin_core::mesh::{PolyMesh, max_planarity};
+use dupin_core::scenes::benchmark_meshes::dome_triangle_mesh;
 use dupin_core::{Vec2, Vec3};
 
 /// A deterministic stream in [0, 1) (the same on every target; no RNG crate on wasm needed).
@@ -59,4 +63,58 @@ fn planarize_10k_quads() {
     let out = pq_perturb(&mesh, PqOptions::default()).unwrap();
     assert!(out.converged, "{:?}", out.reason);
     assert!(max_planarity(&out.mesh) <= 1e-10);
+}
+
+/// Milliseconds on a monotonic clock (wasm32: the JS clock, std's Instant is unavailable).
+fn now_ms() -> f64 {
+    #[cfg(target_arch = "wasm32")]
+    {
+        js_sys::Date::now()
+    }
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        use std::sync::OnceLock;
+        static START: OnceLock<std::time::Instant> = OnceLock::new();
+        START
+            .get_or_init(std::time::Instant::now)
+            .elapsed()
+            .as_secs_f64()
+            * 1e3
+    }
+}
+
+/// The io bench's dome (1 002 528 triangles) as OBJ text and as Dupin's GLB, each read back
+/// into the same mesh; the read times are printed (best of three).
+#[test]
+fn read_1m_triangles_obj_and_glb() {
+    let dome = dome_triangle_mesh(708, 1);
+    let obj = write_obj(&dome);
+    let glb = panels_glb(
+        &[GlbLayer {
+            name: "panels",
+            mesh: &dome,
+        }],
+        LengthUnit::Metre,
+    );
+    let options = ImportOptions::default();
+    for (name, bytes) in [("dome.obj", obj.as_bytes()), ("dome.glb", &glb[..])] {
+        let mut best = f64::INFINITY;
+        for _ in 0..3 {
+            let t = now_ms();
+            let read = read_mesh(name, bytes, &options).unwrap();
+            best = best.min(now_ms() - t);
+            assert_eq!(read.mesh.num_faces(), dome.num_faces(), "{name}");
+            assert_eq!(read.mesh.num_vertices(), dome.num_vertices(), "{name}");
+        }
+        let line = format!(
+            "{name}: {} MB, {} triangles read in {best:.0} ms",
+            bytes.len() / 1_000_000,
+            dome.num_faces()
+        );
+        // wasm32's stdout goes nowhere: the test runner's console instead.
+        #[cfg(target_arch = "wasm32")]
+        wasm_bindgen_test::console_log!("{line}");
+        #[cfg(not(target_arch = "wasm32"))]
+        println!("{line}");
+    }
 }
