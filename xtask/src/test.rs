@@ -57,6 +57,18 @@ pub fn run() -> Result<()> {
             cargo()
                 .args(["clippy", "-p", "dupin-web", "--lib", "--tests"])
                 .args(wasm),
+        )?;
+        // The viewer-only module (shared presentations, `<dupin-viewer>`).
+        util::run(
+            cargo()
+                .args([
+                    "clippy",
+                    "-p",
+                    "dupin-web",
+                    "--lib",
+                    "--no-default-features",
+                ])
+                .args(wasm),
         )
     })?;
     step("native tests", &mut || {
