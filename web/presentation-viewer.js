@@ -31,6 +31,15 @@
     rows.append(dt, dd);
   }
 
+  // The figures fold away, so the client can see the whole design; the title stays.
+  const toggle = byId('cert-toggle');
+  toggle.addEventListener('click', () => {
+    const open = rows.hidden;
+    rows.hidden = !open;
+    toggle.setAttribute('aria-expanded', String(open));
+    toggle.textContent = open ? 'Hide figures' : 'Show figures';
+  });
+
   const canvas = byId('view');
   try {
     await wasm_bindgen({ module_or_path: await inflate(block('dupin-wasm')) });

@@ -126,20 +126,27 @@ export async function presentationFile(exportText, camera, options) {
   h2 { font-size: 12px; margin: 0 0 6px; color: #8d93a3; text-transform: uppercase; letter-spacing: 0.06em; font-weight: 600; }
   dl { display: grid; grid-template-columns: auto 1fr; gap: 3px 12px; margin: 0; }
   dt { color: #8d93a3; } dd { margin: 0; }
+  [hidden] { display: none !important; }
+  #full-screen { position: fixed; right: 16px; top: 16px; }
+  button:focus-visible { outline: 2px solid #7aa2ff; outline-offset: 2px; }
   dd.warning, p.error { color: #ffb86b; font-weight: 600; }
   p { margin: 8px 0 0; color: #8d93a3; font-size: 12px; }
-  button { position: fixed; right: 16px; top: 16px; background: #1b1e27; color: #e6e8ee; border: 1px solid #2a2e3a; border-radius: 6px; padding: 6px 10px; font: inherit; cursor: pointer; }
+  #cert-toggle { position: absolute; right: 12px; top: 10px; padding: 2px 8px; font-size: 12px; }
+  button { background: #1b1e27; color: #e6e8ee; border: 1px solid #2a2e3a; border-radius: 6px; padding: 6px 10px; font: inherit; cursor: pointer; }
 </style>
 </head>
 <body data-state="loading">
+<main>
 <canvas id="view" data-testid="presentation-canvas" role="img" aria-label="${title}: ${cert.panels} planar panels in metal frames; drag to orbit, wheel to zoom"></canvas>
 <section data-testid="certificate" aria-labelledby="cert-title">
 <h2>Dupin quality certificate</h2>
 <h1 id="cert-title">${title}</h1>
+<button id="cert-toggle" type="button" aria-expanded="true" aria-controls="cert-rows">Hide figures</button>
 <dl id="cert-rows"></dl>
 <p data-testid="presentation-status" id="status" role="status">Loading…</p>
 </section>
 <button id="full-screen" type="button">Full screen</button>
+</main>
 <script type="application/json" id="dupin-certificate">${inlineJson(cert)}</script>
 <script type="application/json" id="dupin-camera">${inlineJson(camera ?? null)}</script>
 <script type="application/octet-stream" id="dupin-design">${designB64}</script>

@@ -3,19 +3,7 @@
 // header's controls are reachable by Tab, in order, with a visible focus ring.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import AxeBuilder from '@axe-core/playwright';
-import { byId, openPage } from './harness.mjs';
-
-/** The serious and critical violations; every violation is tallied by impact in the log. */
-async function serious(page, where = '') {
-  const r = await new AxeBuilder({ page }).analyze();
-  const tally = {};
-  for (const v of r.violations) tally[v.impact] = (tally[v.impact] ?? 0) + v.nodes.length;
-  console.log(`# axe, ${where}: ${r.passes.length} rules pass, violations by impact ${JSON.stringify(tally)} (${r.violations.map((v) => v.id).join(', ') || 'none'})`);
-  return r.violations
-    .filter((v) => ['serious', 'critical'].includes(v.impact))
-    .map((v) => `${v.id} (${v.impact}): ${v.nodes.slice(0, 3).map((n) => n.target.join(' ')).join(' | ')}`);
-}
+import { axeSerious as serious, byId, openPage } from './harness.mjs';
 
 test('axe finds no serious or critical violation on the main view, the inset, the 2D tab and presentation mode', async () => {
   const { browser, page, errors } = await openPage({ hash: '#scene=sphere-radial' });

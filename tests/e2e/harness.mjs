@@ -2,6 +2,7 @@
 // the flags that give headless WebGPU on SwiftShader (see DEVELOPERS.md), screenshots saved
 // under target/e2e/ and pixel statistics computed in the page (no image library needed).
 import { chromium } from 'playwright-core';
+import AxeBuilder from '@axe-core/playwright';
 import { existsSync, mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { dirname, join } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -243,4 +244,15 @@ export async function dragImportedGrid(page, n, { dx = 12, dy = -8, moves = 20 }
     return { ms: e.at - window.__up, phase: e.phase, maxPlanarity: e.maxPlanarity };
   });
   return { middle, pointer: [at.x + dx, at.y + dy], perSecond: states / seconds, settle };
+}
+
+/** The serious and critical violations; every violation is tallied by impact in the log. */
+export async function axeSerious(page, where = '') {
+  const r = await new AxeBuilder({ page }).analyze();
+  const tally = {};
+  for (const v of r.violations) tally[v.impact] = (tally[v.impact] ?? 0) + v.nodes.length;
+  console.log(`# axe, ${where}: ${r.passes.length} rules pass, violations by impact ${JSON.stringify(tally)} (${r.violations.map((v) => v.id).join(', ') || 'none'})`);
+  return r.violations
+    .filter((v) => ['serious', 'critical'].includes(v.impact))
+    .map((v) => `${v.id} (${v.impact}): ${v.nodes.slice(0, 3).map((n) => n.target.join(' ')).join(' | ')}`);
 }

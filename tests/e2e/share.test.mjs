@@ -6,7 +6,7 @@ import assert from 'node:assert/strict';
 import { readFileSync, statSync, writeFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { pathToFileURL } from 'node:url';
-import { SHOTS, byId, gridObj, metrics, openPage, pixelStats, waitDone } from './harness.mjs';
+import { SHOTS, axeSerious, byId, gridObj, metrics, openPage, pixelStats, waitDone } from './harness.mjs';
 
 /** Clicks Share and returns the written file's path and text. */
 async function share(page) {
@@ -71,6 +71,15 @@ test('a shared presentation of conical-station opens offline from disk with its 
     assert.match(v.rows['support-beams'], /^\d+, planarity /);
     assert.match(v.rows.computed, /^\d{4}-\d\d-\d\d · Dupin \d+\.\d+\.\d+$/);
     assert.match(v.status, /panels/);
+    assert.deepEqual(await axeSerious(v.page, 'shared presentation'), []);
+    // The figures fold away and come back; the title stays.
+    const toggle = v.page.locator('#cert-toggle');
+    await toggle.click();
+    assert.equal(await toggle.getAttribute('aria-expanded'), 'false');
+    assert.ok(!(await v.page.locator('#cert-rows').isVisible()));
+    assert.ok(await v.page.locator('h1').isVisible());
+    await toggle.click();
+    assert.ok(await v.page.locator('#cert-rows').isVisible());
     await v.context.close();
     assert.deepEqual(errors, []);
   } finally {
