@@ -4,7 +4,7 @@
 
 use dupin_core::Vec3;
 use dupin_core::mesh::PolyMesh;
-use dupin_core::scenes::benchmark_meshes::dome_triangle_mesh;
+use dupin_core::scenes::benchmark_meshes::{bump_triangle_mesh, dome_triangle_mesh};
 use dupin_core::surface::{MeshFitError, MeshFitOptions, MeshSurface, fit_mesh_surface};
 
 #[test]
@@ -61,6 +61,54 @@ fn phex_panels_the_fitted_dome_close_to_the_mesh() {
         .fold(0.0, f64::max);
     eprintln!("max distance to the input mesh {far:.3e} of a {diagonal:.2} m diagonal");
     assert!(far <= 0.005 * diagonal, "{far}");
+}
+
+/// A mixed-curvature freeform (a Gaussian bump: K > 0 on top, K < 0 on its flanks) of over
+/// 20 000 triangles, no UVs: the fit is as close as on the dome, but P-Hex on it misses (open:
+/// the fitted parameter lines are far from conjugate, so method 2's hexagons come out
+/// self-intersecting and the optimisation stalls: measured 135 of 1 572 faces invalid, max
+/// planarity 5.2e-3 after 10 iterations, 143 and the same planarity after 40; the principal
+/// directions, `field_angle = Some(0.0)`, stop at the umbilic on top: 121 faces, 8 invalid).
+/// The run must say so: its shortfall (the CLI's exit 3, the page's warning) names both misses.
+#[test]
+fn phex_on_a_fitted_mixed_curvature_mesh_reports_what_it_misses() {
+    use dupin_core::Stepper;
+    use dupin_core::phex::{PhexConfig, PhexGoals, PhexPipeline};
+    let mesh = bump_triangle_mesh(104, 3);
+    assert!(mesh.num_faces() >= 20_000);
+    let fit = fit_mesh_surface(&mesh, &MeshFitOptions::default()).unwrap();
+    let diagonal = mesh.bbox_diagonal();
+    assert!(fit.max_distance < 1e-3 * diagonal, "{}", fit.max_distance);
+    let config = PhexConfig::for_nurbs("bump", fit.surface, Some(0.3));
+    let goals = PhexGoals::of(&config, true);
+    let r = PhexPipeline::new(config).and_then(Stepper::finish).unwrap();
+    let rep = &r.report;
+    let gaussian = |s: f64| rep.per_face.iter().filter(|f| f.gaussian * s > 0.0).count();
+    eprintln!(
+        "{} faces ({} with K > 0, {} with K < 0), {} invalid, planarity {:e}",
+        rep.faces,
+        gaussian(1.0),
+        gaussian(-1.0),
+        rep.invalid_faces,
+        rep.max_planarity
+    );
+    assert!(gaussian(1.0) > 10 && gaussian(-1.0) > 10, "both signs of K");
+    let missed = goals.shortfall(
+        rep.max_planarity,
+        rep.iterations,
+        rep.invalid_faces,
+        rep.faces,
+    );
+    if rep.invalid_faces > 0 || rep.max_planarity > 1e-10 {
+        let missed = missed.expect("a run that misses says so");
+        assert!(
+            missed.contains("self-intersecting") || missed.contains("above the tolerance"),
+            "{missed}"
+        );
+    } else {
+        // Solved: the acceptance figures of the import issue hold.
+        assert!(missed.is_none());
+    }
 }
 
 #[test]

@@ -173,10 +173,25 @@ pub fn nurbs_roof() -> NurbsDefinition {
     }
 }
 
-/// A triangle mesh with no UVs for the surface fit's tests and benchmarks: a dome 12 m x 12 m, z = 3 - (x² + y²) / 24 (K > 0), as an irregular triangulation of
-/// `2 n²` triangles: a grid with jittered interior vertices and randomly chosen diagonals, the
-/// vertex order shuffled (an exporter's order is not a grid's).
+/// A triangle mesh with no UVs for the surface fit's tests and benchmarks: a dome 12 m x 12 m,
+/// z = 3 - (x² + y²) / 24 (K > 0), as an irregular triangulation of `2 n²` triangles (see
+/// [`jittered_height_mesh`]).
 pub fn dome_triangle_mesh(n: usize, seed: u64) -> PolyMesh {
+    jittered_height_mesh(n, seed, |x, y| 3.0 - (x * x + y * y) / 24.0)
+}
+
+/// A triangle mesh with no UVs of mixed curvature: a Gaussian bump 12 m x 12 m,
+/// z = 3 exp(-r² / 18), elliptic (K > 0) inside r = 3 m and hyperbolic (K < 0) outside, the
+/// parabolic circle r = 3 m between, as an irregular triangulation of `2 n²` triangles (see
+/// [`jittered_height_mesh`]).
+pub fn bump_triangle_mesh(n: usize, seed: u64) -> PolyMesh {
+    jittered_height_mesh(n, seed, |x, y| 3.0 * (-(x * x + y * y) / 18.0).exp())
+}
+
+/// The height field `z(x, y)` over [-6, 6]² as an irregular triangulation of `2 n²` triangles:
+/// a grid with jittered interior vertices and randomly chosen diagonals, the vertex order
+/// shuffled (an exporter's order is not a grid's).
+fn jittered_height_mesh(n: usize, seed: u64, z: impl Fn(f64, f64) -> f64) -> PolyMesh {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let h = 12.0 / n as f64;
     let mut order: Vec<usize> = (0..(n + 1) * (n + 1)).collect();
@@ -195,7 +210,7 @@ pub fn dome_triangle_mesh(n: usize, seed: u64) -> PolyMesh {
             };
             let x = -6.0 + i as f64 * h + jitter(&mut rng, i == 0 || i == n);
             let y = -6.0 + j as f64 * h + jitter(&mut rng, j == 0 || j == n);
-            positions[order[i * (n + 1) + j]] = Vec3::new(x, y, 3.0 - (x * x + y * y) / 24.0);
+            positions[order[i * (n + 1) + j]] = Vec3::new(x, y, z(x, y));
         }
     }
     let id = |i: usize, j: usize| order[i * (n + 1) + j] as u32;
