@@ -174,16 +174,15 @@ pub fn nurbs_roof() -> NurbsDefinition {
 }
 
 /// A triangle mesh with no UVs for the surface fit's tests and benchmarks: a dome 12 m x 12 m,
-/// z = 3 - (x² + y²) / 24 (K > 0), as an irregular triangulation of `2 n²` triangles (see
-/// [`jittered_height_mesh`]).
+/// z = 3 - (x² + y²) / 24 (K > 0), as an irregular triangulation of `2 n²` triangles: a grid
+/// with jittered interior vertices and randomly chosen diagonals, the vertex order shuffled.
 pub fn dome_triangle_mesh(n: usize, seed: u64) -> PolyMesh {
     jittered_height_mesh(n, seed, |x, y| 3.0 - (x * x + y * y) / 24.0)
 }
 
 /// A triangle mesh with no UVs of mixed curvature: a Gaussian bump 12 m x 12 m,
 /// z = 3 exp(-r² / 18), elliptic (K > 0) inside r = 3 m and hyperbolic (K < 0) outside, the
-/// parabolic circle r = 3 m between, as an irregular triangulation of `2 n²` triangles (see
-/// [`jittered_height_mesh`]).
+/// parabolic circle r = 3 m between, triangulated as [`dome_triangle_mesh`] is.
 pub fn bump_triangle_mesh(n: usize, seed: u64) -> PolyMesh {
     jittered_height_mesh(n, seed, |x, y| 3.0 * (-(x * x + y * y) / 18.0).exp())
 }
