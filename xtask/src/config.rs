@@ -78,20 +78,25 @@ impl WebBuild {
     pub fn build(&self) -> Result<()> {
         let b = &self.file.build;
         let features = b.features.trim();
-        self.wasm_pack(&b.target, &b.profile, &self.out_dir(), "dupin_web", |cmd| {
-            if !features.is_empty() {
-                cmd.args(["--features", features]);
-            }
-        })?;
+        let features: &[&str] = if features.is_empty() {
+            &[]
+        } else {
+            &["--features", features]
+        };
+        self.wasm_pack(
+            &b.target,
+            &b.profile,
+            &self.out_dir(),
+            "dupin_web",
+            features,
+        )?;
         self.optimise(&self.out_dir().join("dupin_web_bg.wasm"), &b.wasm_opt)?;
         self.wasm_pack(
             "no-modules",
             &b.viewer_profile,
             &self.viewer_out_dir(),
             "dupin_viewer",
-            |cmd| {
-                cmd.args(["--", "--no-default-features"]);
-            },
+            &["--", "--no-default-features"],
         )?;
         self.optimise(
             &self.viewer_out_dir().join("dupin_viewer_bg.wasm"),
@@ -100,14 +105,14 @@ impl WebBuild {
     }
 
     /// One `wasm-pack build` of the crate for `target` with Cargo profile `profile`, written to
-    /// `out_dir` as `out_name`; `extra` adds flags (after `--`, Cargo's).
+    /// `out_dir` as `out_name`, with `extra` flags last (after `--`: Cargo's).
     fn wasm_pack(
         &self,
         target: &str,
         profile: &str,
         out_dir: &std::path::Path,
         out_name: &str,
-        extra: impl FnOnce(&mut Command),
+        extra: &[&str],
     ) -> Result<()> {
         let b = &self.file.build;
         let mut cmd = Command::new("wasm-pack");
@@ -127,8 +132,7 @@ impl WebBuild {
         } else {
             cmd.args(["--profile", profile]);
         }
-        cmd.arg("--no-pack");
-        extra(&mut cmd);
+        cmd.arg("--no-pack").args(extra);
         run(&mut cmd)
     }
 
