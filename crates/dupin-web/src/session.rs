@@ -769,6 +769,23 @@ impl Session {
         z: f64,
         start: bool,
     ) -> Result<(), JsError> {
+        self.drag_vertices(vertex, x, y, z, Vec::new(), start)
+    }
+
+    /// [`Session::drag_vertex`] with a box-selected `group` dragged along: `vertex` goes to
+    /// `(x, y, z)` and every vertex of `group` moves by the same translation from the
+    /// committed mesh; all of them are held from now on. Throws as `dragVertex` does, and
+    /// for a group vertex outside the mesh.
+    #[wasm_bindgen(js_name = dragVertices)]
+    pub fn drag_vertices(
+        &mut self,
+        vertex: usize,
+        x: f64,
+        y: f64,
+        z: f64,
+        group: Vec<u32>,
+        start: bool,
+    ) -> Result<(), JsError> {
         let Run::Pq { stepper, started } = &mut self.run else {
             return Err(JsError::new(
                 "dragging is for a panel mesh: a P-Hex run follows its surface, not its vertices",
@@ -777,12 +794,52 @@ impl Session {
         if start {
             stepper.commit().map_err(err)?;
         }
+        let group: Vec<usize> = group.into_iter().map(|v| v as usize).collect();
         stepper
-            .hold_vertex(vertex, dupin_core::Vec3::new(x, y, z))
+            .hold_group(vertex, dupin_core::Vec3::new(x, y, z), &group)
             .map_err(err)?;
         *started = true;
         self.per_face = None;
         Ok(())
+    }
+
+    /// The panel-mesh vertices inside a rectangle of the view, for a box selection:
+    /// `view_proj` is the viewer's 16 numbers (`Viewer.viewProj`, column-major), the rectangle
+    /// is given by two corners in normalised device coordinates (x, y in [-1, 1], y up).
+    /// Every vertex in front of the eye whose projection lies inside counts, hidden or not (a
+    /// window selection). Returns `{ vertices, points }`: the vertex numbers in increasing
+    /// order and their positions, 3 numbers each. Throws for a P-Hex run, a matrix that is
+    /// not 16 finite numbers or a corner that is not finite.
+    #[wasm_bindgen(js_name = verticesInRect)]
+    pub fn vertices_in_rect(
+        &self,
+        view_proj: Vec<f64>,
+        x0: f64,
+        y0: f64,
+        x1: f64,
+        y1: f64,
+    ) -> Result<JsValue, JsError> {
+        let Run::Pq { .. } = &self.run else {
+            return Err(JsError::new(
+                "box selection is for a panel mesh: a P-Hex surface has no design vertices to drag",
+            ));
+        };
+        let m = self.current_mesh().unwrap_or_default();
+        let vertices = crate::pick::vertices_in_rect(&m.positions, &view_proj, [x0, y0, x1, y1])
+            .map_err(|e| JsError::new(&e))?;
+        #[derive(Serialize)]
+        struct Selection {
+            vertices: Vec<usize>,
+            points: Vec<f64>,
+        }
+        let points = vertices
+            .iter()
+            .flat_map(|&v| {
+                let p = m.positions[v];
+                [p.x, p.y, p.z]
+            })
+            .collect();
+        to_js(&Selection { vertices, points })
     }
 
     /// The current mesh for the viewer: flat panels coloured by `mode` (`planarity`: blue
@@ -1320,6 +1377,38 @@ mod tests {
         assert!(m.max_planarity <= 1e-9, "{}", m.max_planarity);
         let crosses = anchor_crosses(&after, &[v]);
         assert!(!crosses.is_empty());
+    }
+
+    /// A group drag: the dragged vertex lands where it was put, its box-selected group moves
+    /// by the same translation, every one of them is held, the run ends planar.
+    #[test]
+    fn a_group_drag_moves_the_selection_together() {
+        let mut s = pq_session("conical-station");
+        while !s.done() {
+            s.advance().unwrap();
+        }
+        let before = s.current_mesh().unwrap();
+        let (v, group) = (40usize, vec![41u32, 39, 40]);
+        let p = before.positions[v] + dupin_core::Vec3::new(0.0, 0.0, 0.05);
+        let delta = p - before.positions[v];
+        s.drag_vertices(v, p.x, p.y, p.z, group.clone(), true)
+            .unwrap();
+        while !s.done() {
+            s.advance().unwrap();
+        }
+        let after = s.current_mesh().unwrap();
+        assert_eq!(after.positions[v], p);
+        for &w in &group[..2] {
+            let w = w as usize;
+            assert_eq!(after.positions[w], before.positions[w] + delta);
+        }
+        let m = s.metrics_struct();
+        assert_eq!(m.phase, "done");
+        assert!(m.max_planarity <= 1e-9, "{}", m.max_planarity);
+        let Run::Pq { stepper, .. } = &s.run else {
+            unreachable!()
+        };
+        assert!([39, 40, 41].iter().all(|a| stepper.anchors().contains(a)));
     }
 
     /// A PQ scene steps level by level: the control mesh first, then one perturbation

@@ -89,6 +89,17 @@ impl Viewer {
         .map(|p| p.to_vec())
     }
 
+    /// The current view and projection as one 4 x 4 matrix, 16 numbers column-major (for
+    /// `Session.verticesInRect`).
+    #[wasm_bindgen(js_name = viewProj)]
+    pub fn view_proj(&self) -> Vec<f32> {
+        self.canvas
+            .camera
+            .view_proj(self.canvas.aspect())
+            .to_cols_array()
+            .to_vec()
+    }
+
     /// Moves the camera closer (`factor` < 1) or farther (`factor` > 1).
     pub fn zoom(&mut self, factor: f32) {
         self.canvas.camera.zoom(factor);

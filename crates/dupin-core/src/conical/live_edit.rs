@@ -1,20 +1,21 @@
-//! Live editing of a panel mesh: drag a vertex and the PQ perturbation (conical paper,
-//! Sec. 2.2) keeps every face planar (conical, circular) around it, the dragged vertex held
-//! where the pointer put it.
+//! Live editing of a panel mesh: drag a vertex, or a group of vertices, and the PQ perturbation
+//! (conical paper, Sec. 2.2) keeps every face planar (conical, circular) around them, the
+//! dragged vertices held where the pointer put them.
 //!
-//! Input: a [`PqSceneStepper`] on a panel mesh, a vertex and its new position. Output: the
-//! stepper restarted on its *edit base* (the result committed before the drag) with that
-//! vertex moved and held as an anchor beside the options' anchors, stepped as before, one
+//! Input: a [`PqSceneStepper`] on a panel mesh, the dragged vertex and its new position, and
+//! the vertices dragged with it (a box selection), moved by the same translation. Output: the
+//! stepper restarted on its *edit base* (the result committed before the drag) with those
+//! vertices moved and held as anchors beside the options' anchors, stepped as before, one
 //! perturbation iteration a step, at the current level (no further subdivision).
 //!
 //! Every move of one drag starts from the same base, so the result after a drag is a
-//! function of the base, the vertex and its last position alone, not of how many steps ran
+//! function of the base, the vertices and the last position alone, not of how many steps ran
 //! between pointer events: replaying the committed edits rebuilds a mesh bit for bit (the
-//! page's undo). A move is made in stages of at most [`STAGE`] of the mean edge at the vertex,
-//! each perturbed to the tolerance from the last (continuation): from a planar base one held
-//! vertex jumping an edge length or more leaves the penalty method in a poor local minimum
-//! (conical-station: not converged from 0.8 edge lengths on, measured), while a quarter edge
-//! converges in 4-8 iterations.
+//! page's undo). A move is made in stages of at most [`STAGE`] of the mean edge at each moved
+//! vertex, each perturbed to the tolerance from the last (continuation): from a planar base
+//! one held vertex jumping an edge length or more leaves the penalty method in a poor local
+//! minimum (conical-station: not converged from 0.8 edge lengths on, measured), while a
+//! quarter edge converges in 4-8 iterations.
 
 use super::perturbation::PqPerturbation;
 use super::refinement::{PqSceneError, PqScenePhase, PqSceneStepper, Target};
@@ -27,34 +28,90 @@ pub const STAGE: f64 = 0.25;
 /// Most stages of one edit (a longer move takes longer stages).
 const MAX_STAGES: usize = 64;
 
-/// The positions a vertex is held at, stage by stage, on its way from `from` to `to`, the
-/// last (`to` exactly) first.
-fn stages(mesh: &PolyMesh, vertex: usize, from: Vec3, to: Vec3) -> Vec<Vec3> {
-    let edge = MeshTopology::new(mesh)
-        .ok()
-        .map(|t| {
-            let nb = t.neighbors(vertex);
-            nb.iter()
-                .map(|&u| (mesh.positions[u as usize] - from).norm())
-                .sum::<f64>()
-                / nb.len().max(1) as f64
-        })
-        .filter(|e| *e > 0.0 && e.is_finite());
-    let k = match edge {
-        Some(e) => ((to - from).norm() / (STAGE * e)).ceil() as usize,
-        None => 1,
-    }
-    .clamp(1, MAX_STAGES);
-    (1..=k)
-        .rev()
-        .map(|i| {
-            if i == k {
-                to
-            } else {
-                from + (to - from) * (i as f64 / k as f64)
+/// The stages of a running live edit: every held vertex moves from its base position to its
+/// target in `total` equal steps, the last exactly at the target.
+#[derive(Debug, Clone)]
+pub(super) struct EditStages {
+    /// The held vertices, the dragged one first.
+    vertices: Vec<usize>,
+    from: Vec<Vec3>,
+    to: Vec<Vec3>,
+    /// The stage running now (1 ..= total).
+    stage: usize,
+    total: usize,
+}
+
+impl EditStages {
+    /// The stages of moving `vertices` of `mesh` to `to`: as many as the longest move in
+    /// quarter edges at its vertex needs, 1 ..= [`MAX_STAGES`].
+    fn new(mesh: &PolyMesh, vertices: Vec<usize>, to: Vec<Vec3>) -> Self {
+        let from: Vec<Vec3> = vertices.iter().map(|&v| mesh.positions[v]).collect();
+        let topo = MeshTopology::new(mesh).ok();
+        let stages_of = |v: usize, from: Vec3, to: Vec3| {
+            let edge = topo
+                .as_ref()
+                .map(|t| {
+                    let nb = t.neighbors(v);
+                    nb.iter()
+                        .map(|&u| (mesh.positions[u as usize] - from).norm())
+                        .sum::<f64>()
+                        / nb.len().max(1) as f64
+                })
+                .filter(|e| *e > 0.0 && e.is_finite());
+            match edge {
+                Some(e) => ((to - from).norm() / (STAGE * e)).ceil() as usize,
+                None => 1,
             }
-        })
-        .collect()
+        };
+        let total = (0..vertices.len())
+            .map(|i| stages_of(vertices[i], from[i], to[i]))
+            .max()
+            .unwrap_or(1)
+            .clamp(1, MAX_STAGES);
+        EditStages {
+            vertices,
+            from,
+            to,
+            stage: 1,
+            total,
+        }
+    }
+
+    /// The position of the `i`-th held vertex at the current stage (the target exactly at
+    /// the last).
+    fn position(&self, i: usize) -> Vec3 {
+        if self.stage == self.total {
+            self.to[i]
+        } else {
+            self.from[i] + (self.to[i] - self.from[i]) * (self.stage as f64 / self.total as f64)
+        }
+    }
+
+    /// Moves the held vertices of `mesh` to the current stage's positions.
+    fn place(&self, mesh: &mut PolyMesh) {
+        for (i, &v) in self.vertices.iter().enumerate() {
+            mesh.positions[v] = self.position(i);
+        }
+    }
+
+    /// Stages after the running one.
+    pub(super) fn remaining(&self) -> usize {
+        self.total - self.stage
+    }
+
+    /// Why the edit stopped at the running stage (it did not reach the tolerance).
+    pub(super) fn shortfall(&self) -> String {
+        let what = match self.vertices.len() {
+            1 => format!("vertex {}", self.vertices[0]),
+            n => format!("vertex {} and {} others", self.vertices[0], n - 1),
+        };
+        format!(
+            "the drag of {what} was not followed to the pointer: stage {} of {} did not reach \
+             the tolerance, and the vertices stay where that stage put them (drag a shorter \
+             way at a time)",
+            self.stage, self.total
+        )
+    }
 }
 
 impl PqSceneStepper {
@@ -66,7 +123,7 @@ impl PqSceneStepper {
         Ok(())
     }
 
-    /// Why the last live edit stopped short of where its vertex was dragged (a stage that
+    /// Why the last live edit stopped short of where its vertices were dragged (a stage that
     /// did not reach the tolerance), or `None`.
     pub fn edit_shortfall(&self) -> Option<&str> {
         self.edit_shortfall.as_deref()
@@ -78,10 +135,24 @@ impl PqSceneStepper {
     }
 
     /// Moves `vertex` of the edit base to `position`, holds it there from now on, and
-    /// restarts the perturbation from that mesh (committing first when nothing was). Fails
-    /// for a developable strip (edited through its polylines, not vertex by vertex), a vertex
-    /// outside the mesh or a position that is not finite; the stepper is then unchanged.
+    /// restarts the perturbation from that mesh: [`PqSceneStepper::hold_group`] with no group.
     pub fn hold_vertex(&mut self, vertex: usize, position: Vec3) -> Result<(), PqSceneError> {
+        self.hold_group(vertex, position, &[])
+    }
+
+    /// Moves `vertex` of the edit base to `position` and every vertex of `group` by the same
+    /// translation, holds them there from now on, and restarts the perturbation from that
+    /// mesh (committing first when nothing was). `vertex` lands on `position` bit for bit
+    /// (the others on their base position plus the translation); `group` may contain
+    /// `vertex` and repeats. Fails for a developable strip (edited through its polylines, not
+    /// vertex by vertex), a vertex outside the mesh or a position that is not finite; the
+    /// stepper is then unchanged.
+    pub fn hold_group(
+        &mut self,
+        vertex: usize,
+        position: Vec3,
+        group: &[usize],
+    ) -> Result<(), PqSceneError> {
         if matches!(self.target, Target::Strip { .. }) {
             return Err(PqSceneError::Edit(
                 "a developable strip is edited through its polylines, not vertex by vertex".into(),
@@ -96,27 +167,45 @@ impl PqSceneStepper {
             self.commit()?;
         }
         let base = self.edit_base.as_ref().expect("committed above");
-        if vertex >= base.num_vertices() {
+        let n = base.num_vertices();
+        if let Some(&bad) = std::iter::once(&vertex).chain(group).find(|&&v| v >= n) {
             return Err(PqSceneError::Edit(format!(
-                "vertex {vertex} is not in the mesh ({} vertices)",
-                base.num_vertices()
+                "vertex {bad} is not in the mesh ({n} vertices)"
             )));
         }
-        let mut path = stages(base, vertex, base.positions[vertex], position);
-        let total = path.len();
-        let first = path.pop().expect("at least one stage");
-        let mut mesh = base.clone();
-        mesh.positions[vertex] = first;
-        let mut options = self.options.clone();
-        if !options.fixed_vertices.contains(&vertex) {
-            options.fixed_vertices.push(vertex);
-            options.fixed_vertices.sort_unstable();
+        let mut vertices = vec![vertex];
+        let mut rest: Vec<usize> = group.iter().copied().filter(|&v| v != vertex).collect();
+        rest.sort_unstable();
+        rest.dedup();
+        vertices.extend(rest);
+        let delta = position - base.positions[vertex];
+        let to: Vec<Vec3> = vertices
+            .iter()
+            .map(|&v| {
+                if v == vertex {
+                    position
+                } else {
+                    base.positions[v] + delta
+                }
+            })
+            .collect();
+        if !to.iter().all(|p| p.iter().all(|c| c.is_finite())) {
+            return Err(PqSceneError::Edit(format!(
+                "the group dragged with vertex {vertex} leaves the finite numbers"
+            )));
         }
+        let stages = EditStages::new(base, vertices, to);
+        let mut mesh = base.clone();
+        stages.place(&mut mesh);
+        let mut options = self.options.clone();
+        options.fixed_vertices.extend(&stages.vertices);
+        options.fixed_vertices.sort_unstable();
+        options.fixed_vertices.dedup();
         let perturbation = PqPerturbation::new(&mesh, options.clone())?;
         self.options = options;
         self.perturbation = Some(perturbation);
         self.mesh = mesh;
-        self.edit_stages = Some((vertex, path, total));
+        self.edit_stages = Some(stages);
         self.edit_shortfall = None;
         self.levels = self.level;
         self.phase = PqScenePhase::Perturb;
@@ -128,16 +217,16 @@ impl PqSceneStepper {
     /// Starts the next stage of the running live edit from the current mesh; false when
     /// there is none (the edit is finished).
     pub(super) fn next_edit_stage(&mut self) -> Result<bool, PqSceneError> {
-        let Some((vertex, path, _)) = self.edit_stages.as_mut() else {
+        let Some(stages) = self.edit_stages.as_mut() else {
             return Ok(false);
         };
-        let Some(next) = path.pop() else {
+        if stages.stage >= stages.total {
             self.edit_stages = None;
             return Ok(false);
-        };
-        let vertex = *vertex;
+        }
+        stages.stage += 1;
         let mut mesh = self.mesh.clone();
-        mesh.positions[vertex] = next;
+        stages.place(&mut mesh);
         self.perturbation = Some(PqPerturbation::new(&mesh, self.options.clone())?);
         self.mesh = mesh;
         Ok(true)
@@ -151,7 +240,7 @@ mod tests {
     use crate::scenes::pq_scene_stepper;
 
     /// The stages of a move: evenly spaced, the last exactly at the target, at most a
-    /// [`super::STAGE`] of the mean edge apart.
+    /// [`super::STAGE`] of the mean edge apart; a group takes as many as its longest move.
     #[test]
     fn a_move_is_cut_into_quarter_edge_stages() {
         let grid: Vec<crate::Vec3> = (0..3)
@@ -159,12 +248,31 @@ mod tests {
             .collect();
         let mesh = crate::mesh::PolyMesh::quad_grid(grid, 2, 2).unwrap();
         let (from, to) = (mesh.positions[4], crate::Vec3::new(1.0, 1.0, 1.0));
-        let path = super::stages(&mesh, 4, from, to);
-        let z: Vec<f64> = path.iter().map(|p| p.z).collect();
-        assert_eq!(z, vec![1.0, 0.75, 0.5, 0.25], "the last stage first");
-        assert_eq!(path[0], to);
+        let mut stages = super::EditStages::new(&mesh, vec![4], vec![to]);
+        let mut z = vec![];
+        loop {
+            z.push(stages.position(0).z);
+            if stages.remaining() == 0 {
+                break;
+            }
+            stages.stage += 1;
+        }
+        assert_eq!(z, vec![0.25, 0.5, 0.75, 1.0]);
+        assert_eq!(
+            stages.position(0),
+            to,
+            "the last stage exactly at the target"
+        );
         // No move: one stage, at the target.
-        assert_eq!(super::stages(&mesh, 4, from, from), vec![from]);
+        let still = super::EditStages::new(&mesh, vec![4], vec![from]);
+        assert_eq!((still.total, still.position(0)), (1, from));
+        // A group: the corner's mean edge is 1 as well, its move of 1.5 edges takes 6 stages.
+        let group = super::EditStages::new(
+            &mesh,
+            vec![4, 0],
+            vec![to, mesh.positions[0] + crate::Vec3::new(0.0, 0.0, 1.5)],
+        );
+        assert_eq!(group.total, 6);
     }
 
     /// Dragging a vertex of `conical-station` (its 3 steps of one drag, then a second drag):
@@ -260,6 +368,66 @@ mod tests {
         assert!(s.edit_shortfall().is_none());
     }
 
+    /// A box-selected group dragged with a vertex: the dragged vertex lands on the pointer
+    /// bit for bit, the group moves by the same translation, all of them are held, every face
+    /// is planar again, and a replay of the edit rebuilds the mesh bit for bit.
+    #[test]
+    fn a_dragged_group_moves_together_and_stays_planar() {
+        let mut s = pq_scene_stepper("conical-station").unwrap();
+        s.commit().unwrap();
+        let base = s.mesh().clone();
+        let topo = crate::mesh::MeshTopology::new(&base).unwrap();
+        let v = 166;
+        let group: Vec<usize> = topo.neighbors(v).iter().map(|&u| u as usize).collect();
+        let target = base.positions[v] + crate::Vec3::new(0.01, 0.02, 0.03);
+        // The translation as the dragged vertex made it (its rounding included).
+        let delta = target - base.positions[v];
+        s.hold_group(v, target * 0.5 + base.positions[v] * 0.5, &group)
+            .unwrap();
+        s.step().unwrap();
+        // The group repeats the dragged vertex: it is one of the group, not two.
+        let mut with_v = group.clone();
+        with_v.push(v);
+        s.hold_group(v, target, &with_v).unwrap();
+        s.run_to_end().unwrap();
+        assert!(s.converged());
+        let m = s.mesh().clone();
+        assert_eq!(m.positions[v], target);
+        for &w in &group {
+            assert_eq!(m.positions[w], base.positions[w] + delta, "vertex {w}");
+            assert!(s.anchors().contains(&w));
+        }
+        assert!(max_planarity(&m) <= 1e-9, "{}", max_planarity(&m));
+        // The rest moved to make room: the group is not a rigid copy of the base.
+        assert!(
+            (0..m.num_vertices())
+                .any(|u| u != v && !group.contains(&u) && m.positions[u] != base.positions[u])
+        );
+        let mut replay = pq_scene_stepper("conical-station").unwrap();
+        replay.hold_group(v, target, &group).unwrap();
+        replay.run_to_end().unwrap();
+        assert_eq!(replay.mesh(), &m);
+    }
+
+    /// Every vertex held: the whole mesh translates rigidly and stays planar, with nothing
+    /// left to solve.
+    #[test]
+    fn holding_every_vertex_translates_the_mesh() {
+        let mut s = pq_scene_stepper("conical-station").unwrap();
+        s.commit().unwrap();
+        let base = s.mesh().clone();
+        let all: Vec<usize> = (0..base.num_vertices()).collect();
+        let target = base.positions[0] + crate::Vec3::new(0.5, 0.0, -0.25);
+        // The translation as the dragged vertex made it (its rounding included).
+        let delta = target - base.positions[0];
+        s.hold_group(0, target, &all).unwrap();
+        s.run_to_end().unwrap();
+        for (p, q) in s.mesh().positions.iter().zip(&base.positions) {
+            assert_eq!(*p, q + delta);
+        }
+        assert!(max_planarity(s.mesh()) <= 1e-9);
+    }
+
     /// Edits that cannot be made are refused and leave the stepper as it was.
     #[test]
     fn bad_edits_are_refused() {
@@ -278,5 +446,15 @@ mod tests {
         let mut strip = pq_scene_stepper("developable-trefoil").unwrap();
         let e = strip.hold_vertex(0, crate::Vec3::zeros()).unwrap_err();
         assert!(e.to_string().contains("polylines"), "{e}");
+        // A group vertex outside the mesh.
+        let e = s
+            .hold_group(0, before.positions[0], &[1, n + 7])
+            .unwrap_err();
+        assert!(
+            e.to_string().contains(&format!("vertex {} is not", n + 7)),
+            "{e}"
+        );
+        assert_eq!(s.mesh(), &before);
+        assert!(s.is_done());
     }
 }

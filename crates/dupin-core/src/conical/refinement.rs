@@ -183,9 +183,8 @@ pub struct PqSceneStepper {
     pub(super) converged: bool,
     /// The mesh live edits start from ([`PqSceneStepper::commit`]), `None` before the first.
     pub(super) edit_base: Option<PolyMesh>,
-    /// The stages still to come of the running live edit: its vertex and the positions it is
-    /// held at next, the last one first, and how many stages the edit has.
-    pub(super) edit_stages: Option<(usize, Vec<crate::Vec3>, usize)>,
+    /// The stages of the running live edit.
+    pub(super) edit_stages: Option<super::live_edit::EditStages>,
     /// Why the last live edit stopped short of its target.
     pub(super) edit_shortfall: Option<String>,
 }
@@ -327,18 +326,13 @@ impl PqSceneStepper {
         self.running_iterations = 0;
         self.converged &= r.converged;
         self.show(r.mesh);
-        // A live edit moves its vertex in stages (live_edit.rs): the next one starts here,
+        // A live edit moves its vertices in stages (live_edit.rs): the next one starts here,
         // unless this one missed the tolerance (the edit then ends short of its target, as a
         // run that did not converge).
         if !r.converged
-            && let Some((vertex, path, total)) = self.edit_stages.take()
+            && let Some(stages) = self.edit_stages.take()
         {
-            self.edit_shortfall = Some(format!(
-                "the drag of vertex {vertex} was not followed to the pointer: stage {} of {total} \
-                 did not reach the tolerance, and the vertex stays where that stage put it \
-                 (drag a shorter way at a time)",
-                total - path.len()
-            ));
+            self.edit_shortfall = Some(stages.shortfall());
         }
         if self.next_edit_stage()? {
             return Ok(());
@@ -440,10 +434,7 @@ impl Stepper for PqSceneStepper {
             .as_ref()
             .and_then(|p| p.steps_left_at_most())
             .unwrap_or(0);
-        let stages = self
-            .edit_stages
-            .as_ref()
-            .map_or(0, |(_, path, _)| path.len());
+        let stages = self.edit_stages.as_ref().map_or(0, |s| s.remaining());
         Some(
             running
                 + stages * self.options.max_iterations
