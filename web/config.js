@@ -62,13 +62,18 @@ export function readHash(hash, { scenes, catalog, torusParams }) {
     for (const p of surface.params) c.params[p.key] = h.has(`p.${p.key}`) ? num(h.get(`p.${p.key}`)) : p.default;
     readRunSettings(h, c.free);
   }
-  // Vertex drags `edits=12:0.5,1,-0.25;40:...` (vertex:x,y,z, as many digits as round-trip).
+  // Vertex drags `edits=12:0.5,1,-0.25;40+41+47:...` (vertex:x,y,z, as many digits as
+  // round-trip; `+` joins the box-selected vertices dragged along by the same translation,
+  // written %2B, and a bare `+` of a typed hash reads as a space, so either joins).
   if (c.scene !== 'torus') {
     for (const e of (h.get('edits') ?? '').split(';').slice(0, 1000)) {
-      const m = /^(\d+):([^,]+),([^,]+),([^,]+)$/.exec(e);
+      const m = /^(\d+(?:[+ ]\d+)*):([^,]+),([^,]+),([^,]+)$/.exec(e);
       const xyz = m ? [m[2], m[3], m[4]].map(Number) : [];
+      const [v, ...group] = m ? m[1].split(/[+ ]/).map(Number) : [];
       // Vertex numbers past 2^31 would wrap crossing into wasm: dropped, as any malformed entry.
-      if (m && Number(m[1]) < 2 ** 31 && xyz.every(Number.isFinite)) c.edits.push([Number(m[1]), ...xyz]);
+      if (m && [v, ...group].every((u) => u < 2 ** 31) && xyz.every(Number.isFinite)) {
+        c.edits.push(group.length ? [v, ...xyz, group] : [v, ...xyz]);
+      }
     }
   }
   // The torus preview does not step (writeHash leaves its steps out).
@@ -126,7 +131,7 @@ export function writeHash(c) {
     if (c.imported.closeness !== null) h.set('closeness', String(c.imported.closeness));
     if (c.imported.toleranceMm !== null) h.set('tol', String(c.imported.toleranceMm));
   }
-  if (c.scene !== 'torus' && c.edits.length) h.set('edits', c.edits.map(([v, x, y, z]) => `${v}:${x},${y},${z}`).join(';'));
+  if (c.scene !== 'torus' && c.edits.length) h.set('edits', c.edits.map(([v, x, y, z, group]) => `${[v, ...(group ?? [])].join('+')}:${x},${y},${z}`).join(';'));
   if (c.scene !== 'torus') h.set('steps', String(c.steps));
   if (c.color !== d.color) h.set('color', c.color);
   if (c.panelEdge !== 1.5) h.set('edge', String(c.panelEdge));

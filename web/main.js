@@ -9,6 +9,7 @@ import { buildFields, clearFieldErrors, fillScenePicker, showFieldError } from '
 import { drawHistogram, drawLegend, legendCaption, showMetrics, showProgress } from './metrics.js';
 import { SettingsHistory } from './undo.js';
 import { download } from './download.js';
+import { BoxSelection } from './box-select.js';
 import { presentationFile } from './share.js';
 import { Solver } from './solver.js';
 import { initTeach, showPick } from './teach.js';
@@ -42,6 +43,7 @@ let lastMetrics = null;   // metrics on screen (redrawn when the panel edge chan
 let lastLayers = null;    // offset and beam layers on show: { unavailable, info } (showLayers)
 let pickedPoint = null;   // 3D point of the vertex clicked for the teaching inset (marked)
 const marker = document.createElement('div');
+let selection = null;     // box-selected vertices of a panel mesh in edit mode (box-select.js)
 const stepLog = [];      // per-step { phase, faces, ms } for benchmarks (window.dupin.stepLog)
 let settled = false;      // something was shown or reported (the first frame may count as ready)
 let opened = null;        // the design the user opened: { name, bytes } (never leaves the page)
@@ -132,6 +134,8 @@ function updateButtons() {
 /** Shows configuration `next`; `field` names the input that changed (its errors go there). */
 function load(next, { reframe = true, field = null, rebuild = false } = {}) {
   setMarker(null);
+  // Another run (a scene, a setting, undo): its vertices are not the selected ones.
+  selection?.clear();
   if (next.scene === 'torus') {
     try {
       const m = torusMesh(next.params.R, next.params.r, 96, 48);
@@ -605,7 +609,7 @@ function placeMarker() {
 // moves, one state in flight at a time (the latest pointer position wins); on release the drag
 // is committed to the URL (`edits`), so Undo replays the drags before it, bit for bit.
 let editMode = false;
-let drag = null; // { id, x, y, origin, direction, vertex, point, start, inFlight, sent }
+let drag = null; // { id, x, y, origin, direction, vertex, point, group, start, inFlight, sent }
 
 /** Whether the run on show is a panel mesh whose vertices can be dragged (a PQ mesh scene or an
  * opened panel mesh; not a P-Hex run, not a developable strip). */
@@ -617,6 +621,7 @@ function setEditMode(on) {
   editMode = on;
   setProp($('edit-vertices'), 'ariaPressed', on ? 'true' : 'false');
   canvas.classList.toggle('editing', on);
+  if (!on && selection?.size) { selection.clear(); dirty = true; }
 }
 
 function rayAt(x, y) {
@@ -630,7 +635,7 @@ function dragStart(e) {
   const x = e.clientX - r.left, y = e.clientY - r.top;
   try {
     const ray = rayAt(x, y);
-    drag = { id: e.pointerId, x, y, ...ray, vertex: null, point: null, start: true, inFlight: false, sent: null };
+    drag = { id: e.pointerId, x, y, ...ray, vertex: null, point: null, group: [], start: true, inFlight: false, sent: null };
     solver.post('pick', { origin: ray.origin, direction: ray.direction, panels: true, drag: true });
   } catch (e2) { drag = null; reportError(e2.message ?? String(e2), 'edit-vertices'); }
 }
@@ -640,6 +645,9 @@ function dragPicked(m) {
   if (m.error || !m.pick) { drag = null; if (m.error) reportError(m.error, 'edit-vertices'); return; }
   drag.vertex = m.pick.vertex;
   drag.point = m.pick.point;
+  // A selected vertex takes the selection along; any other one is dragged alone.
+  if (selection.has(drag.vertex)) drag.group = selection.groupOf(drag.vertex);
+  else if (selection.size) { selection.clear(); dirty = true; }
   sendDrag();
 }
 
@@ -661,8 +669,9 @@ function sendDrag() {
   if (!q || (drag.sent && q.every((c, k) => c === drag.sent[k]))) return;
   drag.inFlight = true;
   drag.sent = q;
-  solver.post('drag', { vertex: drag.vertex, point: q, start: drag.start });
+  solver.post('drag', { vertex: drag.vertex, point: q, group: drag.group, start: drag.start });
   drag.start = false;
+  followGroup(drag);
 }
 
 /** A state arrived: the next pointer position may go. */
@@ -680,14 +689,40 @@ function dragEnd() {
   try {
     const q = dragPointOf(d);
     if (q && !(d.sent && q.every((c, k) => c === d.sent[k]))) {
-      solver.post('drag', { vertex: d.vertex, point: q, start: d.start });
+      solver.post('drag', { vertex: d.vertex, point: q, group: d.group, start: d.start });
       d.sent = q;
     }
   } catch { /* the last sent position stands */ }
   if (!d.sent) return;
-  config.edits = [...config.edits, [d.vertex, ...d.sent]];
+  if (d.group.length) {
+    selection.commit(d.sent.map((c, k) => c - d.point[k]));
+    dirty = true;
+  }
+  config.edits = [...config.edits, d.group.length ? [d.vertex, ...d.sent, d.group] : [d.vertex, ...d.sent]];
   welcome = false;
   syncHash();
+}
+
+/** The selection's markers follow a group drag by its translation so far. */
+function followGroup(d) {
+  if (!d.group.length || !d.sent) return;
+  selection.follow(d.sent.map((c, k) => c - d.point[k]));
+  dirty = true;
+}
+
+// ---- box selection (Shift-drag in edit mode; box-select.js) ------------------------------------
+function boxEnd() {
+  const rect = selection.end();
+  if (!rect) return;
+  try {
+    solver.post('select', { viewProj: Array.from(viewer.viewProj()), rect });
+  } catch (e) { reportError(e.message ?? String(e), 'edit-vertices'); }
+}
+
+function onSelection(m) {
+  if (m.error) { reportError(m.error, 'edit-vertices'); return; }
+  selection.set(m);
+  dirty = true;
 }
 
 function dragPointOf(d) {
@@ -702,11 +737,22 @@ function wireInput() {
   let down = null; // where a one-finger press started: a release near it is a click (pick)
   canvas.addEventListener('pointerdown', (e) => {
     canvas.setPointerCapture(e.pointerId);
-    if (editMode && pointers.size === 0 && running) { dragStart(e); return; }
+    if (editMode && pointers.size === 0 && running) {
+      if (e.shiftKey) {
+        const r = canvas.getBoundingClientRect();
+        selection.begin(e.clientX - r.left, e.clientY - r.top);
+      } else dragStart(e);
+      return;
+    }
     pointers.set(e.pointerId, e);
     down = pointers.size === 1 ? { id: e.pointerId, x: e.clientX, y: e.clientY, moved: false } : null;
   });
   canvas.addEventListener('pointermove', (e) => {
+    if (selection.active) {
+      const r = canvas.getBoundingClientRect();
+      selection.move(e.clientX - r.left, e.clientY - r.top);
+      return;
+    }
     if (drag && drag.id === e.pointerId) {
       const r = canvas.getBoundingClientRect();
       drag.x = e.clientX - r.left;
@@ -731,6 +777,7 @@ function wireInput() {
   });
   const up = (e) => { pointers.delete(e.pointerId); pinch = 0; };
   canvas.addEventListener('pointerup', (e) => {
+    if (selection.active) { boxEnd(); return; }
     if (drag && drag.id === e.pointerId) { dragEnd(); return; }
     const click = down && down.id === e.pointerId && !down.moved;
     down = null;
@@ -740,7 +787,7 @@ function wireInput() {
       pickAt(e.clientX - r.left, e.clientY - r.top);
     }
   });
-  canvas.addEventListener('pointercancel', (e) => { if (drag && drag.id === e.pointerId) dragEnd(); up(e); });
+  canvas.addEventListener('pointercancel', (e) => { if (drag && drag.id === e.pointerId) dragEnd(); selection.end(); up(e); });
   canvas.addEventListener('wheel', (e) => { e.preventDefault(); viewer.zoom(Math.exp(e.deltaY * 0.001)); cameraMoved(); }, { passive: false });
 }
 
@@ -756,6 +803,7 @@ function frame() {
     try {
       viewer.render();
       if (pickedPoint) placeMarker();
+      if (selection?.size) selection.draw((x, y, z) => viewer.project(x, y, z));
       noteTask('render', t0);
       if (document.body.dataset.ready !== 'true' && settled) {
         document.body.dataset.firstFrameMs = performance.now().toFixed(0);
@@ -828,7 +876,7 @@ async function main() {
     TORUS = Object.fromEntries(schema.torus.map((p) => [p.key, { label: p.key, value: p.default }]));
     config = defaults();
     ctx = { scenes: sceneNames(), catalog: surfaceCatalog(), defaults: freeDefaults() };
-    solver = new Solver({ onState, onError, onExport, onPick, onFault });
+    solver = new Solver({ onState, onError, onExport, onPick, onFault, onSelection });
     const backend = readHash(location.hash, { scenes: ctx.scenes, catalog: ctx.catalog, torusParams: TORUS }).backend;
     canvas.width = Math.max(1, canvas.clientWidth);
     canvas.height = Math.max(1, canvas.clientHeight);
@@ -841,6 +889,7 @@ async function main() {
   Object.assign(marker, { className: 'pick-marker', hidden: true });
   marker.dataset.testid = 'pick-marker';
   canvas.after(marker);
+  selection = new BoxSelection(canvas, $('selection'));
   fillScenePicker($('scene-select'), ctx.scenes);
   initTeach();
   initHexd2d();
@@ -882,6 +931,7 @@ async function main() {
   $('redo').addEventListener('click', () => undoRedo(true));
   // Ctrl+Z, Ctrl+Shift+Z and Ctrl+Y (Cmd on a Mac), except in a text field, which keeps its own.
   document.addEventListener('keydown', (e) => {
+    if (e.key === 'Escape' && selection.size && !e.target.closest?.('input, textarea, select')) { selection.clear(); dirty = true; return; }
     if (!(e.ctrlKey || e.metaKey) || e.altKey) return;
     if (e.target.closest?.('input:not([type=checkbox]):not([type=range]), textarea')) return;
     const key = e.key.toLowerCase();

@@ -5,14 +5,14 @@
 // than anyone wants to wait: `restart()` terminates the worker (whatever it is computing) and
 // starts a fresh one, and the page reloads its last good state into it.
 export class Solver {
-  constructor({ onState, onError, onExport, onPick, onFault }) {
+  constructor({ onState, onError, onExport, onPick, onFault, onSelection }) {
     this.gen = 0;
-    this.callbacks = { onState, onError, onExport, onPick, onFault };
+    this.callbacks = { onState, onError, onExport, onPick, onFault, onSelection };
     this.start();
   }
 
   start() {
-    const { onState, onError, onExport, onPick, onFault } = this.callbacks;
+    const { onState, onError, onExport, onPick, onFault, onSelection } = this.callbacks;
     const worker = new Worker(new URL('./worker.js', import.meta.url), { type: 'module' });
     this.worker = worker;
     this.ready = new Promise((resolve, reject) => {
@@ -37,6 +37,7 @@ export class Solver {
       else if (m.type === 'error') onError(m);
       else if (m.type === 'export') onExport(m);
       else if (m.type === 'pick') onPick?.(m);
+      else if (m.type === 'selection') onSelection?.(m);
     });
   }
 
@@ -52,8 +53,9 @@ export class Solver {
   /** Starts `config` (a Session config) and replays `steps` steps; `field` names the input
    * that caused the load (bad configurations report back to it); `layers` are the offset and
    * support layers to draw where the run has them; `file` ({ name, bytes }) opens a design
-   * with `config` as its import options (Session.fromFile); `edits` ([vertex, x, y, z] each)
-   * are vertex drags replayed after the steps (Session.dragVertex), each run to its end. */
+   * with `config` as its import options (Session.fromFile); `edits` ([vertex, x, y, z] each,
+   * and the group dragged along as a fifth item) are vertex drags replayed after the steps
+   * (Session.dragVertices), each run to its end. */
   load(config, { steps = 1, mode, field = null, layers = null, file = null, edits = [] } = {}) {
     this.gen += 1;
     this.worker.postMessage({ type: 'load', gen: this.gen, config, steps, mode, field, layers, file, edits });

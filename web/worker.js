@@ -3,7 +3,8 @@
 // ones are dropped on both sides):
 //   in:  load {config, steps, mode, layers, file?, edits?} (file {name, bytes}: Session.fromFile; edits: drags to replay)
 //        | step | play | pause | ack | mode {mode}
-//        | drag {vertex, point, start} (Session.dragVertex; start: a new drag)
+//        | drag {vertex, point, group?, start} (Session.dragVertices; start: a new drag)
+//        | select {viewProj, rect} (Session.verticesInRect: a box selection)
 //        | layers {layers} (offset/support, Session.setLayers) | export {kind, panelEdge} (obj, json, svg, dxf, csv, glb, 3dm)
 //        | pick {origin, direction, panels} (a view ray; panels: Session.pickPanelVertex)
 //        | fault {kind} (debugFault: a deliberate trap or out-of-memory, for recovery tests)
@@ -128,7 +129,7 @@ const handlers = {
       while (steps < target && !session.done()) stepOnce();
       // Committed drags, as the page made them: each starts from the run so far finished.
       const edits = msg.edits ?? [];
-      for (const [v, x, y, z] of edits) session.dragVertex(v, x, y, z, true);
+      for (const [v, x, y, z, group] of edits) session.dragVertices(v, x, y, z, Uint32Array.from(group ?? []), true);
       if (edits.length) while (!session.done()) stepOnce();
       send();
     } catch (e) { fail(e); }
@@ -150,7 +151,7 @@ const handlers = {
   drag(msg) {
     if (!session) return;
     try {
-      session.dragVertex(msg.vertex, msg.point[0], msg.point[1], msg.point[2], !!msg.start);
+      session.dragVertices(msg.vertex, msg.point[0], msg.point[1], msg.point[2], Uint32Array.from(msg.group ?? []), !!msg.start);
     } catch (e) {
       if (e instanceof WebAssembly.RuntimeError) { fail(e); return; }
       postMessage({ type: 'error', gen, message: e?.message ?? String(e), field: 'edit-vertices' });
@@ -189,6 +190,18 @@ const handlers = {
       const pick = msg.panels ? session.pickPanelVertex(msg.origin, msg.direction) : session.pickVertex(msg.origin, msg.direction);
       postMessage({ type: 'pick', gen, panels: !!msg.panels, drag: !!msg.drag, pick });
     } catch (e) { postMessage({ type: 'pick', gen, drag: !!msg.drag, error: e?.message ?? String(e) }); }
+  },
+  // A box selection: the panel-mesh vertices projected inside `rect` (NDC corners).
+  select(msg) {
+    if (!session) return;
+    try {
+      const [x0, y0, x1, y1] = msg.rect;
+      const sel = session.verticesInRect(msg.viewProj, x0, y0, x1, y1);
+      postMessage({ type: 'selection', gen, vertices: sel.vertices, points: sel.points });
+    } catch (e) {
+      if (e instanceof WebAssembly.RuntimeError) { fail(e); return; }
+      postMessage({ type: 'selection', gen, error: e?.message ?? String(e) });
+    }
   },
   export(msg) {
     if (!session) return;

@@ -3,7 +3,7 @@
 // gives back the mesh before the drag and Redo the dragged one, both bit for bit.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { byId, dragImportedGrid, exportText, metrics, openPage, waitDone } from './harness.mjs';
+import { byId, dragImportedGrid, exportText, metrics, objVertices, onScreen, openImportedGrid, openPage, waitDone } from './harness.mjs';
 
 // The drag, in pixels: about half an edge of the finished scene at the default view.
 const DX = 10, DY = 6;
@@ -101,6 +101,101 @@ test('dragging a vertex of an opened 1 024-quad mesh: planar again, the vertex u
     await page.waitForFunction(() => location.hash.includes('edits='));
     await waitDone(page);
     assert.equal(await exportText(page, 'export-obj'), after, 'redo replays the drag bit for bit');
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
+
+test('a box-selected group of an opened quad mesh drags together: planar again, moved by one translation, undo bit for bit', async () => {
+  const { browser, page, errors } = await openPage();
+  try {
+    const n = 32;
+    await openImportedGrid(page, n);
+    const before = await exportText(page, 'export-obj');
+    const base = objVertices(before);
+    const id = (i, j) => i * (n + 1) + j;
+    const middle = id(n / 2, n / 2);
+    const block = [];
+    for (let i = n / 2 - 1; i <= n / 2 + 1; i++) for (let j = n / 2 - 1; j <= n / 2 + 1; j++) block.push(id(i, j));
+    const screen = await onScreen(page, base);
+    // A rectangle around the 3 x 3 block, a third of an edge (on screen) beyond it; the page
+    // must select exactly the vertices whose projection lies inside.
+    const edgePx = Math.hypot(screen[middle][0] - screen[id(n / 2 + 1, n / 2)][0], screen[middle][1] - screen[id(n / 2 + 1, n / 2)][1]);
+    const xs = block.map((v) => screen[v][0]), ys = block.map((v) => screen[v][1]);
+    const pad = edgePx / 3;
+    const rect = [Math.min(...xs) - pad, Math.min(...ys) - pad, Math.max(...xs) + pad, Math.max(...ys) + pad];
+    const inside = screen.flatMap((p, v) => (p && p[0] >= rect[0] && p[0] <= rect[2] && p[1] >= rect[1] && p[1] <= rect[3] ? [v] : []));
+    assert.ok(block.every((v) => inside.includes(v)), 'the block is inside its rectangle');
+
+    await byId(page, 'edit-vertices').click();
+    await page.keyboard.down('Shift');
+    await page.mouse.move(rect[0], rect[1]);
+    await page.mouse.down();
+    await page.mouse.move((rect[0] + rect[2]) / 2, (rect[1] + rect[3]) / 2, { steps: 3 });
+    assert.ok(await byId(page, 'select-band').isVisible(), 'the rectangle is drawn while Shift-dragging');
+    await page.mouse.move(rect[2], rect[3], { steps: 3 });
+    await page.mouse.up();
+    await page.keyboard.up('Shift');
+    const hint = byId(page, 'selection');
+    await page.waitForFunction((k) => document.querySelector('[data-testid=selection]').dataset.count === String(k), inside.length);
+    console.log(`box selection: ${inside.length} vertices (${await hint.textContent()})`);
+    assert.ok(await byId(page, 'selection-overlay').isVisible(), 'the selected vertices are marked');
+    assert.ok(!(await byId(page, 'select-band').isVisible()), 'the rectangle goes on release');
+
+    // Drag the middle vertex: the selection comes along.
+    const [x0, y0] = screen[middle];
+    const [dx, dy] = [12, -8];
+    await page.mouse.move(x0, y0);
+    await page.mouse.down();
+    for (let i = 1; i <= 20; i++) {
+      await page.mouse.move(x0 + (dx * i) / 20, y0 + (dy * i) / 20);
+      await page.waitForTimeout(25);
+    }
+    await page.mouse.up();
+    await page.waitForFunction(() => {
+      const d = document.querySelector('[data-testid=metrics]').dataset;
+      return d.phase === 'done' && Number(d.maxPlanarity) <= 1e-9 && location.hash.includes('edits=');
+    }, null, { timeout: 120_000 });
+    const m = await metrics(page);
+    assert.ok(Number(m.maxPlanarity) <= 1e-9, m.maxPlanarity);
+    const [head, coords] = (await edits(page)).split(':');
+    const [v, ...group] = head.split('+').map(Number);
+    const xyz = coords.split(',').map(Number);
+    assert.equal(v, middle, 'the vertex under the pointer leads');
+    assert.deepEqual(group, inside.filter((u) => u !== middle), 'the whole selection was dragged along');
+    const [q] = await onScreen(page, [xyz]);
+    assert.ok(Math.hypot(q[0] - (x0 + dx), q[1] - (y0 + dy)) < 1.5, `${q} vs pointer ${[x0 + dx, y0 + dy]}`);
+    const after = await exportText(page, 'export-obj');
+    const moved = objVertices(after);
+    const delta = xyz.map((c, k) => c - base[middle][k]);
+    const close = (a, b) => Math.abs(a - b) <= 1e-6 * (1 + Math.abs(b));
+    for (const u of [v, ...group]) {
+      assert.ok(moved[u].every((c, k) => close(c, base[u][k] + delta[k])), `vertex ${u}: ${moved[u]} vs ${base[u]} + ${delta}`);
+    }
+    // The rest made room: some vertex outside the selection moved.
+    assert.ok(moved.some((p, u) => !inside.includes(u) && p.some((c, k) => c !== base[u][k])));
+
+    await byId(page, 'undo').click();
+    await page.waitForFunction(() => !location.hash.includes('edits='));
+    await waitDone(page);
+    assert.equal(await exportText(page, 'export-obj'), before, 'undo restores the mesh before the group drag');
+    assert.ok(!(await hint.isVisible()), 'another run clears the selection');
+    await byId(page, 'redo').click();
+    await page.waitForFunction(() => location.hash.includes('edits='));
+    await waitDone(page);
+    assert.equal(await exportText(page, 'export-obj'), after, 'redo replays the group drag bit for bit');
+
+    // Escape clears a selection.
+    await page.keyboard.down('Shift');
+    await page.mouse.move(rect[0], rect[1]);
+    await page.mouse.down();
+    await page.mouse.move(rect[2], rect[3], { steps: 4 });
+    await page.mouse.up();
+    await page.keyboard.up('Shift');
+    await page.waitForFunction(() => Number(document.querySelector('[data-testid=selection]').dataset.count) > 0);
+    await page.keyboard.press('Escape');
+    await page.waitForFunction(() => document.querySelector('[data-testid=selection]').hidden);
     assert.deepEqual(errors, []);
   } finally {
     await browser.close();

@@ -211,21 +211,41 @@ export function gridObj(n) {
  * in `moves` pointer moves and measures: states per second while dragging, and the time from
  * the pointer's release to the first state that is done (page clock, state arrival).
  */
-export async function dragImportedGrid(page, n, { dx = 12, dy = -8, moves = 20 } = {}) {
+/** Opens the n x n quad grid of `gridObj` as panels and planarises it; returns the OBJ text. */
+export async function openImportedGrid(page, n) {
   const text = gridObj(n);
   await byId(page, 'import-file').setInputFiles({ name: 'grid.obj', mimeType: 'text/plain', buffer: Buffer.from(text) });
   await page.waitForFunction(() => document.querySelector('[data-testid=status]').textContent.includes('grid.obj · panels'), null, { timeout: 120_000 });
   await byId(page, 'play').click();
   await waitDone(page, 300_000);
-  const middle = (n / 2) * (n + 1) + n / 2;
-  const p = text.split('\n').filter((l) => l.startsWith('v '))[middle].split(' ').slice(1).map(Number);
-  const at = await page.evaluate(([x, y, z]) => {
-    const q = window.dupin.viewer.project(x, y, z);
+  return text;
+}
+
+/** Page (CSS pixel) coordinates of the 3D points `points` ([x, y, z] each) in the current view. */
+export function onScreen(page, points) {
+  return page.evaluate((ps) => {
     const r = document.querySelector('[data-testid=canvas]').getBoundingClientRect();
+    return ps.map(([x, y, z]) => {
+      const q = window.dupin.viewer.project(x, y, z);
+      return q ? [r.left + (q[0] + 1) / 2 * r.width, r.top + (1 - q[1]) / 2 * r.height] : null;
+    });
+  }, points);
+}
+
+/** The vertex positions of an OBJ text. */
+export function objVertices(text) {
+  return text.split('\n').filter((l) => l.startsWith('v ')).map((l) => l.split(' ').slice(1, 4).map(Number));
+}
+
+export async function dragImportedGrid(page, n, { dx = 12, dy = -8, moves = 20 } = {}) {
+  const text = await openImportedGrid(page, n);
+  const middle = (n / 2) * (n + 1) + n / 2;
+  const [[ax, ay]] = await onScreen(page, [objVertices(text)[middle]]);
+  const at = { x: ax, y: ay };
+  await page.evaluate(() => {
     window.__up = null;
     document.querySelector('[data-testid=canvas]').addEventListener('pointerup', () => { window.__up = performance.now(); }, { once: true });
-    return { x: r.left + (q[0] + 1) / 2 * r.width, y: r.top + (1 - q[1]) / 2 * r.height };
-  }, p);
+  });
   await byId(page, 'edit-vertices').click();
   const s0 = await page.evaluate(() => window.dupin.stepLog.length);
   const t0 = Date.now();
