@@ -14,8 +14,9 @@ use serde::{Deserialize, Serialize};
 use wasm_bindgen::prelude::*;
 
 /// The options of `Session.fromFile`: `{ importAs, unit, size, method, init, bound, lambda, mu,
-/// mode, fixBoundary }`, all optional: the surface settings are the free mode's.
-#[derive(Deserialize, Default)]
+/// mode, fixBoundary, anchors, closeness, toleranceMm, controlPoints }`, all optional: the
+/// surface settings are the free mode's.
+#[derive(Deserialize, Default, Clone)]
 #[serde(deny_unknown_fields, rename_all = "camelCase")]
 struct ImportConfig {
     /// `surface` (P-Hex panels it) or `panels` (planarised); absent: guessed from the file.
@@ -45,6 +46,22 @@ struct ImportConfig {
     closeness: Option<f64>,
     /// Panels: the largest distance of a panel corner from its plane, in millimetres.
     tolerance_mm: Option<f64>,
+    /// NURBS surface: moved control points, `[index, x, y, z]` each (index row-major,
+    /// `i * nv + j`; coordinates in the file's unit), applied in order.
+    control_points: Option<Vec<[f64; 4]>>,
+}
+
+impl ImportConfig {
+    /// Moves control point `index` to `p` in these options: the entry for `index` is
+    /// replaced (or added), so a drag leaves one entry per point however long it ran.
+    fn move_control_point(&mut self, index: usize, p: [f64; 3]) {
+        let moves = self.control_points.get_or_insert_with(Vec::new);
+        let entry = [index as f64, p[0], p[1], p[2]];
+        match moves.iter_mut().find(|m| m[0] == index as f64) {
+            Some(m) => *m = entry,
+            None => moves.push(entry),
+        }
+    }
 }
 
 /// The keys of [`ImportConfig`] as JS spells them, for the unknown-key check.
@@ -62,6 +79,7 @@ pub(crate) const IMPORT_CONFIG_KEYS: &[&str] = &[
     "anchors",
     "closeness",
     "toleranceMm",
+    "controlPoints",
 ];
 
 /// The free mode's P-Hex run settings, shared by a library surface and an opened one: the
@@ -111,6 +129,18 @@ pub(crate) struct DesignInfo {
     /// The anchored vertices of a panel mesh (drawn with the panels).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub(crate) anchors: Vec<usize>,
+    /// A NURBS surface's control net, with its moved points where they were put.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub(crate) control_net: Option<ControlNet>,
+}
+
+/// A NURBS surface's control net for the page: `nu` rows of `nv` points, `points` flat x, y, z
+/// in the file's unit, point (i, j) at `i * nv + j`.
+#[derive(Serialize, Clone, Debug, PartialEq)]
+pub(crate) struct ControlNet {
+    nu: usize,
+    nv: usize,
+    points: Vec<f64>,
 }
 
 impl DesignInfo {
@@ -140,12 +170,13 @@ pub(crate) enum Imported {
     Panels(Box<PqSceneStepper>),
 }
 
-/// The run and design information of an opened file. Errors name the file.
+/// The run and design information of an opened file, and for a NURBS surface what its
+/// control points can be dragged with ([`NurbsSource`]). Errors name the file.
 pub(crate) fn import_run(
     name: &str,
     bytes: &[u8],
     config: JsValue,
-) -> Result<(Imported, DesignInfo), JsError> {
+) -> Result<(Imported, DesignInfo, Option<NurbsSource>), JsError> {
     crate::js::refuse_unknown_keys(&config, "import config", IMPORT_CONFIG_KEYS)?;
     let cfg: ImportConfig = if config.is_undefined() || config.is_null() {
         ImportConfig::default()
@@ -153,7 +184,38 @@ pub(crate) fn import_run(
         serde_wasm_bindgen::from_value(config)
             .map_err(|e| JsError::new(&format!("bad import config: {e}")))?
     };
-    import_design(name, bytes, &cfg).map_err(|e| JsError::new(&e))
+    let (run, info) = import_design(name, bytes, &cfg).map_err(|e| JsError::new(&e))?;
+    let source = info.control_net.is_some().then(|| NurbsSource {
+        name: name.to_string(),
+        bytes: bytes.to_vec(),
+        cfg,
+    });
+    Ok((run, info, source))
+}
+
+/// An opened NURBS surface as it was read: the file and its options, the moved control points
+/// among them. Moving a point reads the design again with one more move, so a drag ends on
+/// exactly the run a reload of the same options gives.
+pub(crate) struct NurbsSource {
+    name: String,
+    bytes: Vec<u8>,
+    cfg: ImportConfig,
+}
+
+impl NurbsSource {
+    /// The run and design with control point `index` at `p` (file unit); the source keeps the
+    /// move only when it succeeds.
+    pub(crate) fn move_control_point(
+        &mut self,
+        index: usize,
+        p: [f64; 3],
+    ) -> Result<(Imported, DesignInfo), String> {
+        let mut cfg = self.cfg.clone();
+        cfg.move_control_point(index, p);
+        let out = import_design(&self.name, &self.bytes, &cfg)?;
+        self.cfg = cfg;
+        Ok(out)
+    }
 }
 
 /// [`import_run`] after its options are read (plain Rust, tested natively).
@@ -193,10 +255,24 @@ fn import_design(
             ));
         }
         let text = std::str::from_utf8(bytes).map_err(|e| named(&e))?;
-        let s = NurbsSurface::from_json(text).map_err(|e| named(&e))?;
+        let mut s = NurbsSurface::from_json(text).map_err(|e| named(&e))?;
+        for &[index, x, y, z] in cfg.control_points.iter().flatten() {
+            if !(index >= 0.0 && index.fract() == 0.0 && index < u32::MAX as f64) {
+                return Err(named(&format_args!(
+                    "controlPoints: {index} is not a control point index"
+                )));
+            }
+            s.set_control_point(index as usize, dupin_core::Vec3::new(x, y, z))
+                .map_err(|e| named(&format_args!("controlPoints: {e}")))?;
+        }
         unit = unit.or(s.unit());
         (Some(s), None, None)
     } else {
+        if cfg.control_points.as_ref().is_some_and(|m| !m.is_empty()) {
+            return Err(named(
+                &"controlPoints are for a NURBS surface; a mesh has vertices",
+            ));
+        }
         let mesh = read_mesh(name, bytes, &ImportOptions::default())
             .map_err(|e| named(&e))?
             .mesh;
@@ -225,7 +301,16 @@ fn import_design(
         }
         (None, None) => [0.0; 3],
     };
+    let control_net = surface.as_ref().map(|s| {
+        let (nu, nv) = s.control_net_size();
+        ControlNet {
+            nu,
+            nv,
+            points: s.control_points().iter().flatten().copied().collect(),
+        }
+    });
     let info = DesignInfo {
+        control_net: if is_json { control_net } else { None },
         name: name.to_string(),
         import_as: if surface.is_some() {
             "surface"
@@ -465,6 +550,74 @@ mod tests {
             ..ImportConfig::default()
         };
         assert!(refused("a.obj", b"", &as_what).contains("use `surface` or `panels`"));
+    }
+
+    /// Moved control points reshape an opened NURBS surface and show in its control net; a
+    /// drag (`NurbsSource::move_control_point`, one entry per point however often it moves)
+    /// gives the run that opening with the same `controlPoints` gives, bit for bit; bad moves
+    /// and moves on a mesh are refused, naming the file, and leave the source as it was.
+    #[test]
+    fn moved_control_points_reshape_an_opened_surface() {
+        let json = r#"{"degree_u": 2, "degree_v": 2, "knots_u": [0, 0, 0, 1, 1, 1],
+            "knots_v": [0, 0, 0, 1, 1, 1],
+            "control_points": [[[0, 0, 0], [0, 2, 0.5], [0, 4, 0]],
+                               [[2, 0, 0.5], [2, 2, 1.5], [2, 4, 0.5]],
+                               [[4, 0, 0], [4, 2, 0.5], [4, 4, 0]]]}"#;
+        let mut source = NurbsSource {
+            name: "dome.json".into(),
+            bytes: json.as_bytes().to_vec(),
+            cfg: ImportConfig::default(),
+        };
+        let (_, first) =
+            import_design("dome.json", json.as_bytes(), &ImportConfig::default()).unwrap();
+        let net = first.control_net.clone().unwrap();
+        assert_eq!((net.nu, net.nv, net.points.len()), (3, 3, 27));
+        assert_eq!(&net.points[12..15], &[2.0, 2.0, 1.5]);
+        // A drag of the middle point in three moves, then a corner.
+        for z in [1.7, 1.9, 2.5] {
+            source.move_control_point(4, [2.0, 2.0, z]).unwrap();
+        }
+        let (run, info) = source.move_control_point(0, [0.0, 0.0, -0.5]).unwrap();
+        assert_eq!(source.cfg.control_points.as_ref().unwrap().len(), 2);
+        let net = info.control_net.unwrap();
+        assert_eq!(&net.points[12..15], &[2.0, 2.0, 2.5]);
+        assert_eq!(&net.points[0..3], &[0.0, 0.0, -0.5]);
+        assert!(info.dimensions_m[2] > first.dimensions_m[2]);
+        let replay = ImportConfig {
+            control_points: Some(vec![[4.0, 2.0, 2.0, 2.5], [0.0, 0.0, 0.0, -0.5]]),
+            ..ImportConfig::default()
+        };
+        let (again, _) = import_design("dome.json", json.as_bytes(), &replay).unwrap();
+        let (Imported::Phex(mut a, _), Imported::Phex(mut b, _)) = (run, again) else {
+            panic!("a NURBS design is a surface")
+        };
+        a.run_to_end().unwrap();
+        b.run_to_end().unwrap();
+        assert_eq!(a.mesh(), b.mesh(), "the dragged net replays bit for bit");
+
+        let kept = source.cfg.control_points.clone();
+        let e = source.move_control_point(9, [0.0; 3]).err().unwrap();
+        assert_eq!(
+            e,
+            "dome.json: controlPoints: control point 9 is not in the 3 x 3 net"
+        );
+        let e = source
+            .move_control_point(1, [f64::NAN, 0.0, 0.0])
+            .err()
+            .unwrap();
+        assert!(e.contains("not finite"), "{e}");
+        assert_eq!(source.cfg.control_points, kept);
+        let fractional = ImportConfig {
+            control_points: Some(vec![[1.5, 0.0, 0.0, 0.0]]),
+            ..ImportConfig::default()
+        };
+        let e = refused("dome.json", json.as_bytes(), &fractional);
+        assert!(e.contains("1.5 is not a control point index"), "{e}");
+        let e = refused("x.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", &replay);
+        assert!(
+            e.starts_with("x.obj: controlPoints are for a NURBS surface"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -200,6 +200,19 @@ pub struct Session {
     layers: LayerConfig,
     /// The opened design (`Session.fromFile`), shown with the metrics.
     design: Option<crate::import::DesignInfo>,
+    /// An opened NURBS surface, whose control points `moveControlPoint` drags.
+    nurbs: Option<crate::import::NurbsSource>,
+}
+
+/// The run of an opened design.
+fn imported_run(imported: Imported) -> Run {
+    match imported {
+        Imported::Phex(p, goals) => Run::Phex(p, goals),
+        Imported::Panels(stepper) => Run::Pq {
+            stepper,
+            started: false,
+        },
+    }
 }
 
 /// Every scene a `Session` accepts: the P-Hex scenes, then the PQ scenes.
@@ -387,6 +400,7 @@ impl Session {
             per_face: None,
             layers: LayerConfig::default(),
             design: None,
+            nurbs: None,
         })
     }
 
@@ -399,16 +413,10 @@ impl Session {
     /// `Error` naming the file and what is wrong with it.
     #[wasm_bindgen(js_name = fromFile)]
     pub fn from_file(name: &str, bytes: &[u8], config: JsValue) -> Result<Session, JsError> {
-        let (imported, design) = crate::import::import_run(name, bytes, config)?;
-        let run = match imported {
-            Imported::Phex(p, goals) => Run::Phex(p, goals),
-            Imported::Panels(stepper) => Run::Pq {
-                stepper,
-                started: false,
-            },
-        };
+        let (imported, design, nurbs) = crate::import::import_run(name, bytes, config)?;
         Ok(Session {
-            run,
+            run: imported_run(imported),
+            nurbs,
             config: SessionConfig {
                 imported: Some(name.to_string()),
                 ..SessionConfig::default()
@@ -417,6 +425,34 @@ impl Session {
             layers: LayerConfig::default(),
             design: Some(design),
         })
+    }
+
+    /// Moves control point `index` (row-major, `i * nv + j` of the `controlNet` in
+    /// `metrics().design`) of an opened NURBS surface to `(x, y, z)` (the file's unit) and
+    /// restarts the P-Hex run on the reshaped surface from its first step, as a page opened
+    /// with that move in `controlPoints` would (so a dragged net replays bit for bit). Throws
+    /// for a run that is not an opened NURBS surface, an index past the net or a point that is
+    /// not finite, leaving the run as it was.
+    #[wasm_bindgen(js_name = moveControlPoint)]
+    pub fn move_control_point(
+        &mut self,
+        index: usize,
+        x: f64,
+        y: f64,
+        z: f64,
+    ) -> Result<(), JsError> {
+        let Some(source) = self.nurbs.as_mut() else {
+            return Err(JsError::new(
+                "control points are for an opened NURBS surface (open a .json or .3dm surface)",
+            ));
+        };
+        let (imported, design) = source
+            .move_control_point(index, [x, y, z])
+            .map_err(|e| JsError::new(&e))?;
+        self.run = imported_run(imported);
+        self.design = Some(design);
+        self.per_face = None;
+        Ok(())
     }
 
     /// Advances one observable step (a triangulation layer, the dual mesh, one Gauss-Newton
@@ -1267,6 +1303,7 @@ mod tests {
             per_face: None,
             layers: LayerConfig::default(),
             design: None,
+            nurbs: None,
         }
     }
 
@@ -1342,6 +1379,7 @@ mod tests {
             per_face: None,
             layers: LayerConfig::default(),
             design: None,
+            nurbs: None,
         }
     }
 

@@ -174,6 +174,16 @@ pub enum NurbsError {
         /// Column (along v).
         j: usize,
     },
+    /// A control point index past the net (a moved control point).
+    #[error("control point {index} is not in the {nu} x {nv} net")]
+    PointIndex {
+        /// The index given (row-major: `i * nv + j`).
+        index: usize,
+        /// Rows (along u).
+        nu: usize,
+        /// Points per row (along v).
+        nv: usize,
+    },
     /// A weight is not positive and finite.
     #[error("weight ({i}, {j}) is {}; weights must be positive and finite", Num(*.w))]
     Weight {
@@ -453,6 +463,33 @@ impl NurbsSurface {
         self.unit
     }
 
+    /// The control points (Euclidean), point (i, j) at `i * nv + j`.
+    pub fn control_points(&self) -> &[[f64; 3]] {
+        &self.points
+    }
+
+    /// Moves control point `index` (row-major, `i * nv + j`) to `p`, keeping its weight: the
+    /// surface changes over the `(p + 1) x (q + 1)` spans the point supports and nowhere else
+    /// (The NURBS Book, P3.6). Fails, leaving the surface as it was, for an index past the net
+    /// or a point that is not finite (also once weighted).
+    pub fn set_control_point(&mut self, index: usize, p: Vec3) -> Result<(), NurbsError> {
+        let [nu, nv] = self.count;
+        if index >= nu * nv {
+            return Err(NurbsError::PointIndex { index, nu, nv });
+        }
+        let w = self.homogeneous[index][3];
+        let h = [w * p.x, w * p.y, w * p.z, w];
+        if !h.iter().all(|c| c.is_finite()) {
+            return Err(NurbsError::PointNotFinite {
+                i: index / nv,
+                j: index % nv,
+            });
+        }
+        self.points[index] = [p.x, p.y, p.z];
+        self.homogeneous[index] = h;
+        Ok(())
+    }
+
     /// Axis-aligned bounds of the control points (the surface lies in their convex hull).
     pub fn control_bounds(&self) -> (Vec3, Vec3) {
         let mut lo = Vec3::repeat(f64::INFINITY);
@@ -670,6 +707,35 @@ mod tests {
         assert_eq!(m.puu, Vec3::zeros());
         let (lo, hi) = s.control_bounds();
         assert_eq!((lo, hi), (Vec3::zeros(), Vec3::new(1.0, 2.0, 1.0)));
+    }
+
+    /// Moving a control point changes the surface where the point acts, keeps its weight, and
+    /// reads back through the JSON form; a bad move is refused and changes nothing.
+    #[test]
+    fn a_moved_control_point_reshapes_the_surface_locally() {
+        let text = json_with(|v| {
+            v["weights"] = serde_json::json!([[1, 0.5, 2], [1.5, 1, 0.7]]);
+        });
+        let mut s = NurbsSurface::from_json(&text).unwrap();
+        let before = s.clone();
+        // Point (1, 1): the arch's top on the u = 1 side, weight 1.
+        s.set_control_point(4, Vec3::new(1.0, 1.0, 3.0)).unwrap();
+        assert_eq!(s.control_points()[4], [1.0, 1.0, 3.0]);
+        let (a, b) = (before.position(1.0, 0.5), s.position(1.0, 0.5));
+        assert!(b.z > a.z + 0.5, "{a} -> {b}");
+        // At u = 0 (bilinear in u) the other row alone acts: the surface is unchanged there.
+        assert_eq!(before.position(0.0, 0.5), s.position(0.0, 0.5));
+        assert_eq!(NurbsSurface::from_json(&s.to_json()).unwrap(), s);
+        let moved = s.clone();
+        let e = s.set_control_point(6, Vec3::zeros()).unwrap_err();
+        assert_eq!(e.to_string(), "control point 6 is not in the 2 x 3 net");
+        let e = s
+            .set_control_point(2, Vec3::new(f64::INFINITY, 0.0, 0.0))
+            .unwrap_err();
+        assert_eq!(e.to_string(), "control point (0, 2) is not finite");
+        // Weight 2 doubles a huge coordinate past the finite numbers.
+        assert!(s.set_control_point(2, Vec3::new(1e308, 0.0, 0.0)).is_err());
+        assert_eq!(s, moved);
     }
 
     #[test]
