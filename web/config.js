@@ -20,7 +20,7 @@ export function defaults() {
     scene: 'torus',
     params: {},
     // `read`: how the worker read the opened file ({ as, unit }), shown until the user picks.
-    imported: { name: null, as: null, unit: null, method: 'prescribed', init: SCHEMA.initialisations[0].name, size: null, bound: null, lambda: null, mu: null, mode: 'planar', fixBoundary: false, anchors: [], closeness: null, toleranceMm: null, read: null },
+    imported: { name: null, as: null, unit: null, method: 'prescribed', init: SCHEMA.initialisations[0].name, size: null, bound: null, lambda: null, mu: null, mode: 'planar', fixBoundary: false, anchors: [], closeness: null, toleranceMm: null, controlPoints: [], read: null },
     free: { surface: 'torus', method: SCHEMA.methods[0].name, init: SCHEMA.initialisations[0].name, size: null, bound: null, lambda: null, mu: null },
     steps: 1,
     // Committed vertex drags of a panel run, [vertex, x, y, z] each, replayed in order.
@@ -52,6 +52,17 @@ export function readHash(hash, { scenes, catalog, torusParams }) {
     c.imported.anchors = [...new Set(anchors)].slice(0, 100000);
     if (h.has('closeness')) c.imported.closeness = num(h.get('closeness'));
     if (h.has('tol')) c.imported.toleranceMm = num(h.get('tol'));
+    // Moved NURBS control points `cp=4:2,2,2.5;0:0,0,-0.5` (index:x,y,z, one entry a point).
+    const seen = new Set();
+    for (const e of (h.get('cp') ?? '').split(';').slice(0, 100000)) {
+      const m = /^(\d+):([^,]+),([^,]+),([^,]+)$/.exec(e);
+      const xyz = m ? [m[2], m[3], m[4]].map(Number) : [];
+      const i = m ? Number(m[1]) : -1;
+      if (m && i < 2 ** 31 && !seen.has(i) && xyz.every(Number.isFinite)) {
+        seen.add(i);
+        c.imported.controlPoints.push([i, ...xyz]);
+      }
+    }
   }
   if (c.scene === 'torus') {
     for (const [k, spec] of Object.entries(torusParams)) c.params[k] = h.has(k) ? num(h.get(k)) : spec.value;
@@ -130,6 +141,7 @@ export function writeHash(c) {
     if (c.imported.anchors.length) h.set('anchors', c.imported.anchors.join('.'));
     if (c.imported.closeness !== null) h.set('closeness', String(c.imported.closeness));
     if (c.imported.toleranceMm !== null) h.set('tol', String(c.imported.toleranceMm));
+    if (c.imported.controlPoints.length) h.set('cp', c.imported.controlPoints.map(([i, x, y, z]) => `${i}:${x},${y},${z}`).join(';'));
   }
   if (c.scene !== 'torus' && c.edits.length) h.set('edits', c.edits.map(([v, x, y, z, group]) => `${[v, ...(group ?? [])].join('+')}:${x},${y},${z}`).join(';'));
   if (c.scene !== 'torus') h.set('steps', String(c.steps));
@@ -152,6 +164,7 @@ export function sessionConfig(c) {
     if (i.anchors.length) out.anchors = i.anchors;
     if (i.closeness !== null) out.closeness = i.closeness;
     if (i.toleranceMm !== null) out.toleranceMm = i.toleranceMm;
+    if (i.controlPoints.length) out.controlPoints = i.controlPoints;
     if (i.as) out.importAs = i.as;
     if (i.unit) out.unit = i.unit;
     return out;

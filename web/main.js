@@ -10,6 +10,7 @@ import { drawHistogram, drawLegend, legendCaption, showMetrics, showProgress } f
 import { SettingsHistory } from './undo.js';
 import { download } from './download.js';
 import { BoxSelection } from './box-select.js';
+import { ControlNetOverlay } from './control-net.js';
 import { presentationFile } from './share.js';
 import { Solver } from './solver.js';
 import { initTeach, showPick } from './teach.js';
@@ -44,6 +45,7 @@ let lastLayers = null;    // offset and beam layers on show: { unavailable, info
 let pickedPoint = null;   // 3D point of the vertex clicked for the teaching inset (marked)
 const marker = document.createElement('div');
 let selection = null;     // box-selected vertices of a panel mesh in edit mode (box-select.js)
+let net = null;           // an opened NURBS surface's control net, dragged in edit mode (control-net.js)
 const stepLog = [];      // per-step { phase, faces, ms } for benchmarks (window.dupin.stepLog)
 let settled = false;      // something was shown or reported (the first frame may count as ready)
 let opened = null;        // the design the user opened: { name, bytes } (never leaves the page)
@@ -288,16 +290,26 @@ function applyState(s) {
   lastFaces = m.faces;
   lastPhase = m.phase;
   lastMetrics = m;
+  const warned = statusEl.dataset.warning === 'true';
+  statusEl.dataset.warning = String(m.phase === 'warning');
   if (m.phase === 'warning') showStatus(`${viewer.backend} · NOT done: ${m.reason}`, true);
-  else if (m.design && s.steps <= 1) showStatus(`${viewer.backend} · ${designLine(m.design)}`);
+  // A run that starts again (a dragged control point, a drag after a warning) takes the
+  // warning down.
+  else if (m.design && (s.steps <= 1 || warned)) showStatus(`${viewer.backend} · ${designLine(m.design)}`);
+  else if (warned) showStatus(viewer.backend);
   const entry = { phase: m.phase, layer: m.layer, iteration: m.iteration, faces: m.faces, maxPlanarity: m.maxPlanarity, steps: s.steps, ms: m.ms, timing: m.timing, mainMs: performance.now() - t0main, panelMs: null, at: performance.now() };
   stepLog.push(entry);
   if (stepLog.length > 5000) stepLog.shift();
   schedulePanel(m, entry);
-  const canEdit = editable(m);
+  net.set(m.design?.controlNet ?? null);
+  if (netDrag) net.place(netDrag.index, netDrag.sent ?? netDrag.point);
+  net.show(editMode);
+  const canEdit = editable(m) || net.available;
   setProp($('edit-vertices'), 'hidden', !canEdit);
+  setProp($('edit-vertices'), 'textContent', net.available ? 'Drag control points' : 'Drag vertices');
   if (!canEdit && editMode) setEditMode(false);
   dragStateArrived();
+  netStateArrived();
   if (playing) requestAnimationFrame(() => solver.post('ack'));
 }
 
@@ -621,7 +633,9 @@ function setEditMode(on) {
   editMode = on;
   setProp($('edit-vertices'), 'ariaPressed', on ? 'true' : 'false');
   canvas.classList.toggle('editing', on);
-  if (!on && selection?.size) { selection.clear(); dirty = true; }
+  if (!on && selection?.size) selection.clear();
+  net?.show(on);
+  dirty = true;
 }
 
 function rayAt(x, y) {
@@ -703,6 +717,69 @@ function dragEnd() {
   syncHash();
 }
 
+// ---- dragging a control point of an opened NURBS surface (edit mode) -------------------------
+// A press near a control point of the drawn net picks it; moving the pointer drags it in the
+// plane through it facing the view. The worker reshapes the surface and starts P-Hex on it
+// again (Session.moveControlPoint), stepping it while the pointer moves, one state in flight;
+// the panelling follows progressively (triangulation layers, hexagons, optimisation). On release
+// the point is committed to the URL (`cp`), so Undo gives back the surface before it.
+let netDrag = null; // { id, x, y, index, point, direction, inFlight, sent }
+
+function netDragStart(e) {
+  const r = canvas.getBoundingClientRect();
+  const x = e.clientX - r.left, y = e.clientY - r.top;
+  const index = net.pick(x, y, (...p) => viewer.project(...p));
+  if (index < 0) return false;
+  const { direction } = rayAt(x, y);
+  netDrag = { id: e.pointerId, x, y, index, point: net.point(index), direction, inFlight: false, sent: null };
+  net.active = index;
+  userMoved = true; // the view stays put while the panelling follows
+  dirty = true;
+  return true;
+}
+
+function netPoint(d) {
+  const { origin: o, direction: v } = rayAt(d.x, d.y);
+  const n = d.direction, p = d.point;
+  const vn = v[0] * n[0] + v[1] * n[1] + v[2] * n[2];
+  if (Math.abs(vn) < 1e-9) return null;
+  const t = ((p[0] - o[0]) * n[0] + (p[1] - o[1]) * n[1] + (p[2] - o[2]) * n[2]) / vn;
+  return [o[0] + t * v[0], o[1] + t * v[1], o[2] + t * v[2]];
+}
+
+function sendReshape(d = netDrag, force = false) {
+  if (!d || (d.inFlight && !force)) return;
+  let q;
+  try { q = netPoint(d); } catch { q = null; }
+  if (!q || (d.sent && q.every((c, k) => c === d.sent[k]))) return;
+  d.inFlight = true;
+  d.sent = q;
+  solver.post('reshape', { index: d.index, point: q });
+  net.place(d.index, q);
+  dirty = true;
+}
+
+function netStateArrived() {
+  if (!netDrag) return;
+  netDrag.inFlight = false;
+  sendReshape();
+}
+
+function netDragEnd() {
+  const d = netDrag;
+  netDrag = null;
+  net.active = -1;
+  dirty = true;
+  if (!d) return;
+  // The last position goes even if a state is still in flight (the worker takes them in order).
+  sendReshape(d, true);
+  if (!d.sent) return;
+  const moves = config.imported.controlPoints.filter(([i]) => i !== d.index);
+  config.imported.controlPoints = [...moves, [d.index, ...d.sent]];
+  welcome = false;
+  syncHash();
+}
+
 /** The selection's markers follow a group drag by its translation so far. */
 function followGroup(d) {
   if (!d.group.length || !d.sent) return;
@@ -737,7 +814,9 @@ function wireInput() {
   let down = null; // where a one-finger press started: a release near it is a click (pick)
   canvas.addEventListener('pointerdown', (e) => {
     canvas.setPointerCapture(e.pointerId);
-    if (editMode && pointers.size === 0 && running) {
+    if (editMode && pointers.size === 0 && running && net.available) {
+      if (netDragStart(e)) return;
+    } else if (editMode && pointers.size === 0 && running) {
       if (e.shiftKey) {
         const r = canvas.getBoundingClientRect();
         selection.begin(e.clientX - r.left, e.clientY - r.top);
@@ -751,6 +830,13 @@ function wireInput() {
     if (selection.active) {
       const r = canvas.getBoundingClientRect();
       selection.move(e.clientX - r.left, e.clientY - r.top);
+      return;
+    }
+    if (netDrag && netDrag.id === e.pointerId) {
+      const r = canvas.getBoundingClientRect();
+      netDrag.x = e.clientX - r.left;
+      netDrag.y = e.clientY - r.top;
+      sendReshape();
       return;
     }
     if (drag && drag.id === e.pointerId) {
@@ -778,6 +864,7 @@ function wireInput() {
   const up = (e) => { pointers.delete(e.pointerId); pinch = 0; };
   canvas.addEventListener('pointerup', (e) => {
     if (selection.active) { boxEnd(); return; }
+    if (netDrag && netDrag.id === e.pointerId) { netDragEnd(); return; }
     if (drag && drag.id === e.pointerId) { dragEnd(); return; }
     const click = down && down.id === e.pointerId && !down.moved;
     down = null;
@@ -787,7 +874,12 @@ function wireInput() {
       pickAt(e.clientX - r.left, e.clientY - r.top);
     }
   });
-  canvas.addEventListener('pointercancel', (e) => { if (drag && drag.id === e.pointerId) dragEnd(); selection.end(); up(e); });
+  canvas.addEventListener('pointercancel', (e) => {
+    if (drag && drag.id === e.pointerId) dragEnd();
+    if (netDrag && netDrag.id === e.pointerId) netDragEnd();
+    selection.end();
+    up(e);
+  });
   canvas.addEventListener('wheel', (e) => { e.preventDefault(); viewer.zoom(Math.exp(e.deltaY * 0.001)); cameraMoved(); }, { passive: false });
 }
 
@@ -804,6 +896,7 @@ function frame() {
       viewer.render();
       if (pickedPoint) placeMarker();
       if (selection?.size) selection.draw((x, y, z) => viewer.project(x, y, z));
+      net?.draw((x, y, z) => viewer.project(x, y, z));
       noteTask('render', t0);
       if (document.body.dataset.ready !== 'true' && settled) {
         document.body.dataset.firstFrameMs = performance.now().toFixed(0);
@@ -890,6 +983,7 @@ async function main() {
   marker.dataset.testid = 'pick-marker';
   canvas.after(marker);
   selection = new BoxSelection(canvas, $('selection'));
+  net = new ControlNetOverlay(canvas);
   fillScenePicker($('scene-select'), ctx.scenes);
   initTeach();
   initHexd2d();

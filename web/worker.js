@@ -5,6 +5,7 @@
 //        | step | play | pause | ack | mode {mode}
 //        | drag {vertex, point, group?, start} (Session.dragVertices; start: a new drag)
 //        | select {viewProj, rect} (Session.verticesInRect: a box selection)
+//        | reshape {index, point} (Session.moveControlPoint: a dragged NURBS control point)
 //        | layers {layers} (offset/support, Session.setLayers) | export {kind, panelEdge} (obj, json, svg, dxf, csv, glb, 3dm)
 //        | pick {origin, direction, panels} (a view ray; panels: Session.pickPanelVertex)
 //        | fault {kind} (debugFault: a deliberate trap or out-of-memory, for recovery tests)
@@ -190,6 +191,22 @@ const handlers = {
       const pick = msg.panels ? session.pickPanelVertex(msg.origin, msg.direction) : session.pickVertex(msg.origin, msg.direction);
       postMessage({ type: 'pick', gen, panels: !!msg.panels, drag: !!msg.drag, pick });
     } catch (e) { postMessage({ type: 'pick', gen, drag: !!msg.drag, error: e?.message ?? String(e) }); }
+  },
+  // A dragged NURBS control point: the surface is reshaped and P-Hex starts again on it, its
+  // steps counted from there (a reload replays that many on the reshaped surface).
+  reshape(msg) {
+    if (!session) return;
+    try {
+      session.moveControlPoint(msg.index, msg.point[0], msg.point[1], msg.point[2]);
+    } catch (e) {
+      if (e instanceof WebAssembly.RuntimeError) { fail(e); return; }
+      postMessage({ type: 'error', gen, message: e?.message ?? String(e), field: 'edit-vertices' });
+      return;
+    }
+    steps = 0;
+    playing = true;
+    dragRun = true;
+    try { stepOnce(false, DRAG_FRAME_MS); send(); } catch (e) { fail(e); }
   },
   // A box selection: the panel-mesh vertices projected inside `rect` (NDC corners).
   select(msg) {

@@ -3,7 +3,7 @@
 // gives back the mesh before the drag and Redo the dragged one, both bit for bit.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { byId, dragImportedGrid, exportText, metrics, objVertices, onScreen, openImportedGrid, openPage, waitDone } from './harness.mjs';
+import { byId, domeJson, dragImportedGrid, exportText, metrics, objVertices, onScreen, openImportedGrid, openPage, waitDone } from './harness.mjs';
 
 // The drag, in pixels: about half an edge of the finished scene at the default view.
 const DX = 10, DY = 6;
@@ -196,6 +196,66 @@ test('a box-selected group of an opened quad mesh drags together: planar again, 
     await page.waitForFunction(() => Number(document.querySelector('[data-testid=selection]').dataset.count) > 0);
     await page.keyboard.press('Escape');
     await page.waitForFunction(() => document.querySelector('[data-testid=selection]').hidden);
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
+
+test('dragging a control point of an opened NURBS surface: the P-Hex panelling follows, the point under the pointer, undo bit for bit', async () => {
+  const { browser, page, errors } = await openPage();
+  try {
+    await byId(page, 'import-file').setInputFiles({ name: 'dome.json', mimeType: 'application/json', buffer: Buffer.from(domeJson()) });
+    await page.waitForFunction(() => document.querySelector('[data-testid=status]').textContent.includes('dome.json · surface'), null, { timeout: 120_000 });
+    await byId(page, 'play').click();
+    await waitDone(page, 300_000);
+    const before = await exportText(page, 'export-obj');
+    const button = byId(page, 'edit-vertices');
+    assert.equal(await button.textContent(), 'Drag control points');
+    await button.click();
+    const overlay = byId(page, 'control-net');
+    await overlay.waitFor({ state: 'visible', timeout: 5000 }); // edit mode draws the control net
+    assert.equal(await overlay.getAttribute('data-points'), '36');
+
+    // Control point (2, 2) of the 6 x 6 net: x = y = -1.2, z = 3 - 2.88 / 24.
+    const index = 2 * 6 + 2;
+    const [[x0, y0]] = await onScreen(page, [[-1.2, -1.2, 3 - 2.88 / 24]]);
+    const [dx, dy] = [0, -14];
+    const s0 = await page.evaluate(() => window.dupin.stepLog.length);
+    await page.mouse.move(x0, y0);
+    await page.mouse.down();
+    for (let i = 1; i <= 10; i++) {
+      await page.mouse.move(x0 + (dx * i) / 10, y0 + (dy * i) / 10);
+      await page.waitForTimeout(40);
+    }
+    const states = (await page.evaluate(() => window.dupin.stepLog.length)) - s0;
+    const t0 = Date.now();
+    await page.mouse.up();
+    await page.waitForFunction(() => location.hash.includes('cp='));
+    await page.waitForFunction(() => ['done', 'warning'].includes(document.querySelector('[data-testid=metrics]').dataset.phase), null, { timeout: 300_000 });
+    const m = await metrics(page);
+    console.log(`control point drag: ${states} states while dragging; ${m.phase} ${Date.now() - t0} ms after release, ${m.faces} faces, max planarity ${m.maxPlanarity}, ${m.invalidFaces} invalid`);
+    assert.ok(states >= 2, `the panelling followed the drag (${states} states)`);
+    assert.equal(m.phase, 'done', await byId(page, 'status').textContent());
+    assert.ok(Number(m.maxPlanarity) <= 1e-9, m.maxPlanarity);
+    const cp = await page.evaluate(() => new URLSearchParams(location.hash.slice(1)).get('cp'));
+    const [head, coords] = cp.split(':');
+    assert.equal(Number(head), index, cp);
+    const xyz = coords.split(',').map(Number);
+    const [q] = await onScreen(page, [xyz]);
+    assert.ok(Math.hypot(q[0] - (x0 + dx), q[1] - (y0 + dy)) < 1.5, `${q} vs pointer ${[x0 + dx, y0 + dy]}`);
+    assert.ok(xyz[2] > 3 - 2.88 / 24, `dragged up: ${xyz}`);
+    const after = await exportText(page, 'export-obj');
+    assert.notEqual(after, before, 'the panelling follows the reshaped surface');
+
+    await byId(page, 'undo').click();
+    await page.waitForFunction(() => !location.hash.includes('cp='));
+    await waitDone(page, 300_000);
+    assert.equal(await exportText(page, 'export-obj'), before, 'undo restores the surface and its panels');
+    await byId(page, 'redo').click();
+    await page.waitForFunction(() => location.hash.includes('cp='));
+    await waitDone(page, 300_000);
+    assert.equal(await exportText(page, 'export-obj'), after, 'redo replays the reshaped surface bit for bit');
     assert.deepEqual(errors, []);
   } finally {
     await browser.close();

@@ -211,6 +211,21 @@ export function gridObj(n) {
  * in `moves` pointer moves and measures: states per second while dragging, and the time from
  * the pointer's release to the first state that is done (page clock, state arrival).
  */
+/** A bicubic NURBS dome 12 m x 12 m whose control heights are f(x) + g(y) (conjugate lines). */
+export function domeJson() {
+  const knots = [0, 0, 0, 0, 1, 2, 3, 3, 3, 3];
+  const points = [];
+  for (let i = 0; i < 6; i++) {
+    const row = [];
+    for (let j = 0; j < 6; j++) {
+      const [x, y] = [2.4 * i - 6, 2.4 * j - 6];
+      row.push([x, y, 3 - (x * x + y * y) / 24]);
+    }
+    points.push(row);
+  }
+  return JSON.stringify({ degree_u: 3, degree_v: 3, knots_u: knots, knots_v: knots, control_points: points, unit: 'm' });
+}
+
 /** Opens the n x n quad grid of `gridObj` as panels and planarises it; returns the OBJ text. */
 export async function openImportedGrid(page, n) {
   const text = gridObj(n);

@@ -27,12 +27,13 @@ test('the URL-hash parser takes any hash', async () => {
       };
       const pick = (xs) => xs[rand(xs.length)];
       const keys = ['scene', 'surface', 'method', 'init', 'size', 'bound', 'lambda', 'mu', 'steps', 'color',
-        'edge', 'offset', 'support', 'dist', 'cam', 'backend', 'R', 'r', 'p.R', 'p.r', 'p.a', 'p.c', 'x', 'edits', ''];
+        'edge', 'offset', 'support', 'dist', 'cam', 'backend', 'R', 'r', 'p.R', 'p.r', 'p.a', 'p.c', 'x', 'edits', 'cp', ''];
       const values = ['', '0', '-0', '1', '-1', '0.5', '1e-300', '1e300', '1e400', 'NaN', 'Infinity', '-Infinity',
         '100000', '100001', '1.5', '0x10', ' 2 ', '%', '%zz', '%00', '\u0000', '\u202e', '<img src=x>', '"\'',
         'free', 'torus', 'webgl2', '1,2,3,4,5,6', '1,2,3,4,5', 'a,b,c,d,e,f', '🙂', '=', '&', '#', '+',
         '12:0.5,1,-0.25', '40+41+47:1,2,3', '40%2B41:1,2,3;7:0,0,1e300', '4+:1,2,3', '1++2:1,2,3',
-        '2147483648+1:1,1,1', '1+2147483648:1,1,1', '3 4:1,2,3;', '5:1,2',
+        '2147483648+1:1,1,1', '1+2147483648:1,1,1', '3 4:1,2,3;', '5:1,2', 'imported', 'imported',
+        '4:2,2,2.5;0:0,0,-0.5', '4:1,1,1;4:2,2,2', '-1:0,0,0',
         ...ctx.scenes, ...ctx.catalog.map((s) => s.name), ...schema.colorModes,
         ...schema.methods.map((m) => m.name), ...schema.initialisations.map((m) => m.name)];
       const same = (a, b) => JSON.stringify(a, (k, v) => (typeof v === 'number' ? String(v) : v))
@@ -53,7 +54,7 @@ test('the URL-hash parser takes any hash', async () => {
           return { failed: `readHash threw ${e} for ${JSON.stringify(hash)}` };
         }
         const bad = [
-          !(['torus', 'free'].includes(c.scene) || ctx.scenes.includes(c.scene)) && 'scene',
+          !(['torus', 'free', 'imported'].includes(c.scene) || ctx.scenes.includes(c.scene)) && 'scene',
           !(Number.isInteger(c.steps) && c.steps >= 1 && c.steps <= 100000) && 'steps',
           !schema.colorModes.includes(c.color) && 'color',
           !(Number.isFinite(c.panelEdge) && c.panelEdge > 0) && 'edge',
@@ -63,6 +64,8 @@ test('the URL-hash parser takes any hash', async () => {
           c.scene === 'free' && !ctx.catalog.some((s) => s.name === c.free.surface) && 'surface',
           !c.edits.every((e) => [e[0], ...(e[4] ?? [])].every((u) => Number.isInteger(u) && u >= 0 && u < 2 ** 31)
             && e.slice(1, 4).every(Number.isFinite) && (e.length === 4 || (e.length === 5 && e[4].length > 0))) && 'edits',
+          !(c.imported.controlPoints.every((e) => e.length === 4 && Number.isInteger(e[0]) && e[0] >= 0 && e[0] < 2 ** 31 && e.slice(1).every(Number.isFinite))
+            && new Set(c.imported.controlPoints.map((e) => e[0])).size === c.imported.controlPoints.length) && 'cp',
         ].filter(Boolean);
         if (bad.length) return { failed: `${bad.join(', ')} out of the schema for ${JSON.stringify(hash)}: ${JSON.stringify(c)}` };
         const again = cfg.readHash(cfg.writeHash(c), ctx);

@@ -4,22 +4,7 @@
 // file says so. The files are made here, never downloaded.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { byId, exportText, metrics, openPage, parseObj, waitDone } from './harness.mjs';
-
-/** A bicubic NURBS dome 12 m x 12 m whose control heights are f(x) + g(y) (conjugate lines). */
-function domeJson() {
-  const knots = [0, 0, 0, 0, 1, 2, 3, 3, 3, 3];
-  const points = [];
-  for (let i = 0; i < 6; i++) {
-    const row = [];
-    for (let j = 0; j < 6; j++) {
-      const [x, y] = [2.4 * i - 6, 2.4 * j - 6];
-      row.push([x, y, 3 - (x * x + y * y) / 24]);
-    }
-    points.push(row);
-  }
-  return JSON.stringify({ degree_u: 3, degree_v: 3, knots_u: knots, knots_v: knots, control_points: points, unit: 'm' });
-}
+import { byId, domeJson, exportText, metrics, openPage, parseObj, waitDone } from './harness.mjs';
 
 /** A 10 x 10 quad grid over 20 m with seeded +-1 mm noise in z: panels that are nearly planar. */
 function noisyGridObj() {
