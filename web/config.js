@@ -73,17 +73,18 @@ export function readHash(hash, { scenes, catalog, torusParams }) {
     for (const p of surface.params) c.params[p.key] = h.has(`p.${p.key}`) ? num(h.get(`p.${p.key}`)) : p.default;
     readRunSettings(h, c.free);
   }
-  // Vertex drags `edits=12:0.5,1,-0.25;40+41+47:...` (vertex:x,y,z, as many digits as
-  // round-trip; `+` joins the box-selected vertices dragged along by the same translation,
-  // written %2B, and a bare `+` of a typed hash reads as a space, so either joins).
+  // Vertex drags `edits=12:0.5,1,-0.25;40+41+47:1,2,3/1,2,3.5` (vertex:x,y,z, as many digits
+  // as round-trip; `+` joins the box-selected vertices dragged along by the same translation,
+  // written %2B, and a bare `+` of a typed hash reads as a space, so either joins; `/` separates
+  // the waypoints of one drag, the last its end): `{ v, group, path }` each.
   if (c.scene !== 'torus') {
     for (const e of (h.get('edits') ?? '').split(';').slice(0, 1000)) {
-      const m = /^(\d+(?:[+ ]\d+)*):([^,]+),([^,]+),([^,]+)$/.exec(e);
-      const xyz = m ? [m[2], m[3], m[4]].map(Number) : [];
+      const m = /^(\d+(?:[+ ]\d+)*):([^:]+)$/.exec(e);
+      const path = m ? m[2].split('/').slice(0, 10000).map((p) => p.split(',')) : [];
       const [v, ...group] = m ? m[1].split(/[+ ]/).map(Number) : [];
       // Vertex numbers past 2^31 would wrap crossing into wasm: dropped, as any malformed entry.
-      if (m && [v, ...group].every((u) => u < 2 ** 31) && xyz.every(Number.isFinite)) {
-        c.edits.push(group.length ? [v, ...xyz, group] : [v, ...xyz]);
+      if (m && [v, ...group].every((u) => u < 2 ** 31) && path.every((p) => p.length === 3 && p.every((x) => x.trim() !== '' && Number.isFinite(Number(x))))) {
+        c.edits.push({ v, group, path: path.map((p) => p.map(Number)) });
       }
     }
   }
@@ -143,7 +144,7 @@ export function writeHash(c) {
     if (c.imported.toleranceMm !== null) h.set('tol', String(c.imported.toleranceMm));
     if (c.imported.controlPoints.length) h.set('cp', c.imported.controlPoints.map(([i, x, y, z]) => `${i}:${x},${y},${z}`).join(';'));
   }
-  if (c.scene !== 'torus' && c.edits.length) h.set('edits', c.edits.map(([v, x, y, z, group]) => `${[v, ...(group ?? [])].join('+')}:${x},${y},${z}`).join(';'));
+  if (c.scene !== 'torus' && c.edits.length) h.set('edits', c.edits.map(({ v, group, path }) => `${[v, ...group].join('+')}:${path.map((p) => p.join(',')).join('/')}`).join(';'));
   if (c.scene !== 'torus') h.set('steps', String(c.steps));
   if (c.color !== d.color) h.set('color', c.color);
   if (c.panelEdge !== 1.5) h.set('edge', String(c.panelEdge));

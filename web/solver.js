@@ -53,9 +53,10 @@ export class Solver {
   /** Starts `config` (a Session config) and replays `steps` steps; `field` names the input
    * that caused the load (bad configurations report back to it); `layers` are the offset and
    * support layers to draw where the run has them; `file` ({ name, bytes }) opens a design
-   * with `config` as its import options (Session.fromFile); `edits` ([vertex, x, y, z] each,
-   * and the group dragged along as a fifth item) are vertex drags replayed after the steps
-   * (Session.dragVertices), each run to its end. */
+   * with `config` as its import options (Session.fromFile); `edits` (`{ v, group, path }`
+   * each: the dragged vertex, the vertices dragged along and the drag's waypoints, its end
+   * last) are vertex drags replayed after the steps (Session.dragVertices, each waypoint
+   * committed), each run to its end. */
   load(config, { steps = 1, mode, field = null, layers = null, file = null, edits = [] } = {}) {
     this.gen += 1;
     this.worker.postMessage({ type: 'load', gen: this.gen, config, steps, mode, field, layers, file, edits });

@@ -22,6 +22,7 @@ let mode = null; // colour mode; null: Session.mesh's default
 let playing = false;
 let lastMetrics = null;
 let layers = null; // the page's offset/support settings, applied where the run has an offset
+let dragSeq = null; // the last drag or reshape taken (the page's number): its states carry it
 let dragRun = false; // the run was restarted by a drag: each state takes DRAG_FRAME_MS of steps
 
 // Sets the layers on the session where it has an offset layer (else they stay off and the
@@ -48,7 +49,7 @@ function send() {
     overhead = lastMetrics.timing.metrics + (t1 - t0);
   }
   const layerState = { unavailable: session.offsetUnavailable() ?? null, info: session.layerInfo() };
-  postMessage({ type: 'state', gen, metrics: lastMetrics, steps, done, playing: playing && !done, mesh, layers: layerState },
+  postMessage({ type: 'state', gen, metrics: lastMetrics, steps, done, playing: playing && !done, mesh, layers: layerState, dragSeq },
     [mesh.positions.buffer, mesh.normals.buffer, mesh.indices.buffer, mesh.colors.buffer, mesh.edges.buffer, mesh.panelPositions.buffer, mesh.panelFaces.buffer]);
   // Posting (structured clone of the metrics; the typed arrays are transferred) is timed for
   // the step log of the next state.
@@ -117,6 +118,7 @@ const handlers = {
     session?.free();
     session = next;
     gen = msg.gen;
+    dragSeq = null;
     mode = msg.mode ?? mode;
     layers = msg.layers ?? null;
     playing = false;
@@ -130,7 +132,10 @@ const handlers = {
       while (steps < target && !session.done()) stepOnce();
       // Committed drags, as the page made them: each starts from the run so far finished.
       const edits = msg.edits ?? [];
-      for (const [v, x, y, z, group] of edits) session.dragVertices(v, x, y, z, Uint32Array.from(group ?? []), true);
+      // Each waypoint was committed where it was reached, the drag's end last.
+      for (const { v, group, path } of edits) {
+        for (const [x, y, z] of path) session.dragVertices(v, x, y, z, Uint32Array.from(group), true);
+      }
       if (edits.length) while (!session.done()) stepOnce();
       send();
     } catch (e) { fail(e); }
@@ -153,6 +158,7 @@ const handlers = {
     if (!session) return;
     try {
       session.dragVertices(msg.vertex, msg.point[0], msg.point[1], msg.point[2], Uint32Array.from(msg.group ?? []), !!msg.start);
+      dragSeq = msg.seq ?? null;
     } catch (e) {
       if (e instanceof WebAssembly.RuntimeError) { fail(e); return; }
       postMessage({ type: 'error', gen, message: e?.message ?? String(e), field: 'edit-vertices' });
@@ -198,6 +204,7 @@ const handlers = {
     if (!session) return;
     try {
       session.moveControlPoint(msg.index, msg.point[0], msg.point[1], msg.point[2]);
+      dragSeq = msg.seq ?? null;
     } catch (e) {
       if (e instanceof WebAssembly.RuntimeError) { fail(e); return; }
       postMessage({ type: 'error', gen, message: e?.message ?? String(e), field: 'edit-vertices' });

@@ -10,6 +10,13 @@ const DX = 10, DY = 6;
 
 const edits = (page) => page.evaluate(() => new URLSearchParams(location.hash.slice(1)).get('edits'));
 
+/** The last drag of an `edits` hash value: `{ v, group, path }`, its end the last of `path`. */
+function lastEdit(text) {
+  const [head, coords] = text.split(';').at(-1).split(':');
+  const [v, ...group] = head.split('+').map(Number);
+  return { v, group, path: coords.split('/').map((p) => p.split(',').map(Number)) };
+}
+
 test('dragging a vertex of conical-station keeps the panels planar, holds the vertex under the pointer, and undoes bit for bit', async () => {
   const { browser, page, errors } = await openPage({ hash: '#scene=conical-station' });
   try {
@@ -39,7 +46,7 @@ test('dragging a vertex of conical-station keeps the panels planar, holds the ve
     // Planar again after the pointer stops.
     await page.waitForFunction(() => {
       const d = document.querySelector('[data-testid=metrics]').dataset;
-      return d.phase === 'done' && Number(d.maxPlanarity) <= 1e-9 && location.hash.includes('edits=');
+      return !window.dupin.dragPending && d.phase === 'done' && Number(d.maxPlanarity) <= 1e-9 && location.hash.includes('edits=');
     }, null, { timeout: 60_000 });
     const settleMs = Date.now() - stop;
     const m = await metrics(page);
@@ -49,7 +56,8 @@ test('dragging a vertex of conical-station keeps the panels planar, holds the ve
 
     // The dragged vertex is held where the pointer left it: its recorded position projects to
     // the pointer, and the OBJ has it there.
-    const [v, ...xyz] = (await edits(page)).split(/[:,]/).map(Number);
+    const { v, path } = lastEdit(await edits(page));
+    const xyz = path.at(-1);
     const onScreen = await page.evaluate(([px, py, pz]) => {
       const p = window.dupin.viewer.project(px, py, pz);
       const c = document.querySelector('[data-testid=canvas]').getBoundingClientRect();
@@ -83,7 +91,8 @@ test('dragging a vertex of an opened 1 024-quad mesh: planar again, the vertex u
     console.log(`imported 32 x 32: ${r.perSecond.toFixed(1)} states/s while dragging; ${r.settle.phase} at max planarity ${r.settle.maxPlanarity} ${r.settle.ms.toFixed(0)} ms after release`);
     assert.equal(r.settle.phase, 'done');
     assert.ok(r.settle.maxPlanarity <= 1e-9, r.settle.maxPlanarity);
-    const [v, ...xyz] = (await edits(page)).split(/[:,]/).map(Number);
+    const { v, path } = lastEdit(await edits(page));
+    const xyz = path.at(-1);
     assert.equal(v, r.middle, 'the vertex under the pointer was dragged');
     const q = await page.evaluate(([x, y, z]) => {
       const p = window.dupin.viewer.project(x, y, z);
@@ -155,13 +164,13 @@ test('a box-selected group of an opened quad mesh drags together: planar again, 
     await page.mouse.up();
     await page.waitForFunction(() => {
       const d = document.querySelector('[data-testid=metrics]').dataset;
-      return d.phase === 'done' && Number(d.maxPlanarity) <= 1e-9 && location.hash.includes('edits=');
+      return !window.dupin.dragPending && d.phase === 'done' && Number(d.maxPlanarity) <= 1e-9 && location.hash.includes('edits=');
     }, null, { timeout: 120_000 });
     const m = await metrics(page);
     assert.ok(Number(m.maxPlanarity) <= 1e-9, m.maxPlanarity);
-    const [head, coords] = (await edits(page)).split(':');
-    const [v, ...group] = head.split('+').map(Number);
-    const xyz = coords.split(',').map(Number);
+    const { v, group, path } = lastEdit(await edits(page));
+    const xyz = path.at(-1);
+    console.log(`group drag: ${path.length - 1} waypoints`);
     assert.equal(v, middle, 'the vertex under the pointer leads');
     assert.deepEqual(group, inside.filter((u) => u !== middle), 'the whole selection was dragged along');
     const [q] = await onScreen(page, [xyz]);
@@ -232,7 +241,7 @@ test('dragging a control point of an opened NURBS surface: the P-Hex panelling f
     const t0 = Date.now();
     await page.mouse.up();
     await page.waitForFunction(() => location.hash.includes('cp='));
-    await page.waitForFunction(() => ['done', 'warning'].includes(document.querySelector('[data-testid=metrics]').dataset.phase), null, { timeout: 300_000 });
+    await page.waitForFunction(() => !window.dupin.dragPending && ['done', 'warning'].includes(document.querySelector('[data-testid=metrics]').dataset.phase), null, { timeout: 300_000 });
     const m = await metrics(page);
     console.log(`control point drag: ${states} states while dragging; ${m.phase} ${Date.now() - t0} ms after release, ${m.faces} faces, max planarity ${m.maxPlanarity}, ${m.invalidFaces} invalid`);
     assert.ok(states >= 2, `the panelling followed the drag (${states} states)`);

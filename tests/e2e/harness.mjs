@@ -273,9 +273,11 @@ export async function dragImportedGrid(page, n, { dx = 12, dy = -8, moves = 20 }
   const seconds = (Date.now() - t0) / 1000;
   const states = (await page.evaluate(() => window.dupin.stepLog.length)) - s0;
   await page.mouse.up();
-  await page.waitForFunction(() => window.__up !== null && window.dupin.stepLog.some((e) => e.at > window.__up && e.phase !== 'perturb'), null, { timeout: 300_000 });
+  // The state that finishes the run for the last position sent (an earlier position's run may
+  // finish after the release too).
+  await page.waitForFunction(() => window.__up !== null && !window.dupin.dragPending, null, { timeout: 300_000 });
   const settle = await page.evaluate(() => {
-    const e = window.dupin.stepLog.find((x) => x.at > window.__up && x.phase !== 'perturb');
+    const e = window.dupin.stepLog.find((x) => x.at > window.__up && x.dragSeq === window.dupin.dragSeq && x.phase !== 'perturb');
     return { ms: e.at - window.__up, phase: e.phase, maxPlanarity: e.maxPlanarity };
   });
   return { middle, pointer: [at.x + dx, at.y + dy], perSecond: states / seconds, settle };

@@ -33,7 +33,7 @@ test('the URL-hash parser takes any hash', async () => {
         'free', 'torus', 'webgl2', '1,2,3,4,5,6', '1,2,3,4,5', 'a,b,c,d,e,f', '🙂', '=', '&', '#', '+',
         '12:0.5,1,-0.25', '40+41+47:1,2,3', '40%2B41:1,2,3;7:0,0,1e300', '4+:1,2,3', '1++2:1,2,3',
         '2147483648+1:1,1,1', '1+2147483648:1,1,1', '3 4:1,2,3;', '5:1,2', 'imported', 'imported',
-        '4:2,2,2.5;0:0,0,-0.5', '4:1,1,1;4:2,2,2', '-1:0,0,0',
+        '4:2,2,2.5;0:0,0,-0.5', '4:1,1,1;4:2,2,2', '-1:0,0,0', '3:1,2,3/4,5,6', '3+4:1,2,3/4,5', '3:/1,2,3', '3:1,2,3//',
         ...ctx.scenes, ...ctx.catalog.map((s) => s.name), ...schema.colorModes,
         ...schema.methods.map((m) => m.name), ...schema.initialisations.map((m) => m.name)];
       const same = (a, b) => JSON.stringify(a, (k, v) => (typeof v === 'number' ? String(v) : v))
@@ -62,8 +62,8 @@ test('the URL-hash parser takes any hash', async () => {
           !(c.camera === null || (c.camera.length === 6 && c.camera.every(Number.isFinite))) && 'cam',
           !['auto', 'webgl2'].includes(c.backend) && 'backend',
           c.scene === 'free' && !ctx.catalog.some((s) => s.name === c.free.surface) && 'surface',
-          !c.edits.every((e) => [e[0], ...(e[4] ?? [])].every((u) => Number.isInteger(u) && u >= 0 && u < 2 ** 31)
-            && e.slice(1, 4).every(Number.isFinite) && (e.length === 4 || (e.length === 5 && e[4].length > 0))) && 'edits',
+          !c.edits.every((e) => [e.v, ...e.group].every((u) => Number.isInteger(u) && u >= 0 && u < 2 ** 31)
+            && e.path.length > 0 && e.path.every((p) => p.length === 3 && p.every(Number.isFinite))) && 'edits',
           !(c.imported.controlPoints.every((e) => e.length === 4 && Number.isInteger(e[0]) && e[0] >= 0 && e[0] < 2 ** 31 && e.slice(1).every(Number.isFinite))
             && new Set(c.imported.controlPoints.map((e) => e[0])).size === c.imported.controlPoints.length) && 'cp',
         ].filter(Boolean);

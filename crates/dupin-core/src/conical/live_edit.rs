@@ -8,10 +8,11 @@
 //! vertices moved and held as anchors beside the options' anchors, stepped as before, one
 //! perturbation iteration a step, at the current level (no further subdivision).
 //!
-//! Every move of one drag starts from the same base, so the result after a drag is a
-//! function of the base, the vertices and the last position alone, not of how many steps ran
-//! between pointer events: replaying the committed edits rebuilds a mesh bit for bit (the
-//! page's undo). A move is made in stages of at most [`STAGE`] of the mean edge at each moved
+//! Every move held from one base starts from that base, so its result is a function of the
+//! base, the vertices and the position alone, not of how many steps ran between pointer
+//! events; the page commits a move's result as the next base once it is reached (a waypoint:
+//! each pointer position is then a short warm start from the last) and records the waypoints,
+//! so replaying them rebuilds a mesh bit for bit (the page's undo). A move is made in stages of at most [`STAGE`] of the mean edge at each moved
 //! vertex, each perturbed to the tolerance from the last (continuation): from a planar base
 //! one held vertex jumping an edge length or more leaves the penalty method in a poor local
 //! minimum (conical-station: not converged from 0.8 edge lengths on, measured), while a
