@@ -122,6 +122,11 @@ pub(crate) struct DesignInfo {
     dimensions_m: [f64; 3],
     #[serde(skip_serializing_if = "Option::is_none")]
     fit_max_distance_m: Option<f64>,
+    /// Seconds the file took to read (parse, and weld a mesh) in this worker.
+    read_seconds: f64,
+    /// Seconds the smooth fit of a triangle mesh took, for a fitted mesh.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    fit_seconds: Option<f64>,
     /// A panel mesh's vertices as opened: the design the schedule's deviations are measured
     /// from (the planarisation keeps the vertex order).
     #[serde(skip)]
@@ -168,6 +173,21 @@ pub(crate) enum Imported {
     Phex(Box<PhexPipeline>, PhexGoals),
     /// The panels' perturbation, stepped like a PQ scene with no subdivision.
     Panels(Box<PqSceneStepper>),
+}
+
+/// Milliseconds on a monotonic-enough clock: the page's (`Date.now`, whole milliseconds) in
+/// wasm, the system's natively. For the read and fit times the page shows.
+fn now_ms() -> f64 {
+    #[cfg(target_arch = "wasm32")]
+    {
+        js_sys::Date::now()
+    }
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0.0, |d| d.as_secs_f64() * 1e3)
+    }
 }
 
 /// The run and design information of an opened file, and for a NURBS surface what its
@@ -248,6 +268,9 @@ fn import_design(
             .find(|b| !b.is_ascii_whitespace())
             .is_some_and(|&b| b == b'{'),
     };
+    let t0 = now_ms();
+    let read_ms: f64;
+    let mut fit_ms = None;
     let (surface, mesh, fit_distance) = if is_json {
         if wanted == Some(false) {
             return Err(named(
@@ -266,6 +289,7 @@ fn import_design(
                 .map_err(|e| named(&format_args!("controlPoints: {e}")))?;
         }
         unit = unit.or(s.unit());
+        read_ms = now_ms() - t0;
         (Some(s), None, None)
     } else {
         if cfg.control_points.as_ref().is_some_and(|m| !m.is_empty()) {
@@ -276,9 +300,11 @@ fn import_design(
         let mesh = read_mesh(name, bytes, &ImportOptions::default())
             .map_err(|e| named(&e))?
             .mesh;
+        read_ms = now_ms() - t0;
         let triangles = mesh.faces().all(|f| f.len() == 3);
         if wanted.unwrap_or(triangles) {
             let fit = fit_mesh_surface(&mesh, &MeshFitOptions::default()).map_err(|e| named(&e))?;
+            fit_ms = Some(now_ms() - t0 - read_ms);
             (Some(fit.surface), Some(mesh), Some(fit.max_distance))
         } else {
             (None, Some(mesh), None)
@@ -320,6 +346,8 @@ fn import_design(
         unit: unit.name(),
         dimensions_m: extent.map(|e| e * unit.to_m()),
         fit_max_distance_m: fit_distance.map(|d| d * unit.to_m()),
+        read_seconds: read_ms * 1e-3,
+        fit_seconds: fit_ms.map(|ms| ms * 1e-3),
         positions: match (&surface, &mesh) {
             (None, Some(m)) => Some(m.positions.clone()),
             _ => None,
@@ -519,6 +547,12 @@ mod tests {
         .unwrap();
         assert_eq!((info.import_as, info.unit), ("surface", "m"));
         assert!(info.fit_max_distance_m.unwrap() < 0.01, "{info:?}");
+        // The fit is timed apart from the read.
+        let (read, fit) = (info.read_seconds, info.fit_seconds.unwrap());
+        assert!(
+            read >= 0.0 && fit >= 0.0 && (read + fit).is_finite(),
+            "{info:?}"
+        );
         assert!(matches!(run, Imported::Phex(..)));
 
         let as_panels = ImportConfig {
@@ -537,6 +571,7 @@ mod tests {
         let (_, info) =
             import_design("roof.json", json.as_bytes(), &ImportConfig::default()).unwrap();
         assert_eq!((info.import_as, info.unit), ("surface", "mm"));
+        assert!(info.read_seconds >= 0.0 && info.fit_seconds.is_none());
         assert!(
             (info.dimensions_m[0] - 3.0).abs() < 1e-12
                 && (info.dimensions_m[2] - 0.5).abs() < 1e-12
