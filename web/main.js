@@ -691,21 +691,22 @@ function dragPicked(m) {
   sendDrag();
 }
 
-/** The pointer's point on the drag plane: through the picked vertex, normal to the press's
- * view ray (null when the ray runs along the plane). */
-function dragPoint() {
-  const { origin: o, direction: d } = rayAt(drag.x, drag.y);
-  const n = drag.direction, p = drag.point;
-  const dn = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
-  if (Math.abs(dn) < 1e-9) return null;
-  const t = ((p[0] - o[0]) * n[0] + (p[1] - o[1]) * n[1] + (p[2] - o[2]) * n[2]) / dn;
-  return [o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]];
+/** The pointer's point on the plane a drag `d` moves in: through the picked point `d.point`,
+ * normal to the press's view ray `d.direction`, under the pointer at (`d.x`, `d.y`) (null when
+ * the ray runs along the plane). Vertex drags and control point drags alike. */
+function dragPoint(d) {
+  const { origin: o, direction: v } = rayAt(d.x, d.y);
+  const n = d.direction, p = d.point;
+  const vn = v[0] * n[0] + v[1] * n[1] + v[2] * n[2];
+  if (Math.abs(vn) < 1e-9) return null;
+  const t = ((p[0] - o[0]) * n[0] + (p[1] - o[1]) * n[1] + (p[2] - o[2]) * n[2]) / vn;
+  return [o[0] + t * v[0], o[1] + t * v[1], o[2] + t * v[2]];
 }
 
 function sendDrag() {
   if (!drag || drag.vertex === null || drag.inFlight || !(drag.start || drag.finished)) return;
   let q;
-  try { q = dragPoint(); } catch { q = null; }
+  try { q = dragPoint(drag); } catch { q = null; }
   if (!q || (drag.sent && q.every((c, k) => c === drag.sent[k]))) return;
   postDrag(drag, q);
   followGroup(drag);
@@ -740,7 +741,7 @@ function dragEnd() {
   if (!d || d.vertex === null) return;
   // The last position goes even if a state is still in flight (the worker takes them in order).
   try {
-    const q = dragPointOf(d);
+    const q = dragPoint(d);
     if (q && !(d.sent && q.every((c, k) => c === d.sent[k]))) postDrag(d, q);
   } catch { /* the last sent position stands */ }
   if (!d.sent) return;
@@ -774,19 +775,10 @@ function netDragStart(e) {
   return true;
 }
 
-function netPoint(d) {
-  const { origin: o, direction: v } = rayAt(d.x, d.y);
-  const n = d.direction, p = d.point;
-  const vn = v[0] * n[0] + v[1] * n[1] + v[2] * n[2];
-  if (Math.abs(vn) < 1e-9) return null;
-  const t = ((p[0] - o[0]) * n[0] + (p[1] - o[1]) * n[1] + (p[2] - o[2]) * n[2]) / vn;
-  return [o[0] + t * v[0], o[1] + t * v[1], o[2] + t * v[2]];
-}
-
 function sendReshape(d = netDrag, force = false) {
   if (!d || (d.inFlight && !force)) return;
   let q;
-  try { q = netPoint(d); } catch { q = null; }
+  try { q = dragPoint(d); } catch { q = null; }
   if (!q || (d.sent && q.every((c, k) => c === d.sent[k]))) return;
   d.inFlight = true;
   d.sent = q;
@@ -838,25 +830,22 @@ function onSelection(m) {
   dirty = true;
 }
 
-function dragPointOf(d) {
-  const keep = drag;
-  drag = d;
-  try { return dragPoint(); } finally { drag = keep; }
-}
-
 function wireInput() {
   const pointers = new Map();
   let pinch = 0;
   let down = null; // where a one-finger press started: a release near it is a click (pick)
+  // The pointer in canvas CSS pixels.
+  const local = (e) => {
+    const r = canvas.getBoundingClientRect();
+    return [e.clientX - r.left, e.clientY - r.top];
+  };
   canvas.addEventListener('pointerdown', (e) => {
     canvas.setPointerCapture(e.pointerId);
     if (editMode && pointers.size === 0 && running && net.available) {
       if (netDragStart(e)) return;
     } else if (editMode && pointers.size === 0 && running) {
-      if (e.shiftKey) {
-        const r = canvas.getBoundingClientRect();
-        selection.begin(e.clientX - r.left, e.clientY - r.top);
-      } else dragStart(e);
+      if (e.shiftKey) selection.begin(...local(e));
+      else dragStart(e);
       return;
     }
     pointers.set(e.pointerId, e);
@@ -864,23 +853,15 @@ function wireInput() {
   });
   canvas.addEventListener('pointermove', (e) => {
     if (selection.active) {
-      const r = canvas.getBoundingClientRect();
-      selection.move(e.clientX - r.left, e.clientY - r.top);
+      selection.move(...local(e));
       return;
     }
-    if (netDrag && netDrag.id === e.pointerId) {
-      const r = canvas.getBoundingClientRect();
-      netDrag.x = e.clientX - r.left;
-      netDrag.y = e.clientY - r.top;
-      sendReshape();
-      return;
-    }
-    if (drag && drag.id === e.pointerId) {
-      const r = canvas.getBoundingClientRect();
-      drag.x = e.clientX - r.left;
-      drag.y = e.clientY - r.top;
-      sendDrag();
-      return;
+    for (const [d, send] of [[netDrag, sendReshape], [drag, sendDrag]]) {
+      if (d && d.id === e.pointerId) {
+        [d.x, d.y] = local(e);
+        send();
+        return;
+      }
     }
     const prev = pointers.get(e.pointerId);
     if (!prev) return;
@@ -905,10 +886,7 @@ function wireInput() {
     const click = down && down.id === e.pointerId && !down.moved;
     down = null;
     up(e);
-    if (click) {
-      const r = canvas.getBoundingClientRect();
-      pickAt(e.clientX - r.left, e.clientY - r.top);
-    }
+    if (click) pickAt(...local(e));
   });
   canvas.addEventListener('pointercancel', (e) => {
     if (drag && drag.id === e.pointerId) dragEnd();

@@ -91,6 +91,9 @@ test('dragging a vertex of an opened 1 024-quad mesh: planar again, the vertex u
     console.log(`imported 32 x 32: ${r.perSecond.toFixed(1)} states/s while dragging; ${r.settle.phase} at max planarity ${r.settle.maxPlanarity} ${r.settle.ms.toFixed(0)} ms after release`);
     assert.equal(r.settle.phase, 'done');
     assert.ok(r.settle.maxPlanarity <= 1e-9, r.settle.maxPlanarity);
+    // Measured 53-100 ms (BENCHMARKS.md; the issue's budget is 100 ms); a restart from the
+    // drag's start took 0.8-1 s. Five times the budget leaves room for a busy machine.
+    assert.ok(r.settle.ms <= 500, `planar ${r.settle.ms} ms after release`);
     const { v, path } = lastEdit(await edits(page));
     const xyz = path.at(-1);
     assert.equal(v, r.middle, 'the vertex under the pointer was dragged');
