@@ -357,6 +357,31 @@ mod tests {
         }
     }
 
+    /// The stages of an edit hand their analyses of the sparsity pattern on: a stage after the
+    /// first starts with the first's analyses, and the whole edit analyses each phase's
+    /// pattern once however many stages it takes.
+    #[test]
+    fn the_stages_of_an_edit_share_their_analyses() {
+        let mut s = pq_scene_stepper("conical-station").unwrap();
+        s.commit().unwrap();
+        let p = s.mesh().positions[166] + crate::Vec3::new(0.0, 0.0, 0.18 * 1.2);
+        s.hold_vertex(166, p).unwrap();
+        assert_eq!(s.perturbation.as_ref().unwrap().analyses(), 0);
+        let mut later_stages = 0;
+        while !s.is_done() {
+            s.step().unwrap();
+            if let (Some(p), Some(stages)) = (&s.perturbation, &s.edit_stages)
+                && stages.stage > 1
+                && s.running_iterations == 0
+            {
+                later_stages += 1;
+                assert!(p.analyses() > 0, "stage {} starts analysed", stages.stage);
+            }
+        }
+        assert!(later_stages >= 3, "{later_stages} later stages");
+        assert!(s.converged());
+    }
+
     /// A drag the perturbation cannot follow (a vertex pulled ten edge lengths out of the
     /// surface) ends not converged, and says which of its stages stopped it.
     #[test]

@@ -317,11 +317,9 @@ impl PqSceneStepper {
         if !self.perturbation.as_ref().is_some_and(|p| p.is_done()) {
             return Ok(());
         }
-        let Ok(r) = self
-            .perturbation
-            .take()
-            .expect("a finished perturbation")
-            .finish();
+        let mut finished = self.perturbation.take().expect("a finished perturbation");
+        let analyses = finished.take_analyses();
+        let Ok(r) = finished.finish();
         self.done_iterations += r.iterations;
         self.running_iterations = 0;
         self.converged &= r.converged;
@@ -335,6 +333,10 @@ impl PqSceneStepper {
             self.edit_shortfall = Some(stages.shortfall());
         }
         if self.next_edit_stage()? {
+            // The next stage solves the same pattern: it starts from this one's analyses.
+            if let Some(p) = self.perturbation.as_mut() {
+                p.adopt_analyses(analyses);
+            }
             return Ok(());
         }
         if self.level == self.levels {

@@ -156,6 +156,10 @@ pub struct LmStep {
     pub damping: f64,
 }
 
+/// An iteration's analysis of its sparsity pattern, moved to another iteration
+/// ([`LevenbergMarquardt::take_analysis`]).
+pub(crate) struct LmAnalysis(BlockNormal);
+
 /// A stateful Levenberg-Marquardt iteration: call [`LevenbergMarquardt::step`] repeatedly; the
 /// problem may change its weights between steps (the PQ penalty schedule does).
 pub struct LevenbergMarquardt {
@@ -198,6 +202,25 @@ impl LevenbergMarquardt {
             chord_damping: 0.0,
             chord_sys: BlockSystem::default(),
         }
+    }
+
+    /// Takes this iteration's analysis of the sparsity pattern (and its storage) for an
+    /// iteration about to solve a problem of the same pattern ([`Self::adopt_analysis`]); this
+    /// one keeps its counters and analyses again if it steps once more.
+    pub(crate) fn take_analysis(&mut self) -> LmAnalysis {
+        let mut fresh = BlockNormal::default();
+        fresh.set_factor_limit(self.options.max_factor_bytes);
+        self.chord_ready = false;
+        LmAnalysis(std::mem::replace(&mut self.normal, fresh))
+    }
+
+    /// Starts from `normal`, another iteration's analysis ([`Self::take_analysis`]): the first
+    /// step factorises at once when the pattern is the analysed one. The pattern is checked
+    /// at that step as always; one the analysis does not cover is analysed anew.
+    pub(crate) fn adopt_analysis(&mut self, LmAnalysis(mut normal): LmAnalysis) {
+        normal.set_factor_limit(self.options.max_factor_bytes);
+        self.normal = normal;
+        self.chord_ready = false;
     }
 
     /// Tells the iteration that the problem changed (e.g. its weights), so the evaluation kept

@@ -28,7 +28,7 @@ mod sqp;
 
 pub(crate) use block_system::{BlockLayout, BlockSystem};
 pub(crate) use cholesky::SparseCholesky;
-pub(crate) use gauss_newton::BlockLeastSquares;
+pub(crate) use gauss_newton::{BlockLeastSquares, LmAnalysis};
 pub use gauss_newton::{LevenbergMarquardt, LmOptions, LmStep, NonlinearLeastSquares};
 pub use sqp::{ConstrainedLeastSquares, Sqp, SqpOptions, SqpStep};
 

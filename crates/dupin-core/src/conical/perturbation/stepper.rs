@@ -11,7 +11,9 @@ use crate::mesh::PolyMesh;
 use crate::mesh::SolverFrame;
 use crate::mesh::max_planarity;
 use crate::mesh::representable_planarity;
-use crate::solver::{LevenbergMarquardt, LmOptions, LmStep, SolverError, Sqp, SqpOptions};
+use crate::solver::{
+    LevenbergMarquardt, LmAnalysis, LmOptions, LmStep, SolverError, Sqp, SqpOptions,
+};
 use crate::{Stepper, Vec3};
 use std::convert::Infallible;
 
@@ -110,6 +112,13 @@ pub struct PqPerturbation {
     chord: bool,
     /// See [`PqResult::refused`].
     refused: bool,
+}
+
+/// A finished perturbation's analyses of its sparsity patterns (penalty and exact phase), for
+/// the next stage of a live edit ([`PqPerturbation::take_analyses`]).
+pub(crate) struct PqAnalyses {
+    lm: LmAnalysis,
+    exact: LmAnalysis,
 }
 
 /// Settings of the penalty and exact-phase Levenberg-Marquardt iterations.
@@ -246,6 +255,32 @@ impl PqPerturbation {
             s.converged = true;
         }
         Ok(s)
+    }
+
+    /// Takes the solvers' analyses of the sparsity patterns, for the perturbation of a live
+    /// edit's next stage (the same mesh and anchors, other positions;
+    /// [`PqPerturbation::adopt_analyses`]): its first steps factorise at once instead of
+    /// analysing the patterns again (a fifth of a 10 000-quad drag's time, measured natively).
+    /// A stage that follows the same stage gets the same analyses, so a replayed edit repeats
+    /// the run bit for bit.
+    pub(crate) fn take_analyses(&mut self) -> PqAnalyses {
+        PqAnalyses {
+            lm: self.lm.take_analysis(),
+            exact: self.exact.take_analysis(),
+        }
+    }
+
+    /// Symbolic analyses of sparsity patterns behind this perturbation's solvers, those of
+    /// the perturbations it took its analyses from included.
+    #[cfg(test)]
+    pub(crate) fn analyses(&self) -> usize {
+        self.lm.analyses() + self.exact.analyses()
+    }
+
+    /// Starts from another perturbation's analyses ([`PqPerturbation::take_analyses`]).
+    pub(crate) fn adopt_analyses(&mut self, a: PqAnalyses) {
+        self.lm.adopt_analysis(a.lm);
+        self.exact.adopt_analysis(a.exact);
     }
 
     fn mode_residual(&self) -> f64 {
