@@ -436,11 +436,18 @@ impl Session {
     #[wasm_bindgen(js_name = moveControlPoint)]
     pub fn move_control_point(
         &mut self,
-        index: usize,
+        // A number, checked here: an index parameter would take -1 as 2^32 - 1 and "x" as 0.
+        index: f64,
         x: f64,
         y: f64,
         z: f64,
     ) -> Result<(), JsError> {
+        if !(index >= 0.0 && index.fract() == 0.0 && index < u32::MAX as f64) {
+            return Err(JsError::new(&format!(
+                "{index} is not a control point index"
+            )));
+        }
+        let index = index as usize;
         let Some(source) = self.nurbs.as_mut() else {
             return Err(JsError::new(
                 "control points are for an opened NURBS surface (open a .json or .3dm surface)",

@@ -38,6 +38,11 @@ pub const STAGE: f64 = 0.25;
 /// Most stages of one edit (a longer move takes longer stages).
 const MAX_STAGES: usize = 64;
 
+/// Farthest a live edit may move a vertex, in sizes (bounding-box diagonals) of the mesh: the
+/// solver's accuracy holds up to scales of 1e6, and a move past it would squeeze the rest of
+/// the mesh below rounding in the solver's unit box.
+const MAX_MOVE_IN_SIZES: f64 = 1e6;
+
 /// The stages of a running live edit: every held vertex moves from its base position to its
 /// target in `total` equal steps, the last exactly at the target.
 #[derive(Debug, Clone)]
@@ -189,6 +194,18 @@ impl PqSceneStepper {
         rest.dedup();
         vertices.extend(rest);
         let delta = position - base.positions[vertex];
+        let (lo, hi) = base.positions.iter().fold(
+            (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)),
+            |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+        );
+        let size = (hi - lo).norm();
+        if delta.norm() > MAX_MOVE_IN_SIZES * size {
+            return Err(PqSceneError::Edit(format!(
+                "vertex {vertex} would move {:.3e}, more than {MAX_MOVE_IN_SIZES:.0e} times the \
+                 mesh's size ({size:.3e})",
+                delta.norm()
+            )));
+        }
         let to: Vec<Vec3> = vertices
             .iter()
             .map(|&v| {
@@ -489,6 +506,10 @@ mod tests {
             e.to_string().contains(&format!("vertex {} is not", n + 7)),
             "{e}"
         );
+        // A move past a million sizes of the mesh.
+        let far = before.positions[5] + crate::Vec3::new(1e300, 0.0, 0.0);
+        let e = s.hold_group(5, far, &[6]).unwrap_err();
+        assert!(e.to_string().contains("times the mesh's size"), "{e}");
         assert_eq!(s.mesh(), &before);
         assert!(s.is_done());
     }

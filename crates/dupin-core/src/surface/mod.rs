@@ -25,8 +25,8 @@ pub use library::{
 pub use mesh_fit::{MAX_FIT_TRIANGLES, MeshFit, MeshFitError, MeshFitOptions, fit_mesh_surface};
 pub use mesh_surface::{MeshClosestPoint, MeshSurface, MeshSurfaceError, VertexCurvature};
 pub use nurbs::{
-    MAX_NURBS_CONTROL_POINTS, MAX_NURBS_DEGREE, MAX_NURBS_JSON_BYTES, NurbsDefinition, NurbsError,
-    NurbsSurface,
+    MAX_MOVE_IN_NET_SIZES, MAX_NURBS_CONTROL_POINTS, MAX_NURBS_DEGREE, MAX_NURBS_JSON_BYTES,
+    NurbsDefinition, NurbsError, NurbsSurface,
 };
 pub use registry::{
     ParamSpec, RegistryError, SurfaceSpec, parse_assignment, surface_by_name, surface_catalog,

@@ -174,6 +174,19 @@ pub enum NurbsError {
         /// Column (along v).
         j: usize,
     },
+    /// A moved control point farther from the net than [`MAX_MOVE_IN_NET_SIZES`] times its size.
+    #[error(
+        "control point {index} would be {} from the net, more than 1e6 times its size ({})",
+        Num(*.distance), Num(*.size)
+    )]
+    PointTooFar {
+        /// The index given.
+        index: usize,
+        /// Distance of the new point from the net's bounding box.
+        distance: f64,
+        /// The net's bounding-box diagonal.
+        size: f64,
+    },
     /// A control point index past the net (a moved control point).
     #[error("control point {index} is not in the {nu} x {nv} net")]
     PointIndex {
@@ -223,6 +236,10 @@ pub struct NurbsDefinition {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub unit: Option<String>,
 }
+
+/// Farthest a moved control point may lie from the net, in sizes (bounding-box diagonals) of
+/// the net.
+pub const MAX_MOVE_IN_NET_SIZES: f64 = 1e6;
 
 /// A checked NURBS surface, evaluated with exact first and second derivatives.
 ///
@@ -468,7 +485,8 @@ impl NurbsSurface {
         &self.points
     }
 
-    /// Moves control point `index` (row-major, `i * nv + j`) to `p`, keeping its weight: the
+    /// Moves control point `index` (row-major, `i * nv + j`) to `p`, keeping its weight (at
+    /// most [`MAX_MOVE_IN_NET_SIZES`] net sizes from the net, where evaluation stays exact): the
     /// surface changes over the `(p + 1) x (q + 1)` spans the point supports and nowhere else
     /// (The NURBS Book, P3.6). Fails, leaving the surface as it was, for an index past the net
     /// or a point that is not finite (also once weighted).
@@ -476,6 +494,16 @@ impl NurbsSurface {
         let [nu, nv] = self.count;
         if index >= nu * nv {
             return Err(NurbsError::PointIndex { index, nu, nv });
+        }
+        let (lo, hi) = self.control_bounds();
+        let size = (hi - lo).norm();
+        let distance = (p - p.sup(&lo).inf(&hi)).norm();
+        if !(distance <= MAX_MOVE_IN_NET_SIZES * size) && p.iter().all(|c| c.is_finite()) {
+            return Err(NurbsError::PointTooFar {
+                index,
+                distance,
+                size,
+            });
         }
         let w = self.homogeneous[index][3];
         let h = [w * p.x, w * p.y, w * p.z, w];
@@ -733,8 +761,14 @@ mod tests {
             .set_control_point(2, Vec3::new(f64::INFINITY, 0.0, 0.0))
             .unwrap_err();
         assert_eq!(e.to_string(), "control point (0, 2) is not finite");
-        // Weight 2 doubles a huge coordinate past the finite numbers.
-        assert!(s.set_control_point(2, Vec3::new(1e308, 0.0, 0.0)).is_err());
+        // Past a million net sizes.
+        let e = s
+            .set_control_point(2, Vec3::new(1e308, 0.0, 0.0))
+            .unwrap_err();
+        assert!(
+            e.to_string().contains("more than 1e6 times its size"),
+            "{e}"
+        );
         assert_eq!(s, moved);
     }
 
