@@ -7,6 +7,7 @@
 // The markers are drawn on a 2D canvas over the 3D view from the selected vertices' positions,
 // projected with Viewer.project: the held vertices of a group drag move by the drag's
 // translation exactly, so the page knows where they are without asking the worker.
+import { fitOverlay } from './overlay.js';
 
 /** Smallest rectangle side, in CSS pixels, that selects (a shorter Shift-drag is a slip). */
 const MIN_SIDE = 3;
@@ -112,16 +113,8 @@ export class BoxSelection {
 
   /** Redraws the markers with `project` (Viewer.project: NDC of a 3D point, or undefined). */
   draw(project) {
-    const o = this.overlay, c = this.canvas;
-    const dpr = window.devicePixelRatio || 1;
-    const w = Math.max(1, Math.round(c.clientWidth * dpr)), h = Math.max(1, Math.round(c.clientHeight * dpr));
-    if (o.width !== w || o.height !== h) { o.width = w; o.height = h; }
-    o.style.left = `${c.offsetLeft}px`;
-    o.style.top = `${c.offsetTop}px`;
-    o.style.width = `${c.clientWidth}px`;
-    o.style.height = `${c.clientHeight}px`;
-    const g = o.getContext('2d');
-    g.clearRect(0, 0, w, h);
+    const o = this.overlay;
+    const { g, w, h, dpr } = fitOverlay(o, this.canvas);
     o.hidden = this.vertices.length === 0;
     if (o.hidden) return;
     const s = 3 * dpr;

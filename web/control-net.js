@@ -4,6 +4,7 @@
 //
 // The net is a few dozen to a few thousand points, so it is drawn on a 2D canvas from
 // Viewer.project and picked in screen space here; the surface and its panels stay in wasm.
+import { fitOverlay } from './overlay.js';
 
 /** How near (CSS pixels) a press must be to a control point to pick it. */
 const PICK_PX = 12;
@@ -58,15 +59,10 @@ export class ControlNetOverlay {
 
   /** Redraws the net (its rows and columns, then its points) with `project` (Viewer.project). */
   draw(project) {
-    const o = this.overlay, c = this.canvas;
+    const o = this.overlay;
     o.hidden = !this.shown;
     if (!this.shown) return;
-    const dpr = window.devicePixelRatio || 1;
-    const w = Math.max(1, Math.round(c.clientWidth * dpr)), h = Math.max(1, Math.round(c.clientHeight * dpr));
-    if (o.width !== w || o.height !== h) { o.width = w; o.height = h; }
-    Object.assign(o.style, { left: `${c.offsetLeft}px`, top: `${c.offsetTop}px`, width: `${c.clientWidth}px`, height: `${c.clientHeight}px` });
-    const g = o.getContext('2d');
-    g.clearRect(0, 0, w, h);
+    const { g, w, h, dpr } = fitOverlay(o, this.canvas);
     const { nu, nv } = this.net;
     const screen = [];
     for (let i = 0; i < nu * nv; i++) {

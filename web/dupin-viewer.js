@@ -1,9 +1,10 @@
 // <dupin-viewer src="design.json">: a Dupin design embedded in any web page, read-only. The
 // element loads Dupin's viewer-only wasm module (`pkg-viewer/` beside this file, once per page:
-// the renderer without the solvers, under half the configurator's size), fetches `src` (a design
-// as the page's JSON export writes it, or a bare { vertices, faces }), and draws its panels
-// coloured by planarity with WebGPU, or WebGL2 where WebGPU is missing. Drag to orbit, wheel to
-// zoom. The module's glue is a classic script that defines the global `wasm_bindgen`.
+// the renderer without the solvers), fetches `src` (a design as the page's JSON export writes
+// it, or a bare { vertices, faces }), and draws its panels coloured by planarity with WebGPU, or
+// with WebGL2 where the browser has no WebGPU adapter: then it loads the module's WebGL2 build
+// (`pkg-viewer-gl/`) instead. Drag to orbit, wheel to zoom. The module's glue is a classic script
+// that defines the global `wasm_bindgen`.
 //
 //   <script type="module" src="dupin-viewer.js"></script>
 //   <dupin-viewer src="examples/conical-station.json" style="width: 640px; height: 400px"></dupin-viewer>
@@ -11,11 +12,15 @@
 // State for scripts and tests: `data-state` is `loading`, `ready` or `error`; a `load` event
 // carries { faces, backend }, an `error` event { message } (the message is also shown inside).
 /* global wasm_bindgen */
-const PKG = new URL('pkg-viewer/', import.meta.url);
 let wasm = null; // one module for every element of the page: resolves to its exports
 
-/** Loads the viewer-only module: its glue as a script element, then its wasm. */
-function loadModule() {
+async function hasWebGpuAdapter() {
+  try { return !!(await navigator.gpu?.requestAdapter()); } catch { return false; }
+}
+
+/** Loads the viewer-only module (its WebGL2 build without WebGPU): its glue as a script element, then its wasm. */
+async function loadModule() {
+  const PKG = new URL(await hasWebGpuAdapter() ? 'pkg-viewer/' : 'pkg-viewer-gl/', import.meta.url);
   return new Promise((resolve, reject) => {
     const script = document.createElement('script');
     script.src = new URL('dupin_viewer.js', PKG).href;

@@ -1,7 +1,7 @@
 // 2D tab: hexagonal Delaunay triangulation (Sußner & Greiner) step by step. The refinement, the
 // cells, the dual triangulation and its angle histogram all come from wasm (`HexDelaunayLab`);
 // this file handles clicks and drags and draws into 2D canvases.
-import { HexDelaunayLab, pageSchema } from './pkg/dupin_web.js';
+import { wasm } from './wasm.js';
 import { download as save } from './download.js';
 
 const VIEW = 3.2; // half-height of the shown world square when everything fits inside it
@@ -49,7 +49,7 @@ function toWorld(px, py) { const s = scale(); return [(px - canvas.width / 2) / 
 function restart() {
   try {
     lab?.free();
-    lab = new HexDelaunayLab(modeSel.value);
+    lab = new wasm.HexDelaunayLab(modeSel.value);
     if (points.length > 0) lab.setInput(new Float64Array(points.flat()), new Uint32Array(segments.flat()));
     inputError = null;
   } catch (e) {
@@ -313,7 +313,7 @@ export function initHexd2d() {
   hist = el('canvas', { 'data-testid': 'hexd-histogram', width: '300', height: '120', 'aria-label': 'Angle histogram' });
   statusEl = el('p', { 'data-testid': 'hexd-status', role: 'status', class: 'hexd-status' });
   modeSel = el('select', { 'data-testid': 'hexd-mode', 'aria-label': 'Refinement mode' });
-  modes = pageSchema().hexDelaunayModes;
+  modes = wasm.pageSchema().hexDelaunayModes;
   modeSel.append(...modes.map((m) => new Option(`${m.name} (${m.angleBounds[0]}°–${m.angleBounds[1]}°)`, m.name)));
   const bounds = (m) => `[${m.angleBounds[0]}°, ${m.angleBounds[1]}°]`;
   toolSel = el('select', { 'data-testid': 'hexd-tool', 'aria-label': 'Tool' });

@@ -3,7 +3,7 @@
 // DOM events, the URL hash and the frame loop; the pieces are small modules:
 //   config.js (configuration <-> hash), controls.js (picker and fields), metrics.js (panel,
 //   histogram, legend), solver.js (worker client). Other tabs plug in through `window.dupin`.
-import init, { MeshData, Viewer, colorLegend, dupinVersion, freeDefaults, pageSchema, sceneDescription, sceneNames, surfaceCatalog, torusMesh } from './pkg/dupin_web.js';
+import { forcedWebgl2, loadWasm, openView, workerUrl } from './wasm.js';
 import { FREE, IMPORTED, defaults, readHash, sessionConfig, useSchema, writeHash } from './config.js';
 import { buildFields, clearFieldErrors, fillScenePicker, showFieldError } from './controls.js';
 import { drawHistogram, drawLegend, legendCaption, showMetrics, showProgress } from './metrics.js';
@@ -25,6 +25,8 @@ const metricsEl = $('metrics');
 const canvas = $('canvas');
 const fieldsBox = document.getElementById('params');
 
+// The wasm module's exports (wasm.js picks the WebGPU or the WebGL2 build), set by main().
+let MeshData, Viewer, colorLegend, dupinVersion, freeDefaults, pageSchema, sceneDescription, sceneNames, surfaceCatalog, torusMesh;
 let TORUS = null;         // the torus preview's parameters { key: { label, value } } (pageSchema)
 
 let viewer = null;
@@ -977,17 +979,18 @@ function restore(hash) {
 
 async function main() {
   try {
-    await init();
+    ({ MeshData, Viewer, colorLegend, dupinVersion, freeDefaults, pageSchema, sceneDescription, sceneNames, surfaceCatalog, torusMesh } = await loadWasm());
     const schema = pageSchema();
     useSchema(schema);
     TORUS = Object.fromEntries(schema.torus.map((p) => [p.key, { label: p.key, value: p.default }]));
     config = defaults();
     ctx = { scenes: sceneNames(), catalog: surfaceCatalog(), defaults: freeDefaults() };
-    solver = new Solver({ onState, onError, onExport, onPick, onFault, onSelection });
-    const backend = readHash(location.hash, { scenes: ctx.scenes, catalog: ctx.catalog, torusParams: TORUS }).backend;
+    solver = new Solver(workerUrl(), { onState, onError, onExport, onPick, onFault, onSelection });
     canvas.width = Math.max(1, canvas.clientWidth);
     canvas.height = Math.max(1, canvas.clientHeight);
-    viewer = await Viewer.create(canvas, backend === 'webgl2');
+    let exports;
+    ({ view: viewer, exports } = await openView((w) => w.Viewer.create(canvas, forcedWebgl2)));
+    ({ MeshData, Viewer, colorLegend, dupinVersion, freeDefaults, pageSchema, sceneDescription, sceneNames, surfaceCatalog, torusMesh } = exports);
     await solver.ready;
   } catch (e) {
     showStatus(`Cannot start: ${e.message ?? e}`, true);

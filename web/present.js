@@ -1,7 +1,7 @@
 // Presentation mode: the current panels as glass in metal frames, with sun shadows, a damped
 // orbit, full screen and a 2x PNG. Rendering and geometry are wasm's (`Presenter`); this file
 // wires events and the frame loop.
-import { Presenter, torusPanels } from './pkg/dupin_web.js';
+import { forcedWebgl2, wasm } from './wasm.js';
 import { download } from './download.js';
 
 let presenter = null;
@@ -98,8 +98,7 @@ async function openPresentation() {
     try {
       canvas.width = Math.max(1, canvas.clientWidth);
       canvas.height = Math.max(1, canvas.clientHeight);
-      const webgl2 = new URLSearchParams(location.hash.slice(1)).get('backend') === 'webgl2';
-      presenter = await Presenter.create(canvas, webgl2);
+      presenter = await wasm.Presenter.create(canvas, forcedWebgl2);
     } catch (e) { status(`Cannot start presentation: ${e.message ?? e}`, true); return; }
   }
   show(demo ?? getMesh());
@@ -165,7 +164,7 @@ export function initPresent(currentMesh) {
   offsetBox.addEventListener('change', () => show(demo ?? getMesh()));
   demoBtn.addEventListener('click', () => {
     demo?.free();
-    demo = torusPanels(10000);
+    demo = wasm.torusPanels(10000);
     show(demo);
   });
   fsBtn.addEventListener('click', () => {

@@ -1,9 +1,10 @@
-// The script of a shared presentation file (share.js inlines it, after wasm-bindgen's
-// `no-modules` glue of the viewer-only module, which defines the global `wasm_bindgen`). A
-// classic script, not a module: a file opened from disk cannot import modules. It reads the
-// blocks share.js wrote (certificate, camera, gzip+base64 design and wasm), fills in the
-// certificate, and draws the panels with the module's `Presenter`: drag to orbit (it coasts),
-// wheel to zoom. `document.body.dataset.state` is `loading`, `ready` (with `readyMs`, from
+// The script of a shared presentation file (share.js inlines it). A classic script, not a
+// module: a file opened from disk cannot import modules. It reads the blocks share.js wrote
+// (certificate, camera, and gzip+base64 design and the viewer-only module's two builds), fills in
+// the certificate, runs the build this browser can draw with (WebGPU only, or the one with
+// WebGL2 where there is no WebGPU adapter: its wasm-bindgen `no-modules` glue as a script
+// element, which defines the global `wasm_bindgen`) and draws the panels with its `Presenter`:
+// drag to orbit (it coasts), wheel to zoom. `document.body.dataset.state` is `loading`, `ready` (with `readyMs`, from
 // navigation to the first drawn view) or `error`, and
 // `window.dupinPresentation.snapshotDataUrl()` reads the view back (for tests).
 /* global wasm_bindgen */
@@ -42,7 +43,13 @@
 
   const canvas = byId('view');
   try {
-    await wasm_bindgen({ module_or_path: await inflate(block('dupin-wasm')) });
+    let webgpu = false;
+    try { webgpu = !!(await navigator.gpu?.requestAdapter()); } catch { /* no WebGPU: WebGL2 */ }
+    const suffix = webgpu ? '' : '-gl';
+    const glue = document.createElement('script');
+    glue.textContent = new TextDecoder().decode(await inflate(block(`dupin-glue${suffix}`)));
+    document.head.append(glue);
+    await wasm_bindgen({ module_or_path: await inflate(block(`dupin-wasm${suffix}`)) });
     const mesh = wasm_bindgen.designMesh(new TextDecoder().decode(await inflate(block('dupin-design'))));
     const presenter = await wasm_bindgen.Presenter.create(canvas, false);
     const fit = () => {

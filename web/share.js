@@ -1,9 +1,11 @@
 // "Share presentation": ONE self-contained HTML file a client opens offline, from disk, with no
-// server: the panels as glass in metal frames (the viewer-only wasm module, `pkg-viewer/`, which
-// carries the renderer and none of the solvers), the camera the design was shared from, and a
-// quality certificate. Everything the file needs is inside it: the module and the design are
-// gzip-compressed and base64-encoded in inert <script> blocks, the wasm-bindgen glue and
-// `presentation-viewer.js` are inlined as classic scripts. Nothing is uploaded anywhere.
+// server: the panels as glass in metal frames (the viewer-only wasm module, which carries the
+// renderer and none of the solvers), the camera the design was shared from, and a quality
+// certificate. Everything the file needs is inside it: the module's two builds (`pkg-viewer/`,
+// WebGPU only, and `pkg-viewer-gl/`, with WebGL2 for browsers without WebGPU), each its
+// wasm-bindgen glue and wasm, and the design, gzip-compressed and base64-encoded in inert
+// <script> blocks; `presentation-viewer.js`, inlined as a classic script, runs the build the
+// browser can draw with. Nothing is uploaded anywhere.
 
 /** gzip (the browser's CompressionStream) then base64 of `bytes`. */
 async function gzipBase64(bytes) {
@@ -102,14 +104,16 @@ export function certificate(doc, { layers, panelEdge, title, version, date = new
 export async function presentationFile(exportText, camera, options) {
   const doc = JSON.parse(exportText);
   const cert = certificate(doc, options);
-  const [glue, viewer, wasm] = await Promise.all([
-    fetchOk('pkg-viewer/dupin_viewer.js'),
+  const [glue, glueGl, viewer, wasm, wasmGl] = await Promise.all([
+    fetchOk('pkg-viewer/dupin_viewer.js', 'bytes'),
+    fetchOk('pkg-viewer-gl/dupin_viewer.js', 'bytes'),
     fetchOk('presentation-viewer.js'),
     fetchOk('pkg-viewer/dupin_viewer_bg.wasm', 'bytes'),
+    fetchOk('pkg-viewer-gl/dupin_viewer_bg.wasm', 'bytes'),
   ]);
   // Only what the viewer draws: the panels (full precision: the certificate is about them).
   const design = new TextEncoder().encode(JSON.stringify({ vertices: doc.mesh.vertices, faces: doc.mesh.faces }));
-  const [designB64, wasmB64] = await Promise.all([gzipBase64(design), gzipBase64(wasm)]);
+  const [designB64, glueB64, wasmB64, glueGlB64, wasmGlB64] = await Promise.all([design, glue, wasm, glueGl, wasmGl].map(gzipBase64));
   const title = escapeHtml(cert.title);
   return `<!doctype html>
 <html lang="en">
@@ -150,8 +154,10 @@ export async function presentationFile(exportText, camera, options) {
 <script type="application/json" id="dupin-certificate">${inlineJson(cert)}</script>
 <script type="application/json" id="dupin-camera">${inlineJson(camera ?? null)}</script>
 <script type="application/octet-stream" id="dupin-design">${designB64}</script>
+<script type="application/octet-stream" id="dupin-glue">${glueB64}</script>
 <script type="application/octet-stream" id="dupin-wasm">${wasmB64}</script>
-<script>${inlineScript(glue)}</script>
+<script type="application/octet-stream" id="dupin-glue-gl">${glueGlB64}</script>
+<script type="application/octet-stream" id="dupin-wasm-gl">${wasmGlB64}</script>
 <script>${inlineScript(viewer)}</script>
 </body>
 </html>

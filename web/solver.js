@@ -5,7 +5,9 @@
 // than anyone wants to wait: `restart()` terminates the worker (whatever it is computing) and
 // starts a fresh one, and the page reloads its last good state into it.
 export class Solver {
-  constructor({ onState, onError, onExport, onPick, onFault, onSelection }) {
+  /** `url`: the worker script's (wasm.js's `workerUrl`: it names the module build to load). */
+  constructor(url, { onState, onError, onExport, onPick, onFault, onSelection }) {
+    this.url = url;
     this.gen = 0;
     this.callbacks = { onState, onError, onExport, onPick, onFault, onSelection };
     this.start();
@@ -13,7 +15,7 @@ export class Solver {
 
   start() {
     const { onState, onError, onExport, onPick, onFault, onSelection } = this.callbacks;
-    const worker = new Worker(new URL('./worker.js', import.meta.url), { type: 'module' });
+    const worker = new Worker(this.url, { type: 'module' });
     this.worker = worker;
     this.ready = new Promise((resolve, reject) => {
       worker.addEventListener('error', (e) => reject(new Error(`solver worker: ${e.message ?? 'failed to start'}`)), { once: true });

@@ -2,7 +2,7 @@
 // comes from wasm (`DupinLesson`); this file draws its primitives as SVG and forwards drags. The
 // lesson is either at a surface point (u, v) picked in the inset, or at a mesh vertex clicked in
 // the 3D view (`showPick`, fed by `Session.pickVertex` in the worker).
-import { DupinLesson, surfaceCatalog } from './pkg/dupin_web.js';
+import { wasm } from './wasm.js';
 import { download as save } from './download.js';
 
 const SVGNS = 'http://www.w3.org/2000/svg';
@@ -181,7 +181,7 @@ function load() {
   try {
     const u = Number(uIn.value), v = Number(vIn.value);
     if (uIn.value.trim() === '' || vIn.value.trim() === '' || !Number.isFinite(u) || !Number.isFinite(v)) throw new Error('u and v must be numbers');
-    const next = new DupinLesson(spec.name, params, u, v);
+    const next = new wasm.DupinLesson(spec.name, params, u, v);
     lesson?.free();
     lesson = next;
     setPicked(null, true);
@@ -239,7 +239,7 @@ export function showPick(pick, error) {
     return pick;
   }
   try {
-    const next = DupinLesson.fromStar(pick);
+    const next = wasm.DupinLesson.fromStar(pick);
     lesson?.free();
     lesson = next;
     state = lesson.state();
@@ -281,7 +281,7 @@ async function insetPng(scale) {
 
 /** Adds the Teach button and the inset panel to the page. */
 export function initTeach() {
-  CATALOG = surfaceCatalog();
+  CATALOG = wasm.surfaceCatalog();
   panel = el('section', { class: 'teach', 'data-testid': 'teach-panel', hidden: '' });
   surfaceSel = el('select', { 'data-testid': 'teach-surface', 'aria-label': 'Surface' });
   for (const s of CATALOG) if (s.name !== 'bspline') surfaceSel.append(new Option(s.name, s.name));

@@ -13,7 +13,10 @@
 //        {unavailable, info}} | error {message, field}
 //        | export {kind, text} | pick {panels, pick | error} (Session.pickVertex's or pickPanelVertex's answer)
 //        error {fatal: true} after a wasm trap: the module is unusable and the page restarts us
-import init, { Session, debugFault } from './pkg/dupin_web.js';
+// The page's build of the module (wasm.js: `build=gl` for the WebGL2 one, which the page has
+// already fetched; the solvers are the same in both).
+const gl = new URL(self.location.href).searchParams.get('build') === 'gl';
+const { default: init, Session, debugFault } = await import(gl ? './pkg-gl/dupin_web.js' : './pkg/dupin_web.js');
 
 let session = null;
 let gen = 0;

@@ -9,7 +9,7 @@ import { openPage } from './harness.mjs';
 const { browser, page } = await openPage({ webgpu: false });
 try {
   const r = await page.evaluate(async () => {
-    const { Session } = await import('./pkg/dupin_web.js');
+    const { Session } = (await import('./wasm.js')).wasm; // the build the page loaded
     // 709 x 709 vertices: 2 x 708 x 708 = 1 002 528 triangles.
     const n = 709;
     const positions = new Float32Array(n * n * 3);

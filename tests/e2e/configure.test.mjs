@@ -205,15 +205,32 @@ test('JSON and SVG exports parse and match the face count; colour modes change p
 
 test('WebGL2 fallback steps a scene in the worker', async () => {
   // Twelve layers in: a band wide enough to measure (three were a sliver of 1% of the view).
-  const { browser, page, errors } = await openPage({ webgpu: false, hash: '#scene=sphere-spiral&steps=12' });
+  const { browser, page, errors, wasm } = await openPage({ webgpu: false, hash: '#scene=sphere-spiral&steps=12' });
   try {
     assert.equal((await byId(page, 'status').textContent()).trim(), 'WebGL2');
+    // Without WebGPU the page and its worker load the WebGL2 build, and only it.
+    assert.deepEqual([...new Set(wasm)], ['pkg-gl/dupin_web_bg.wasm']);
     await waitSteps(page, 12);
     const { covered } = await pixelStats(page, await shot(page, 'webgl2-sphere-spiral'));
     assert.ok(covered > 0.01, `only ${(covered * 100).toFixed(1)}% covered`);
     await byId(page, 'play').click();
     await waitDone(page);
     assert.ok(Number((await metrics(page)).maxPlanarity) <= 1e-10);
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
+
+test('a browser that offers WebGPU but gives no adapter falls back to the WebGL2 build', async () => {
+  const { browser, page, errors, wasm } = await openPage({ adapter: false, hash: '#scene=sphere-spiral&steps=3' });
+  try {
+    assert.equal((await byId(page, 'status').textContent()).trim(), 'WebGL2');
+    // The WebGPU build first (page and worker), then the WebGL2 one for the view.
+    assert.deepEqual([...new Set(wasm)], ['pkg/dupin_web_bg.wasm', 'pkg-gl/dupin_web_bg.wasm']);
+    await waitSteps(page, 3);
+    const { covered } = await pixelStats(page, await shot(page, 'no-adapter-sphere-spiral'));
+    assert.ok(covered > 0.001, `only ${(covered * 100).toFixed(2)}% covered`);
     assert.deepEqual(errors, []);
   } finally {
     await browser.close();

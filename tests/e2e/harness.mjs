@@ -21,9 +21,10 @@ const FLAGS = [
 ];
 
 /** Opens the page (`hash` is appended to its URL: a hash, or another page of web/); with
- * `webgpu: false` the browser offers no `navigator.gpu` at all; `ready: false` does not wait for
- * the configurator's first frame. */
-export async function openPage({ webgpu = true, hash = '', viewport = { width: 960, height: 640 }, ready = true } = {}) {
+ * `webgpu: false` the browser offers no `navigator.gpu` at all, with `adapter: false` it offers
+ * one that gives no adapter; `ready: false` does not wait for
+ * the configurator's first frame. `wasm` lists the wasm modules the page and its worker fetched. */
+export async function openPage({ webgpu = true, adapter = true, hash = '', viewport = { width: 960, height: 640 }, ready = true } = {}) {
   const browser = await chromium.launch({
     executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
     headless: true,
@@ -36,19 +37,26 @@ export async function openPage({ webgpu = true, hash = '', viewport = { width: 9
       delete Navigator.prototype.gpu;
     });
   }
+  if (!adapter) {
+    // WebGPU offered but no adapter (a browser whose GPU is blocklisted).
+    await context.addInitScript(() => { GPU.prototype.requestAdapter = async () => null; });
+  }
   const page = await context.newPage();
   const errors = [];
   page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
   page.on('pageerror', (e) => errors.push(String(e)));
   // The page fetches nothing from anywhere but its own origin.
   const origin = new URL(URL_BASE).origin;
+  // The wasm modules fetched (page and worker), as paths under the page's folder.
+  const wasm = [];
   page.on('request', (r) => {
     const u = new URL(r.url());
     if (!['data:', 'blob:'].includes(u.protocol) && u.origin !== origin) errors.push(`request outside the page's origin: ${r.url()}`);
+    if (u.pathname.endsWith('.wasm')) wasm.push(u.pathname.slice(new URL(URL_BASE).pathname.length));
   });
   await page.goto(URL_BASE + hash);
   if (ready) await page.waitForFunction(() => document.body.dataset.ready === 'true', null, { timeout: Number(process.env.READY_MS ?? 90_000) });
-  return { browser, page, errors };
+  return { browser, page, errors, wasm };
 }
 
 export const byId = (page, id) => page.locator(`[data-testid="${id}"]`);

@@ -13,7 +13,7 @@ test('the URL-hash parser takes any hash', async () => {
   try {
     const result = await page.evaluate(async (runs) => {
       const cfg = await import('./config.js');
-      const wasm = await import('./pkg/dupin_web.js');
+      const { wasm } = await import('./wasm.js'); // the build the page loaded, initialised
       const ctx = {
         scenes: wasm.sceneNames(),
         catalog: wasm.surfaceCatalog(),

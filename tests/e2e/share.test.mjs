@@ -17,11 +17,18 @@ async function share(page) {
   return { path, name: download.suggestedFilename(), text: readFileSync(path, 'utf8'), bytes: statSync(path).size };
 }
 
-/** Opens `path` from disk in a fresh, offline context of `browser`; returns the page, its
- * certificate rows and the requests it tried beyond the file itself. */
-async function openOffline(browser, path) {
+/** Opens `path` from disk in a fresh, offline context of `browser` (with `webgpu: false`, one
+ * that offers no `navigator.gpu`); returns the page, its certificate rows and the requests it
+ * tried beyond the file itself. */
+async function openOffline(browser, path, { webgpu = true } = {}) {
   const context = await browser.newContext({ viewport: { width: 960, height: 640 } });
   await context.setOffline(true);
+  if (!webgpu) {
+    await context.addInitScript(() => {
+      Object.defineProperty(Navigator.prototype, 'gpu', { get: () => undefined, configurable: true });
+      delete Navigator.prototype.gpu;
+    });
+  }
   const outside = [];
   await context.route('**/*', (route) => {
     const u = route.request().url();
@@ -37,7 +44,7 @@ async function openOffline(browser, path) {
   const state = await page.evaluate(() => document.body.dataset.state);
   const status = await byId(page, 'presentation-status').textContent();
   assert.equal(state, 'ready', status);
-  console.log(`${path.split('/').pop()}: ready ${await page.evaluate(() => document.body.dataset.readyMs)} ms after navigation`);
+  console.log(`${path.split('/').pop()}: ready ${await page.evaluate(() => document.body.dataset.readyMs)} ms after navigation (${status})`);
   const rows = await page.evaluate(() => Object.fromEntries([...document.querySelectorAll('[data-testid=certificate] dd')].map((d) => [d.dataset.row, d.textContent])));
   await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
   const url = await page.evaluate(() => window.dupinPresentation.snapshotDataUrl(1));
@@ -70,7 +77,7 @@ test('a shared presentation of conical-station opens offline from disk with its 
     assert.equal(v.rows.status, 'finished');
     assert.match(v.rows['support-beams'], /^\d+, planarity /);
     assert.match(v.rows.computed, /^\d{4}-\d\d-\d\d · Dupin \d+\.\d+\.\d+$/);
-    assert.match(v.status, /panels/);
+    assert.match(v.status, /panels · \d+ beams · WebGPU$/);
     assert.deepEqual(await axeSerious(v.page, 'shared presentation'), []);
     // The figures fold away and come back; the title stays.
     const toggle = v.page.locator('#cert-toggle');
@@ -81,6 +88,12 @@ test('a shared presentation of conical-station opens offline from disk with its 
     await toggle.click();
     assert.ok(await v.page.locator('#cert-rows').isVisible());
     await v.context.close();
+    // A browser without WebGPU runs the file's WebGL2 build of the viewer.
+    const gl = await openOffline(browser, file.path, { webgpu: false });
+    assert.deepEqual([gl.outside, gl.errors], [[], []]);
+    assert.match(gl.status, /panels · \d+ beams · WebGL2$/);
+    assert.ok(gl.px.covered > 0.05, `the design is drawn with WebGL2: ${JSON.stringify(gl.px)}`);
+    await gl.context.close();
     assert.deepEqual(errors, []);
   } finally {
     await browser.close();

@@ -7,9 +7,11 @@ import rhino3dm from '../../web/vendor/node_modules/rhino3dm/rhino3dm.module.js'
 import { byId, exportText, metrics, openPage, parseObj } from './harness.mjs';
 
 test('smoke: start, run a scene to the end, export, open a .3dm', async () => {
-  const { browser, page, errors } = await openPage({ hash: '#scene=sphere-radial' });
+  const { browser, page, errors, wasm } = await openPage({ hash: '#scene=sphere-radial' });
   try {
-    assert.match(await byId(page, 'status').textContent(), /WebGPU|WebGL2/);
+    assert.match(await byId(page, 'status').textContent(), /^WebGPU/);
+    // One module for the page and its worker: the WebGPU-only build (no WebGL2 backend).
+    assert.deepEqual([...new Set(wasm)], ['pkg/dupin_web_bg.wasm']);
     await page.waitForFunction(() => document.querySelector('[data-testid=metrics]').dataset.steps === '1', null, { timeout: 60_000 });
     await byId(page, 'play').click();
     await page.waitForFunction(() => document.querySelector('[data-testid=metrics]').dataset.phase === 'done', null, { timeout: 120_000 });

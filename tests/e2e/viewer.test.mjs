@@ -5,12 +5,13 @@ import assert from 'node:assert/strict';
 import { SHOTS, byId, openPage, pixelStats } from './harness.mjs';
 
 test('<dupin-viewer> shows an embedded design, orbits on drag and names a bad file\'s fault', async () => {
-  const { browser, page, errors } = await openPage({ hash: 'viewer-example.html', ready: false });
+  const { browser, page, errors, wasm } = await openPage({ hash: 'viewer-example.html', ready: false });
   try {
     const viewer = byId(page, 'viewer');
     await page.waitForFunction(() => document.querySelector('dupin-viewer').dataset.state === 'ready', null, { timeout: 60_000 });
     const note = () => viewer.evaluate((v) => v.shadowRoot.querySelector('p').textContent);
-    assert.match(await note(), /^384 panels · (WebGPU|WebGL2)$/);
+    assert.match(await note(), /^384 panels · WebGPU$/);
+    assert.deepEqual(wasm, ['pkg-viewer/dupin_viewer_bg.wasm']);
     await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
     const first = await viewer.screenshot({ path: `${SHOTS}/viewer-example.png` });
     const { covered } = await pixelStats(page, first);
@@ -37,6 +38,22 @@ test('<dupin-viewer> shows an embedded design, orbits on drag and names a bad fi
     await viewer.evaluate((v) => v.setAttribute('src', 'examples/conical-station.json'));
     assert.equal((await loaded).faces, 384);
     assert.deepEqual(errors.filter((e) => !/404/.test(e)), []);
+  } finally {
+    await browser.close();
+  }
+});
+
+test('<dupin-viewer> without WebGPU loads the WebGL2 build of the viewer and draws', async () => {
+  const { browser, page, errors, wasm } = await openPage({ webgpu: false, hash: 'viewer-example.html', ready: false });
+  try {
+    const viewer = byId(page, 'viewer');
+    await page.waitForFunction(() => document.querySelector('dupin-viewer').dataset.state === 'ready', null, { timeout: 60_000 });
+    assert.equal(await viewer.evaluate((v) => v.shadowRoot.querySelector('p').textContent), '384 panels · WebGL2');
+    assert.deepEqual(wasm, ['pkg-viewer-gl/dupin_viewer_bg.wasm']);
+    await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+    const { covered } = await pixelStats(page, await viewer.screenshot({ path: `${SHOTS}/viewer-example-webgl2.png` }));
+    assert.ok(covered > 0.05, `only ${(covered * 100).toFixed(1)}% of the element shows the design`);
+    assert.deepEqual(errors, []);
   } finally {
     await browser.close();
   }

@@ -27,6 +27,12 @@ struct Build {
     viewer_profile: String,
     #[serde(rename = "viewer-wasm-opt", default)]
     viewer_wasm_opt: Vec<String>,
+    #[serde(rename = "gl-out-dir")]
+    gl_out_dir: String,
+    #[serde(rename = "viewer-gl-out-dir")]
+    viewer_gl_out_dir: String,
+    #[serde(rename = "gl-features")]
+    gl_features: String,
 }
 
 #[derive(Deserialize)]
@@ -62,46 +68,49 @@ impl WebBuild {
         Ok(WebBuild { file })
     }
 
-    /// Where the package lands, absolute.
-    pub fn out_dir(&self) -> std::path::PathBuf {
-        root().join(&self.file.build.out_dir)
-    }
-
-    /// Where the viewer-only package lands, absolute.
-    pub fn viewer_out_dir(&self) -> std::path::PathBuf {
-        root().join(&self.file.build.viewer_out_dir)
-    }
-
     /// `wasm-pack build` with the configured flags: the configurator's module, then the
     /// viewer-only one (the same crate without its default `configurator` feature, as a classic
-    /// script a shared presentation file inlines), each through wasm-opt.
+    /// script a shared presentation file inlines), each as a WebGPU-only build and a WebGL2
+    /// fallback build (`gl-features`), each through wasm-opt.
     pub fn build(&self) -> Result<()> {
         let b = &self.file.build;
-        let features = b.features.trim();
-        let features: &[&str] = if features.is_empty() {
-            &[]
-        } else {
-            &["--features", features]
+        let with = |extra: &str| -> Vec<String> {
+            let all: Vec<&str> = [b.features.trim(), extra]
+                .into_iter()
+                .flat_map(|f| f.split(','))
+                .map(str::trim)
+                .filter(|f| !f.is_empty())
+                .collect();
+            if all.is_empty() {
+                Vec::new()
+            } else {
+                vec!["--features".into(), all.join(",")]
+            }
         };
-        self.wasm_pack(
-            &b.target,
-            &b.profile,
-            &self.out_dir(),
-            "dupin_web",
-            features,
-        )?;
-        self.optimise(&self.out_dir().join("dupin_web_bg.wasm"), &b.wasm_opt)?;
-        self.wasm_pack(
-            "no-modules",
-            &b.viewer_profile,
-            &self.viewer_out_dir(),
-            "dupin_viewer",
-            &["--", "--no-default-features"],
-        )?;
-        self.optimise(
-            &self.viewer_out_dir().join("dupin_viewer_bg.wasm"),
-            &b.viewer_wasm_opt,
-        )
+        for (dir, extra) in [(&b.out_dir, ""), (&b.gl_out_dir, b.gl_features.as_str())] {
+            let out = root().join(dir);
+            self.wasm_pack(&b.target, &b.profile, &out, "dupin_web", &with(extra))?;
+            self.optimise(&out.join("dupin_web_bg.wasm"), &b.wasm_opt)?;
+        }
+        for (dir, extra) in [
+            (&b.viewer_out_dir, ""),
+            (&b.viewer_gl_out_dir, b.gl_features.as_str()),
+        ] {
+            let out = root().join(dir);
+            let mut flags = vec!["--".to_string(), "--no-default-features".to_string()];
+            if !extra.trim().is_empty() {
+                flags.extend(["--features".to_string(), extra.trim().to_string()]);
+            }
+            self.wasm_pack(
+                "no-modules",
+                &b.viewer_profile,
+                &out,
+                "dupin_viewer",
+                &flags,
+            )?;
+            self.optimise(&out.join("dupin_viewer_bg.wasm"), &b.viewer_wasm_opt)?;
+        }
+        Ok(())
     }
 
     /// One `wasm-pack build` of the crate for `target` with Cargo profile `profile`, written to
@@ -112,7 +121,7 @@ impl WebBuild {
         profile: &str,
         out_dir: &std::path::Path,
         out_name: &str,
-        extra: &[&str],
+        extra: &[String],
     ) -> Result<()> {
         let b = &self.file.build;
         let mut cmd = Command::new("wasm-pack");
@@ -201,7 +210,9 @@ impl WebBuild {
             .args(["test", "--headless", "--chrome", "--chromedriver"])
             .arg(&self.file.test.chromedriver)
             .arg(&self.file.build.krate)
-            .args(&self.file.test.chrome);
+            .args(&self.file.test.chrome)
+            // The browser tests draw with WebGL2 too.
+            .args(["--features", &self.file.build.gl_features]);
         run(&mut cmd)
     }
 }

@@ -14,9 +14,15 @@ use std::path::{Path, PathBuf};
 const FILES: &[&str] = &[
     "pkg/dupin_web.js",
     "pkg/dupin_web_bg.wasm",
-    // Fetched by the page when it writes a shared presentation file.
+    // The WebGL2 build, loaded where the browser has no WebGPU adapter.
+    "pkg-gl/dupin_web.js",
+    "pkg-gl/dupin_web_bg.wasm",
+    // Fetched by the page when it writes a shared presentation file (both builds go in it), and
+    // by `<dupin-viewer>`.
     "pkg-viewer/dupin_viewer.js",
     "pkg-viewer/dupin_viewer_bg.wasm",
+    "pkg-viewer-gl/dupin_viewer.js",
+    "pkg-viewer-gl/dupin_viewer_bg.wasm",
     "vendor/node_modules/rhino3dm/rhino3dm.module.js",
     "vendor/node_modules/rhino3dm/rhino3dm.wasm",
     // The design `viewer-example.html` embeds with `<dupin-viewer>`.
@@ -79,8 +85,12 @@ mod tests {
             "pkg/dupin_web.js",
             "pkg/dupin_web_bg.wasm",
             "pkg/dupin_web.d.ts",
+            "pkg-gl/dupin_web.js",
+            "pkg-gl/dupin_web_bg.wasm",
             "pkg-viewer/dupin_viewer.js",
             "pkg-viewer/dupin_viewer_bg.wasm",
+            "pkg-viewer-gl/dupin_viewer.js",
+            "pkg-viewer-gl/dupin_viewer_bg.wasm",
             "vendor/package.json",
             "vendor/node_modules/rhino3dm/rhino3dm.module.js",
             "vendor/node_modules/rhino3dm/rhino3dm.wasm",
@@ -94,7 +104,7 @@ mod tests {
         }
         let out = tmp.join("dist");
         let files = copy(&web, &out).unwrap();
-        assert_eq!(files.len(), 10, "{files:?}");
+        assert_eq!(files.len(), 14, "{files:?}");
         for f in &files {
             assert_eq!(
                 std::fs::read_to_string(out.join(f)).unwrap(),

@@ -327,7 +327,8 @@ fn import_design(
         }
         (None, None) => [0.0; 3],
     };
-    let control_net = surface.as_ref().map(|s| {
+    // Only an opened NURBS surface has a net the user can drag; a fitted one's is ours.
+    let control_net = surface.as_ref().filter(|_| is_json).map(|s| {
         let (nu, nv) = s.control_net_size();
         ControlNet {
             nu,
@@ -336,7 +337,7 @@ fn import_design(
         }
     });
     let info = DesignInfo {
-        control_net: if is_json { control_net } else { None },
+        control_net,
         name: name.to_string(),
         import_as: if surface.is_some() {
             "surface"

@@ -13,7 +13,8 @@ pub struct Viewer {
 #[wasm_bindgen]
 impl Viewer {
     /// Creates a viewer on `canvas`. With `force_webgl2`, WebGPU is not tried (for testing the
-    /// fallback and for browsers whose WebGPU misbehaves).
+    /// fallback and for browsers whose WebGPU misbehaves). The build without the `webgl` feature
+    /// refuses, with the canvas untouched, where it would need WebGL2.
     pub async fn create(
         canvas: web_sys::HtmlCanvasElement,
         force_webgl2: bool,
@@ -166,7 +167,8 @@ pub(crate) struct Canvas<R> {
 
 impl<R: Draw> Canvas<R> {
     /// Opens `canvas` with WebGPU, or WebGL2 where WebGPU is missing (`force_webgl2`: WebGL2
-    /// only), under WebGL2's limits so both backends behave alike.
+    /// only; an error without the `webgl` feature), under WebGL2's limits so both backends
+    /// behave alike.
     pub(crate) async fn open(
         canvas: web_sys::HtmlCanvasElement,
         force_webgl2: bool,
@@ -174,13 +176,23 @@ impl<R: Draw> Canvas<R> {
         renderer: impl FnOnce(&wgpu::Device, wgpu::TextureFormat) -> R,
     ) -> Result<Self, JsError> {
         let (width, height) = (canvas.width().max(1), canvas.height().max(1));
+        // WebGPU only where the browser gives an adapter (Chrome on Linux offers `navigator.gpu`
+        // and none). Asked before the canvas is touched: a canvas that gave out a WebGPU context
+        // gives no WebGL2 one, and the page retries this canvas with the WebGL2 build.
+        let webgpu = !force_webgl2 && wgpu::util::is_browser_webgpu_supported().await;
+        if !webgpu && !cfg!(feature = "webgl") {
+            return Err(JsError::new(
+                "this browser gives no WebGPU adapter, and this build of Dupin's module draws \
+                 with WebGPU only (its WebGL2 build is pkg-gl/ or pkg-viewer-gl/)",
+            ));
+        }
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
-        desc.backends = if force_webgl2 {
-            wgpu::Backends::GL
-        } else {
+        desc.backends = if webgpu {
             wgpu::Backends::BROWSER_WEBGPU | wgpu::Backends::GL
+        } else {
+            wgpu::Backends::GL
         };
-        let instance = wgpu::util::new_instance_with_webgpu_detection(desc).await;
+        let instance = wgpu::Instance::new(desc);
         let surface = instance
             .create_surface(wgpu::SurfaceTarget::Canvas(canvas))
             .map_err(|e| JsError::new(&format!("cannot draw into the canvas: {e}")))?;
