@@ -4,8 +4,8 @@
 // the certificate, runs the build this browser can draw with (WebGPU only, or the one with
 // WebGL2 where there is no WebGPU adapter: its wasm-bindgen `no-modules` glue as a script
 // element, which defines the global `wasm_bindgen`) and draws the panels with its `Presenter`:
-// drag to orbit (it coasts), wheel to zoom. `document.body.dataset.state` is `loading`, `ready` (with `readyMs`, from
-// navigation to the first drawn view) or `error`, and
+// drag to orbit (it coasts), wheel to zoom. `document.body.dataset.state` is `loading`,
+// `ready` (with `readyMs`, from navigation to the first drawn view) or `error`, and
 // `window.dupinPresentation.snapshotDataUrl()` reads the view back (for tests).
 /* global wasm_bindgen */
 (async () => {

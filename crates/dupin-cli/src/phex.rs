@@ -22,8 +22,8 @@ pub struct PhexArgs {
     #[arg(long, conflicts_with = "input")]
     pub surface: Option<String>,
     /// A design to panel: a NURBS surface as JSON (docs/nurbs-json.md), or a triangle mesh of a
-    /// smooth disk-like surface (OBJ, STL, glTF/GLB) that is fitted first; --size is in the
-    /// file's unit.
+    /// smooth disk- or cylinder-like surface (OBJ, STL, glTF/GLB) that is fitted first (a
+    /// cylinder cut open along a seam); --size is in the file's unit.
     #[arg(long, conflicts_with = "scene")]
     pub input: Option<PathBuf>,
     /// Surface parameter KEY=VALUE (repeatable).

@@ -518,6 +518,32 @@ mod tests {
     }
 
     #[test]
+    fn a_tube_of_triangles_opens_as_a_surface_cut_open_along_a_seam() {
+        let (nu, nv) = (24, 6);
+        let mut obj = String::new();
+        for j in 0..=nv {
+            for i in 0..nu {
+                let a = std::f64::consts::TAU * i as f64 / nu as f64;
+                let r = 2.0 + 0.2 * (j as f64).cos();
+                obj += &format!("v {} {} {}\n", r * a.cos(), r * a.sin(), 0.5 * j as f64);
+            }
+        }
+        let id = |i: usize, j: usize| j * nu + i % nu + 1;
+        for j in 0..nv {
+            for i in 0..nu {
+                let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+                obj += &format!("f {a} {b} {c}\nf {a} {c} {d}\n");
+            }
+        }
+        let (run, info) = import_design("tube.obj", obj.as_bytes(), &ImportConfig::default())
+            .expect("a cylinder is fitted, not refused");
+        assert_eq!(info.import_as, "surface");
+        // 168 vertices only, so a coarse net: within 1% of the 6.2 m diagonal (6 cm).
+        assert!(info.fit_max_distance_m.unwrap() < 0.07, "{info:?}");
+        assert!(matches!(run, Imported::Phex(..)));
+    }
+
+    #[test]
     fn quads_are_panels_and_triangles_a_surface_unless_told() {
         let cfg = ImportConfig {
             unit: Some("ft".into()),

@@ -1,6 +1,7 @@
 //! A triangle mesh of a smooth surface (a freeform roof exported from a CAD tool with no UVs)
 //! made into a [`Surface`] that the P-Hex pipeline panels like a library surface: a mean-value
-//! parametrisation onto the unit square, then a faired least-squares bicubic B-spline fit.
+//! parametrisation onto the unit square, then a faired least-squares bicubic B-spline fit. A
+//! mesh of cylinder topology is cut open along a seam first (`cylinder_cut.rs`).
 //!
 //! Why this route and not a triangulation walking the mesh itself: P-Hex needs second
 //! derivatives everywhere (the Dupin indicatrix, P-Hex paper section 3) and closest points
@@ -19,6 +20,7 @@
 //!   largest and mean, so a user sees how far the panelled surface is from their design.
 
 use super::Surface;
+use super::cylinder_cut::cut_open_cylinder;
 use super::nurbs::{NurbsDefinition, NurbsError, NurbsSurface, basis_values};
 use crate::Vec2;
 use crate::mesh::{MeshTopology, PolyMesh, TopologyError};
@@ -81,11 +83,12 @@ pub enum MeshFitError {
     /// The mesh is not an oriented manifold.
     #[error("{0}")]
     Topology(#[from] TopologyError),
-    /// The mesh is not one disk-like piece.
+    /// The mesh is neither one disk-like piece nor one cylinder-like piece.
     #[error(
-        "a surface is fitted to one piece with one boundary (a disk, like a roof); this mesh \
-         has {loops} boundary loops and Euler characteristic {euler} (a cylinder has 2 loops \
-         and 0: cut it open along a seam first)"
+        "a surface is fitted to one piece with one boundary (a disk, like a roof) or two (a \
+         cylinder, like a tube or a vault, cut open along a seam); this mesh has {loops} \
+         boundary loops and Euler characteristic {euler} (a disk has 1 loop and 1, a cylinder \
+         2 and 0)"
     )]
     NotADisk {
         /// Boundary loops found.
@@ -142,10 +145,11 @@ pub struct MeshFit {
     pub mean_distance: f64,
 }
 
-/// Fits a smooth surface to a triangulated disk (see the module documentation).
+/// Fits a smooth surface to a triangulated disk or cylinder (see the module documentation).
 ///
-/// Input: an oriented triangle mesh with one boundary loop; output: the surface, the vertex
-/// parameters and the fit distances. Errors: [`MeshFitError`].
+/// Input: an oriented triangle mesh with one boundary loop, or two (a cylinder, cut open along
+/// a seam first); output: the surface, the vertex parameters and the fit distances. Errors:
+/// [`MeshFitError`].
 pub fn fit_mesh_surface(
     mesh: &PolyMesh,
     options: &MeshFitOptions,
@@ -181,7 +185,26 @@ pub fn fit_mesh_surface(
     }
     let loops = boundary_loops(mesh, &topo);
     let euler = mesh.num_vertices() as i64 - topo.edges().len() as i64 + mesh.num_faces() as i64;
-    if loops.len() != 1 || euler != 1 {
+    let not_a_disk = MeshFitError::NotADisk {
+        loops: loops.len(),
+        euler,
+    };
+    // A cylinder is cut open along a seam into a disk whose corners are the seam's ends.
+    let (cut, origin, seam_ends) = match (loops.len(), euler) {
+        (1, 1) => (None, None, None),
+        (2, 0) => {
+            let c = cut_open_cylinder(mesh, &topo, &[loops[0].clone(), loops[1].clone()])
+                .ok_or(not_a_disk)?;
+            (Some(c.mesh), Some(c.origin), Some(c.ends))
+        }
+        _ => return Err(not_a_disk),
+    };
+    let disk = cut.as_ref().unwrap_or(mesh);
+    let loops = match &cut {
+        Some(d) => boundary_loops(d, &MeshTopology::new(d)?),
+        None => loops,
+    };
+    if loops.len() != 1 {
         return Err(MeshFitError::NotADisk {
             loops: loops.len(),
             euler,
@@ -193,8 +216,16 @@ pub fn fit_mesh_surface(
         });
     }
     let boundary = &loops[0];
-    let (corners, boundary_uv) = square_boundary(mesh, boundary);
-    let uv = mean_value_map(mesh, boundary, &boundary_uv)?;
+    let corners = match seam_ends {
+        Some(ends) => {
+            let mut at = ends.map(|e| boundary.iter().position(|&v| v == e).unwrap_or(0));
+            at.sort_unstable();
+            at
+        }
+        None => square_corners(disk, boundary),
+    };
+    let boundary_uv = square_boundary(disk, boundary, &corners);
+    let disk_uv = mean_value_map(disk, boundary, &boundary_uv)?;
     let (nu, nv) = match options.control_points {
         Some((nu, nv)) => {
             if !(4..=1000).contains(&nu) || !(4..=1000).contains(&nv) {
@@ -204,9 +235,11 @@ pub fn fit_mesh_surface(
             }
             (nu, nv)
         }
-        None => net_size(mesh, boundary, &corners),
+        None => net_size(disk, boundary, &corners),
     };
-    let surface = least_squares_bspline(mesh, &uv, nu, nv, options.fairness)?;
+    let surface = least_squares_bspline(disk, &disk_uv, nu, nv, options.fairness)?;
+    // Distances of the input's vertices (a seam vertex at its first copy's parameters).
+    let uv = disk_uv[..mesh.num_vertices()].to_vec();
     let (mut max_distance, mut sum) = (0.0f64, 0.0);
     for (p, t) in mesh.positions.iter().zip(&uv) {
         let d = surface
@@ -215,10 +248,11 @@ pub fn fit_mesh_surface(
         max_distance = max_distance.max(d);
         sum += d;
     }
+    let input_vertex = |v: u32| origin.as_ref().map_or(v, |o| o[v as usize]) as usize;
     Ok(MeshFit {
         surface,
         uv,
-        corners: corners.map(|k| boundary[k] as usize),
+        corners: corners.map(|k| input_vertex(boundary[k])),
         max_distance,
         mean_distance: sum / mesh.num_vertices() as f64,
     })
@@ -226,7 +260,7 @@ pub fn fit_mesh_surface(
 
 /// The boundary loops, each in the direction with the mesh on its left (counter-clockwise seen
 /// along the normals).
-fn boundary_loops(mesh: &PolyMesh, topo: &MeshTopology) -> Vec<Vec<u32>> {
+pub(super) fn boundary_loops(mesh: &PolyMesh, topo: &MeshTopology) -> Vec<Vec<u32>> {
     let corners: usize = mesh.faces().map(<[u32]>::len).sum();
     let mut next_from = vec![u32::MAX; mesh.num_vertices()];
     for c in 0..corners as u32 {
@@ -252,12 +286,24 @@ fn boundary_loops(mesh: &PolyMesh, topo: &MeshTopology) -> Vec<Vec<u32>> {
     loops
 }
 
-/// Picks the four boundary vertices that become the square's corners and places the boundary
-/// on the square by arc length. Corner 0 is the sharpest turn of the loop; corners 1 to 3 the
-/// sharpest turns within an eighth of the perimeter of the quarter points after it (a roof
-/// exported from a four-sided patch has its corners there; a round boundary gets its quarters).
-/// Returns the corners as positions in `boundary` and the parameters of the boundary vertices.
-fn square_boundary(mesh: &PolyMesh, boundary: &[u32]) -> ([usize; 4], Vec<Vec2>) {
+/// Arc length along the boundary loop at each of its vertices from vertex 0, and the perimeter.
+fn boundary_arc(mesh: &PolyMesh, boundary: &[u32]) -> (Vec<f64>, f64) {
+    let m = boundary.len();
+    let p = |k: usize| mesh.positions[boundary[k % m] as usize];
+    let mut arc = vec![0.0; m + 1];
+    for k in 0..m {
+        arc[k + 1] = arc[k] + (p(k + 1) - p(k)).norm();
+    }
+    let total = arc[m];
+    arc.pop();
+    (arc, total)
+}
+
+/// Picks the four boundary vertices that become the square's corners: corner 0 is the sharpest
+/// turn of the loop; corners 1 to 3 the sharpest turns within an eighth of the perimeter of the
+/// quarter points after it (a roof exported from a four-sided patch has its corners there; a
+/// round boundary gets its quarters). Returns them as positions in `boundary`, in loop order.
+fn square_corners(mesh: &PolyMesh, boundary: &[u32]) -> [usize; 4] {
     let m = boundary.len();
     let p = |k: usize| mesh.positions[boundary[k % m] as usize];
     let turn: Vec<f64> = (0..m)
@@ -267,12 +313,7 @@ fn square_boundary(mesh: &PolyMesh, boundary: &[u32]) -> ([usize; 4], Vec<Vec2>)
             a.angle(&b)
         })
         .collect();
-    // Arc length at each boundary vertex from vertex 0.
-    let mut arc = vec![0.0; m + 1];
-    for k in 0..m {
-        arc[k + 1] = arc[k] + (p(k + 1) - p(k)).norm();
-    }
-    let total = arc[m];
+    let (arc, total) = boundary_arc(mesh, boundary);
     let c0 = (0..m)
         .max_by(|&a, &b| turn[a].total_cmp(&turn[b]).then(b.cmp(&a)))
         .unwrap_or(0);
@@ -302,6 +343,15 @@ fn square_boundary(mesh: &PolyMesh, boundary: &[u32]) -> ([usize; 4], Vec<Vec2>)
             corners[q] = (corners[q - 1] + 1) % m;
         }
     }
+    corners
+}
+
+/// Places the boundary on the unit square by arc length, `corners` (positions in `boundary`, in
+/// loop order) at (0, 0), (1, 0), (1, 1), (0, 1). Returns the boundary vertices' parameters.
+fn square_boundary(mesh: &PolyMesh, boundary: &[u32], corners: &[usize; 4]) -> Vec<Vec2> {
+    let m = boundary.len();
+    let (arc, total) = boundary_arc(mesh, boundary);
+    let along = |k: usize| (arc[k] - arc[corners[0]]).rem_euclid(total);
     let square = [
         Vec2::new(0.0, 0.0),
         Vec2::new(1.0, 0.0),
@@ -324,7 +374,7 @@ fn square_boundary(mesh: &PolyMesh, boundary: &[u32]) -> ([usize; 4], Vec<Vec2>)
             }
         }
     }
-    (corners, uv)
+    uv
 }
 
 /// Floater's mean-value map: every interior vertex the weighted mean of its neighbours, weights

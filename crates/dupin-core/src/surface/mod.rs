@@ -6,6 +6,7 @@
 mod bspline_patch;
 mod closest_point;
 mod curvature;
+mod cylinder_cut;
 mod library;
 mod mesh_fit;
 mod mesh_surface;
