@@ -282,11 +282,12 @@ export async function dragImportedGrid(page, n, { dx = 12, dy = -8, moves = 20 }
   const states = (await page.evaluate(() => window.dupin.stepLog.length)) - s0;
   await page.mouse.up();
   // The state that finishes the run for the last position sent (an earlier position's run may
-  // finish after the release too).
+  // finish after the release too; the last one's before it, when the release adds no move).
   await page.waitForFunction(() => window.__up !== null && !window.dupin.dragPending, null, { timeout: 300_000 });
   const settle = await page.evaluate(() => {
-    const e = window.dupin.stepLog.find((x) => x.at > window.__up && x.dragSeq === window.dupin.dragSeq && x.phase !== 'perturb');
-    return { ms: e.at - window.__up, phase: e.phase, maxPlanarity: e.maxPlanarity };
+    // The run for the last position may have finished before the release (0 ms then).
+    const e = window.dupin.stepLog.find((x) => x.dragSeq === window.dupin.dragSeq && x.phase !== 'perturb');
+    return { ms: Math.max(0, e.at - window.__up), phase: e.phase, maxPlanarity: e.maxPlanarity };
   });
   return { middle, pointer: [at.x + dx, at.y + dy], perSecond: states / seconds, settle };
 }

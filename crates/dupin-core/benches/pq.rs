@@ -1,13 +1,14 @@
 //! PQ perturbation benchmarks: the speeds the conical paper reports are the yardstick.
 
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use dupin_core::conical::{
-    PqMode, PqOptions, StripRule, developable_subdivision, pq_perturb, principal_quad_mesh,
-    trefoil_moebius,
+    MeshRule, PqMode, PqOptions, PqSceneStepper, StripRule, developable_subdivision, pq_perturb,
+    principal_quad_mesh, trefoil_moebius,
 };
 use dupin_core::mesh::{catmull_clark, max_planarity};
 use dupin_core::scenes::benchmark_meshes::{noisy_vase, skew_quad_grid, torus_centroid_dual};
 use dupin_core::surface::SurfaceOfRevolution;
+use dupin_core::{Stepper, Vec3};
 use std::hint::black_box;
 
 /// CPU time of this thread in seconds (Linux `schedstat`), to separate our own work from the
@@ -53,6 +54,43 @@ fn subdivided_conical_vase() -> dupin_core::mesh::PolyMesh {
     m
 }
 
+/// The page's drag benchmark (`tests/e2e/bench-drag.mjs`) natively: an n x n quad grid of
+/// edge 2 with +-1e-3 of height noise (the same generator), planarised keeping the design
+/// and committed; returns the stepper and its middle vertex.
+fn committed_grid(n: usize) -> (PqSceneStepper, usize) {
+    let mut seed: u64 = 11;
+    let mut rnd = || {
+        seed = (seed * 1_103_515_245 + 12_345) % 2_147_483_648;
+        seed as f64 / 2_147_483_648.0
+    };
+    let mut points = vec![];
+    for i in 0..=n {
+        for j in 0..=n {
+            points.push(Vec3::new(
+                2.0 * i as f64,
+                2.0 * j as f64,
+                (rnd() - 0.5) * 0.002,
+            ));
+        }
+    }
+    let mesh = dupin_core::mesh::PolyMesh::quad_grid(points, n, n).unwrap();
+    let options = PqOptions {
+        keep_design: true,
+        ..PqOptions::default()
+    };
+    let mut s = PqSceneStepper::for_mesh(&mesh, MeshRule::CatmullClark, 0, options).unwrap();
+    s.commit().unwrap();
+    (s, (n / 2) * (n + 1) + n / 2)
+}
+
+/// A drag of 1.2 edge lengths (five quarter-edge stages), in and out of the grid's plane.
+const DRAG: [f64; 3] = [1.8, 1.2, 1.2];
+
+fn drag(s: &mut PqSceneStepper, v: usize, to: Vec3) {
+    s.hold_vertex(v, to).unwrap();
+    s.run_to_end().unwrap();
+}
+
 fn bench(c: &mut Criterion) {
     let grid = skew_quad_grid(30, 30.0);
     let dual = torus_centroid_dual(48, 24, 3.0, 1.0);
@@ -95,6 +133,22 @@ fn bench(c: &mut Criterion) {
             t.elapsed().as_secs_f64()
         );
     }
+    let (mut s, middle) = committed_grid(100);
+    let target = s.mesh().positions[middle] + Vec3::from(DRAG);
+    {
+        let before = s.iteration();
+        let t = std::time::Instant::now();
+        let c0 = thread_cpu_seconds();
+        drag(&mut s, middle, target);
+        let cpu = c0.and_then(|c| Some(thread_cpu_seconds()? - c));
+        eprintln!(
+            "drag-grid-100x100: cpu {cpu:.4?} s, iterations {} converged {} max_planarity {:.3e} time {:.4} s",
+            s.iteration() - before,
+            s.converged(),
+            max_planarity(s.mesh()),
+            t.elapsed().as_secs_f64()
+        );
+    }
     let mut g = c.benchmark_group("pq");
     g.bench_function("planarize trefoil Moebius band 336 quads", |b| {
         b.iter(|| black_box(&trefoil).perturb(planar.clone()).unwrap())
@@ -108,6 +162,13 @@ fn bench(c: &mut Criterion) {
     });
     g.bench_function("conical optimisation 5913 vertices (subdivided)", |b| {
         b.iter(|| pq_perturb(black_box(&vase), conical.clone()).unwrap())
+    });
+    g.bench_function("drag a vertex of a 100x100 quad grid 1.2 edges", |b| {
+        b.iter_batched(
+            || committed_grid(100).0,
+            |mut s| drag(&mut s, middle, black_box(target)),
+            BatchSize::PerIteration,
+        )
     });
     g.finish();
 }

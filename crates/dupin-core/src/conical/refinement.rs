@@ -177,7 +177,7 @@ pub struct PqSceneStepper {
     pub(super) perturbation: Option<PqPerturbation>,
     pub(super) mesh: PolyMesh,
     /// Iterations of the finished perturbations.
-    done_iterations: usize,
+    pub(super) done_iterations: usize,
     /// Iterations of the running perturbation.
     pub(super) running_iterations: usize,
     pub(super) converged: bool,
@@ -317,6 +317,9 @@ impl PqSceneStepper {
         if !self.perturbation.as_ref().is_some_and(|p| p.is_done()) {
             return Ok(());
         }
+        if self.continue_edit() || self.restart_edit_slowly()? {
+            return Ok(());
+        }
         let mut finished = self.perturbation.take().expect("a finished perturbation");
         let analyses = finished.take_analyses();
         let Ok(r) = finished.finish();
@@ -346,7 +349,7 @@ impl PqSceneStepper {
     }
 
     /// Takes the positions of the perturbation's mesh (for strips, of the cut-open mesh).
-    fn show(&mut self, perturbed: PolyMesh) {
+    pub(super) fn show(&mut self, perturbed: PolyMesh) {
         match &mut self.target {
             Target::Mesh(_) => self.mesh = perturbed,
             Target::Strip { strip, .. } => {
@@ -425,7 +428,8 @@ impl Stepper for PqSceneStepper {
         self.phase == PqScenePhase::Done
     }
 
-    /// The running perturbation's iterations under its cap, then per level still to come a
+    /// The running perturbation's iterations under its cap, then those of a live edit's
+    /// stages still to come, then per level still to come a
     /// subdivision and a perturbation's cap.
     fn steps_left_at_most(&self) -> Option<usize> {
         if self.is_done() {
@@ -436,12 +440,11 @@ impl Stepper for PqSceneStepper {
             .as_ref()
             .and_then(|p| p.steps_left_at_most())
             .unwrap_or(0);
-        let stages = self.edit_stages.as_ref().map_or(0, |s| s.remaining());
-        Some(
-            running
-                + stages * self.options.max_iterations
-                + (self.levels - self.level) * (1 + self.options.max_iterations),
-        )
+        let stages = self
+            .edit_stages
+            .as_ref()
+            .map_or(0, |s| s.steps_at_most(self.options.max_iterations));
+        Some(running + stages + (self.levels - self.level) * (1 + self.options.max_iterations))
     }
 
     /// The current state and its measures (computed on the current mesh).

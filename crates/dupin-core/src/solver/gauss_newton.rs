@@ -492,6 +492,32 @@ impl LevenbergMarquardt {
         self.chord_step_blocks(&Scalar::new(problem), x)
     }
 
+    /// Keeps the last factorisation for chord steps on a changed problem of the same layout
+    /// and Jacobian pattern (e.g. a held vertex moved): evaluates `problem` at `x`, the point
+    /// the last accepted step reached, as the residual the next
+    /// [`Self::chord_step_blocks`] starts from. False (and no chord step ready) when there
+    /// is no factorisation to keep, `x` is not that point, or the evaluation fails or
+    /// changes the pattern.
+    pub(crate) fn keep_factor_for<P: BlockLeastSquares + ?Sized>(
+        &mut self,
+        problem: &P,
+        x: &[f64],
+    ) -> bool {
+        if !self.chord_ready || self.cached_x.as_deref() != Some(x) {
+            self.chord_ready = false;
+            return false;
+        }
+        self.trial_sys.clear();
+        let ok = problem.evaluate(x, &mut self.trial_sys).is_ok()
+            && self.trial_sys.validate(problem.layout()).is_ok()
+            && self.sys.same_pattern(&self.trial_sys);
+        if !ok {
+            self.chord_ready = false;
+            self.cached_x = None;
+        }
+        ok
+    }
+
     /// [`Self::chord_step`] for a block problem.
     pub(crate) fn chord_step_blocks<P: BlockLeastSquares + ?Sized>(
         &mut self,

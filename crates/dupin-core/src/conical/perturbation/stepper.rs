@@ -112,6 +112,9 @@ pub struct PqPerturbation {
     chord: bool,
     /// See [`PqResult::refused`].
     refused: bool,
+    /// The iteration at which the run stops: [`PqOptions::max_iterations`] after its start,
+    /// or after the start of its last [`PqPerturbation::restage`].
+    iteration_cap: usize,
 }
 
 /// A finished perturbation's analyses of its sparsity patterns (penalty and exact phase), for
@@ -222,6 +225,7 @@ impl PqPerturbation {
         let scale_for_sqp = terms.scale;
         let factor_limit = o.max_factor_bytes;
         let probe_allowed = o.refinement == Refinement::GaussNewton && o.penalty_iterations > 1;
+        let iteration_cap = o.max_iterations;
         let mut s = PqPerturbation {
             mesh: mesh.clone(),
             work,
@@ -248,6 +252,7 @@ impl PqPerturbation {
             last: (f64::INFINITY, f64::INFINITY),
             chord: false,
             refused: false,
+            iteration_cap,
         };
         s.last = s.measures();
         if s.is_converged() {
@@ -268,6 +273,73 @@ impl PqPerturbation {
             lm: self.lm.take_analysis(),
             exact: self.exact.take_analysis(),
         }
+    }
+
+    /// Moves the held vertices `moved` (vertex, position in the user's coordinates) and
+    /// continues from the current mesh in the exact phase, its first steps chord steps on the
+    /// last factorisation: the next stage of a live edit (live_edit.rs), a quarter edge on
+    /// from a converged stage, which the factor of that stage's Jacobian brings back to the
+    /// constraints in a few triangular solves where a fresh perturbation (a penalty step, a
+    /// probe, Newton steps) takes three to four factorisations. False, and nothing changed,
+    /// unless this run converged in the exact phase with its factorisation still held; a
+    /// stage that fails from here ends not converged like any run.
+    pub(crate) fn restage(&mut self, moved: &[(usize, Vec3)]) -> bool {
+        if !self.converged
+            || self.options.refinement != Refinement::GaussNewton
+            || moved.iter().any(|&(v, _)| self.terms.var_of[v] != NONE)
+        {
+            return false;
+        }
+        let mut work = self.work.clone();
+        for &(v, p) in moved {
+            work.positions[v] = self.frame.to_solver(p);
+        }
+        let problem = Problem {
+            mesh: &work,
+            topo: &self.topo,
+            terms: &self.terms,
+            mode: self.options.mode,
+            determinant_terms: self.options.determinant_terms,
+            w_fair: self.w_fair,
+            w_close: self.w_close,
+        };
+        if !self.exact.keep_factor_for(&Feasibility(&problem), &self.x) {
+            return false;
+        }
+        self.work = work;
+        for &(v, p) in moved {
+            self.mesh.positions[v] = p;
+        }
+        self.phase = PqPhase::Sqp;
+        self.probe = false;
+        self.chord = true;
+        self.converged = false;
+        self.reason = None;
+        self.iteration_cap = self.iteration + self.options.max_iterations;
+        self.last = self.measures();
+        if self.is_converged() {
+            self.phase = PqPhase::Done;
+            self.converged = true;
+        }
+        true
+    }
+
+    /// Starts in the exact phase, its first step the probe of [`PROBE_CONTRACTION`] (a
+    /// penalty step when the probe fails); true when it does (a run not started whose options
+    /// allow the probe). For a mesh that is planar but where its held vertices moved, the
+    /// first stage of a live edit: the penalty phase is there to bring a mesh from far, and
+    /// from a planar mesh a quarter edge away its first step only costs a factorisation.
+    pub(crate) fn start_exact(&mut self) -> bool {
+        let start = self.phase == PqPhase::Penalty && self.iteration == 0 && self.probe_allowed;
+        if start {
+            self.enter_refinement(true);
+        }
+        start
+    }
+
+    /// Whether the run has reached the tolerance (so far).
+    pub(crate) fn converged(&self) -> bool {
+        self.converged
     }
 
     /// Symbolic analyses of sparsity patterns behind this perturbation's solvers, those of
@@ -421,7 +493,7 @@ impl PqPerturbation {
         if self.is_converged() {
             self.phase = PqPhase::Done;
             self.converged = true;
-        } else if self.iteration >= self.options.max_iterations {
+        } else if self.iteration >= self.iteration_cap {
             self.phase = PqPhase::Done;
             self.reason = Some(format!(
                 "iteration cap {} reached (max_planarity {:.3e}, mode residual {:.3e}){}",
@@ -480,7 +552,7 @@ impl PqPerturbation {
     }
 
     /// Sparse factorisations so far (penalty and exact phase).
-    fn factorizations(&self) -> usize {
+    pub(crate) fn factorizations(&self) -> usize {
         self.lm.factorizations() + self.exact.factorizations()
     }
 }
@@ -508,7 +580,7 @@ impl Stepper for PqPerturbation {
         Some(if self.is_done() {
             0
         } else {
-            self.options.max_iterations.saturating_sub(self.iteration)
+            self.iteration_cap.saturating_sub(self.iteration)
         })
     }
 
