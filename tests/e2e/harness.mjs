@@ -260,7 +260,7 @@ export function objVertices(text) {
   return text.split('\n').filter((l) => l.startsWith('v ')).map((l) => l.split(' ').slice(1, 4).map(Number));
 }
 
-export async function dragImportedGrid(page, n, { dx = 12, dy = -8, moves = 20 } = {}) {
+export async function dragImportedGrid(page, n, { dx = 12, dy = -8, moves = 20, pause = 25 } = {}) {
   const text = await openImportedGrid(page, n);
   const middle = (n / 2) * (n + 1) + n / 2;
   const [[ax, ay]] = await onScreen(page, [objVertices(text)[middle]]);
@@ -276,7 +276,7 @@ export async function dragImportedGrid(page, n, { dx = 12, dy = -8, moves = 20 }
   await page.mouse.down();
   for (let i = 1; i <= moves; i++) {
     await page.mouse.move(at.x + (dx * i) / moves, at.y + (dy * i) / moves);
-    await page.waitForTimeout(25);
+    await page.waitForTimeout(pause);
   }
   const seconds = (Date.now() - t0) / 1000;
   const states = (await page.evaluate(() => window.dupin.stepLog.length)) - s0;
