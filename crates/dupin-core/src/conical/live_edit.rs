@@ -160,9 +160,9 @@ impl EditStages {
 
     /// Most perturbation iterations the edit takes after the running one's, each perturbation
     /// capped at `cap`: one perturbation per stage to come, and while the edit runs fast, the
-    /// slow run of every stage after it.
+    /// slow way's remake of the whole edit.
     pub(super) fn steps_at_most(&self, cap: usize) -> usize {
-        (self.remaining() + if self.fast { self.total } else { 0 }) * cap
+        (self.remaining() + if self.fast { self.count(STAGE) } else { 0 }) * cap
     }
 
     /// Why the edit stopped at the running stage (it did not reach the tolerance).
@@ -432,6 +432,8 @@ mod tests {
         // The fast way: stages of an edge, 2 for the group; gone slow, 6 from the first.
         let mut fast = super::EditStages::new(&mesh, vec![4, 0], vec![to, corner], true);
         assert_eq!(fast.total, 2);
+        // Its progress bound: the fast stage to come, then a slow remake of six stages.
+        assert_eq!(fast.steps_at_most(10), (1 + 6) * 10);
         fast.stage = 2;
         fast.go_slow();
         assert_eq!((fast.fast, fast.stage, fast.total), (false, 1, 6));
