@@ -12,7 +12,7 @@
 use super::circular::circular_residual;
 use super::cones::conical_residual;
 use super::developable_strip::{PqStrip, StripRule};
-use super::perturbation::{PqError, PqMode, PqOptions, PqPerturbation, PqPhase};
+use super::perturbation::{PqAnalyses, PqError, PqMode, PqOptions, PqPerturbation, PqPhase};
 use crate::Stepper;
 use crate::mesh::{MeshTopology, PolyMesh, TopologyError, catmull_clark, doo_sabin, max_planarity};
 use thiserror::Error;
@@ -187,6 +187,9 @@ pub struct PqSceneStepper {
     pub(super) edit_stages: Option<super::live_edit::EditStages>,
     /// Why the last live edit stopped short of its target.
     pub(super) edit_shortfall: Option<String>,
+    /// The analyses of the last finished live edit's perturbation, for the next edit (the
+    /// page's next pointer position: the same mesh and held vertices).
+    pub(super) edit_analyses: Option<PqAnalyses>,
 }
 
 /// Why a finished PQ scene misses what it was asked (a perturbation level that did not reach
@@ -245,6 +248,7 @@ impl PqSceneStepper {
             edit_base: None,
             edit_stages: None,
             edit_shortfall: None,
+            edit_analyses: None,
         })
     }
 
@@ -275,6 +279,7 @@ impl PqSceneStepper {
             edit_base: None,
             edit_stages: None,
             edit_shortfall: None,
+            edit_analyses: None,
         })
     }
 
@@ -341,6 +346,9 @@ impl PqSceneStepper {
                 p.adopt_analyses(analyses);
             }
             return Ok(());
+        }
+        if self.edit_base.is_some() {
+            self.edit_analyses = Some(analyses.face_space_only());
         }
         if self.level == self.levels {
             self.phase = PqScenePhase::Done;

@@ -129,7 +129,7 @@ impl Structure {
             }
         }
         let upper = SymbolicSparseColMat::new_checked(n, n, scol, None, srow);
-        let perm = block_ordering(nk, &pattern)?;
+        let perm = fill_reducing_ordering(nk, &pattern)?;
         let mut fwd = Vec::with_capacity(n);
         for &b in &perm {
             let o = layout.offset(b as usize);
@@ -183,12 +183,15 @@ impl Structure {
     }
 }
 
-/// The fill-reducing ordering of the kept blocks (`perm[new] = old`) for the block pattern
-/// `pattern` (upper triangle, diagonal included): AMD, and from [`DISSECTION_FROM`] blocks
-/// on nested dissection too, keeping whichever gives the smaller Cholesky factor of the
-/// pattern (each block's unknowns are then numbered together, so the scalar factor follows
-/// the block one).
-fn block_ordering(nk: usize, pattern: &SymbolicSparseColMat<u32>) -> Result<Vec<u32>, SolverError> {
+/// The fill-reducing ordering (`perm[new] = old`) of the `nk` nodes of `pattern` (upper
+/// triangle, diagonal included; nodes are the kept blocks here, scalar unknowns in face
+/// space): AMD, and from [`DISSECTION_FROM`] nodes on nested dissection too, keeping
+/// whichever gives the smaller Cholesky factor of the pattern (for blocks, each block's
+/// unknowns are then numbered together, so the scalar factor follows the block one).
+pub(crate) fn fill_reducing_ordering(
+    nk: usize,
+    pattern: &SymbolicSparseColMat<u32>,
+) -> Result<Vec<u32>, SolverError> {
     let perm = amd_ordering(pattern)?;
     if nk < DISSECTION_FROM {
         return Ok(perm);

@@ -26,10 +26,12 @@ mod nested_dissection;
 mod pattern;
 mod sqp;
 
+pub(crate) use block_normal::fill_reducing_ordering;
 pub(crate) use block_system::{BlockLayout, BlockSystem};
 pub(crate) use cholesky::SparseCholesky;
 pub(crate) use gauss_newton::{BlockLeastSquares, LmAnalysis};
 pub use gauss_newton::{LevenbergMarquardt, LmOptions, LmStep, NonlinearLeastSquares};
+pub(crate) use pattern::csc_pattern;
 pub use sqp::{ConstrainedLeastSquares, Sqp, SqpOptions, SqpStep};
 
 use thiserror::Error;

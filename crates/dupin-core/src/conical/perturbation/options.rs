@@ -47,7 +47,12 @@ pub struct PqOptions {
     /// the design's unit or its distance from the origin. Off
     /// for the library's scenes (meshes made to be fair, where the settings were tuned); on
     /// in `dupin planarize`. Measured on a 20 m planar quad grid with ±1 mm noise, 40 x 40:
-    /// max_move 287 mm off, 1.25 mm on; 200 x 200: 201 mm off, 1.17 mm on.
+    /// max_move 287 mm off, 1.25 mm on; 200 x 200: 201 mm off, 1.17 mm on. In planar mode on
+    /// a mesh of quads the run starts with the least move onto planar quads, solved in face
+    /// space (one unknown per quad), and keeps to it when its first step divides the
+    /// planarity by 10 or more (the design is then near planar, and its nearest planar mesh is
+    /// the one asked for: closeness and fairness do not enter); otherwise it starts again from
+    /// the input, penalty phase first.
     pub keep_design: bool,
     /// Convergence: contract `max_planarity` and the mode's residual (radians) both at most
     /// this (> 0).

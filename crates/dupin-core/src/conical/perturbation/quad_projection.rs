@@ -1,0 +1,378 @@
+//! The least move onto planar quads, solved in face space: the exact phase of a live edit of
+//! a quad mesh (conical paper, Sec. 2.2: "a PQ mesh near the given one").
+//!
+//! Input: the solver-frame positions of an all-quad mesh, its free vertices (the anchors and
+//! held vertices have no unknowns) and the unknowns' layout; output: one Gauss-Newton step on
+//! the constraints `det(ê₀, ê₁, ê₂) = 0` per quad (unit vectors along three consecutive edges,
+//! zero exactly when the quad is planar), of least Euclidean length:
+//!
+//! `Δx = -Jᵀ λ`, `(J Jᵀ) λ = c`,
+//!
+//! with `c` the determinants and `J` their gradients with respect to the free vertices. The
+//! matrix `J Jᵀ` has one unknown per quad (its multiplier `λ`), coupled to the quads sharing a
+//! vertex with it. The exact phase of [`super::PqPerturbation`] solves the same least-move
+//! problem on the vertex positions and one plane per face, its normal matrix one 3 x 3 block
+//! per vertex after the planes are eliminated: three times the unknowns on the same graph, so
+//! its supernodal factor takes about 27 times the floating-point work of this one (a
+//! 10 000-quad grid: 60 ms natively per factorisation against a few here, and in wasm, whose
+//! dense kernels run two lanes without fused multiply-add against AVX-512's eight, 0.25 s).
+//! A live edit moves a vertex of a planar mesh, so every Newton step is near the constraints,
+//! where the determinants are as good a measure of planarity as the planes.
+//!
+//! Only planar mode on meshes of quads: a polygon of `n` vertices needs `n - 3` determinants,
+//! whose conditioning depends on which vertices they take, and the conical and circular
+//! conditions are not determinants.
+
+use crate::Vec3;
+use crate::conical::discrete_terms::quad_det_grad;
+use crate::mesh::PolyMesh;
+use crate::solver::{SolverError, SparseCholesky, csc_pattern, fill_reducing_ordering};
+
+/// Marks a vertex without unknowns.
+const FIXED: u32 = u32::MAX;
+
+/// Relative Levenberg damping of the face-space matrix: it keeps a quad whose four vertices
+/// are all held (a zero row) from making the matrix singular and is far below the
+/// determinants' curvature, so the steps stay Newton steps.
+const DAMPING: f64 = 1e-12;
+
+/// Step halvings tried when a full step raises the residual.
+const HALVINGS: usize = 4;
+
+#[cfg(test)]
+thread_local! {
+    /// Tests only: every step fails (to exercise what a live edit does when its fast way
+    /// misses, which no move found by a search over the library's quad meshes does).
+    pub(crate) static FAIL_STEPS: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// The face-space least-move projection of one all-quad mesh with fixed free vertices (the
+/// pattern of `J Jᵀ` and its analysed Cholesky factor, kept across steps and stages).
+pub(super) struct QuadProjection {
+    /// What the pattern was made for: the quads and the unknowns of their vertices.
+    faces: Vec<u32>,
+    var_of: Vec<u32>,
+    /// For every free vertex, its incident (quad, corner) pairs, `incident[start[v]..start[v+1]]`.
+    start: Vec<u32>,
+    incident: Vec<(u32, u8)>,
+    /// For every pair of corners at one free vertex (in the order [`Self::assemble`] walks
+    /// them), where its product lands in the factor's values.
+    slots: Vec<u32>,
+    /// Where each quad's diagonal entry lands.
+    diagonal: Vec<u32>,
+    cholesky: SparseCholesky,
+    values: Vec<f64>,
+    grads: Vec<[Vec3; 4]>,
+    residual: Vec<f64>,
+    factorizations: usize,
+}
+
+impl QuadProjection {
+    /// Whether `mesh` can be projected so: every face a quad.
+    pub(super) fn applies(mesh: &PolyMesh) -> bool {
+        mesh.num_faces() > 0 && mesh.faces().all(|f| f.len() == 4)
+    }
+
+    /// The pattern and its analysis for `mesh` (all quads) whose vertex `v` has its unknowns at
+    /// `var_of[v] .. + 3` (`u32::MAX` for none). Refused like the other solvers when the factor
+    /// would take more than `max_factor_bytes`.
+    pub(super) fn new(
+        mesh: &PolyMesh,
+        var_of: &[u32],
+        max_factor_bytes: usize,
+    ) -> Result<Self, SolverError> {
+        let nf = mesh.num_faces();
+        let nv = mesh.num_vertices();
+        let mut start = vec![0u32; nv + 1];
+        for f in mesh.faces() {
+            for &v in f {
+                if var_of[v as usize] != FIXED {
+                    start[v as usize + 1] += 1;
+                }
+            }
+        }
+        for v in 0..nv {
+            start[v + 1] += start[v];
+        }
+        let mut fill = start.clone();
+        let mut incident = vec![(0u32, 0u8); start[nv] as usize];
+        for (q, f) in mesh.faces().enumerate() {
+            for (k, &v) in f.iter().enumerate() {
+                if var_of[v as usize] != FIXED {
+                    incident[fill[v as usize] as usize] = (q as u32, k as u8);
+                    fill[v as usize] += 1;
+                }
+            }
+        }
+        // The upper triangle's entries: every quad's diagonal, then the pairs at each vertex.
+        let mut pairs: Vec<(u32, u32)> = (0..nf as u32).map(|q| (q, q)).collect();
+        for v in 0..nv {
+            let at = &incident[start[v] as usize..start[v + 1] as usize];
+            for (i, &(a, _)) in at.iter().enumerate() {
+                for &(b, _) in &at[i..] {
+                    pairs.push((a.min(b), a.max(b)));
+                }
+            }
+        }
+        let (pattern, csc_slot) = csc_pattern(nf, &pairs)?;
+        let order = fill_reducing_ordering(nf, &pattern)?;
+        let cholesky = SparseCholesky::analyse_within(pattern.as_ref(), &order, max_factor_bytes)?;
+        let slot = |k: usize| cholesky.positions()[csc_slot[k] as usize];
+        let diagonal = (0..nf).map(slot).collect();
+        let slots = (nf..pairs.len()).map(slot).collect();
+        let values = vec![0.0; cholesky.nnz()];
+        Ok(QuadProjection {
+            faces: mesh.faces().flatten().copied().collect(),
+            var_of: var_of.to_vec(),
+            start,
+            incident,
+            slots,
+            diagonal,
+            cholesky,
+            values,
+            grads: vec![[Vec3::zeros(); 4]; nf],
+            residual: vec![0.0; nf],
+            factorizations: 0,
+        })
+    }
+
+    /// Whether this projection was made for `mesh`'s quads with these unknowns.
+    pub(super) fn covers(&self, mesh: &PolyMesh, var_of: &[u32]) -> bool {
+        self.var_of == var_of && mesh.faces().flatten().eq(self.faces.iter())
+    }
+
+    /// Sparse factorisations so far.
+    pub(super) fn factorizations(&self) -> usize {
+        self.factorizations
+    }
+
+    /// The quads' determinants and their gradients at the positions `p` (the solver's frame):
+    /// the squared residual norm, or an error for a degenerate quad (an edge of length zero).
+    fn evaluate(&mut self, mesh: &PolyMesh, p: &[Vec3]) -> Result<f64, SolverError> {
+        let mut cost = 0.0;
+        for (q, f) in mesh.faces().enumerate() {
+            let (d, g) = quad_det_grad(std::array::from_fn(|k| p[f[k] as usize]));
+            if !d.is_finite() || g.iter().any(|g| !g.iter().all(|c| c.is_finite())) {
+                return Err(SolverError::NonFinite);
+            }
+            self.residual[q] = d;
+            self.grads[q] = g;
+            cost += d * d;
+        }
+        Ok(cost)
+    }
+
+    /// One least-move Gauss-Newton step of the free vertices of `x` (the unknowns of
+    /// [`super::PqPerturbation`]: three per free vertex at `var_of`) towards planar quads, its
+    /// length halved up to [`HALVINGS`] times until it lowers the determinants' squared sum;
+    /// `work` holds the positions of `x` (the solver's frame) and follows it. Fails when no
+    /// step lowers it (or the factorisation fails), `x` unchanged then.
+    pub(super) fn step(
+        &mut self,
+        mesh: &PolyMesh,
+        work: &mut [Vec3],
+        var_of: &[u32],
+        x: &mut [f64],
+    ) -> Result<(), SolverError> {
+        #[cfg(test)]
+        if FAIL_STEPS.get() {
+            return Err(SolverError::Factorization("failing on purpose".into()));
+        }
+        let before = self.evaluate(mesh, work)?;
+        if before == 0.0 {
+            return Ok(());
+        }
+        self.assemble();
+        self.cholesky.factorize(&self.values)?;
+        self.factorizations += 1;
+        let mut lambda = self.residual.clone();
+        self.cholesky.solve_in_place(&mut lambda)?;
+        // Δv = -Σ λ_q ∇_v c_q over the quads at v.
+        let nv = work.len();
+        let mut delta = vec![Vec3::zeros(); nv];
+        for (v, d) in delta.iter_mut().enumerate() {
+            for &(q, k) in &self.incident[self.start[v] as usize..self.start[v + 1] as usize] {
+                *d -= self.grads[q as usize][k as usize] * lambda[q as usize];
+            }
+        }
+        let start: Vec<Vec3> = work.to_vec();
+        let mut t = 1.0;
+        for _ in 0..=HALVINGS {
+            for v in 0..nv {
+                if var_of[v] != FIXED {
+                    work[v] = start[v] + delta[v] * t;
+                }
+            }
+            if self.evaluate(mesh, work).is_ok_and(|after| after < before) {
+                for v in 0..nv {
+                    let b = var_of[v];
+                    if b != FIXED {
+                        let b = b as usize;
+                        x[b..b + 3].copy_from_slice(work[v].as_slice());
+                    }
+                }
+                return Ok(());
+            }
+            t *= 0.5;
+        }
+        work.copy_from_slice(&start);
+        Err(SolverError::Factorization(
+            "no least-move step lowers the quads' non-planarity".into(),
+        ))
+    }
+
+    /// Writes `J Jᵀ` (and the damping on its diagonal) into the factor's values.
+    fn assemble(&mut self) {
+        self.values.iter_mut().for_each(|v| *v = 0.0);
+        let mut s = 0;
+        for v in 0..self.start.len() - 1 {
+            let at = &self.incident[self.start[v] as usize..self.start[v + 1] as usize];
+            for (i, &(a, ka)) in at.iter().enumerate() {
+                let ga = self.grads[a as usize][ka as usize];
+                for &(b, kb) in &at[i..] {
+                    self.values[self.slots[s] as usize] +=
+                        ga.dot(&self.grads[b as usize][kb as usize]);
+                    s += 1;
+                }
+            }
+        }
+        let mean = self
+            .diagonal
+            .iter()
+            .map(|&d| self.values[d as usize])
+            .sum::<f64>()
+            / self.diagonal.len().max(1) as f64;
+        let damping = DAMPING * mean.max(f64::MIN_POSITIVE);
+        for &d in &self.diagonal {
+            self.values[d as usize] += damping;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::max_planarity;
+    use nalgebra::{DMatrix, DVector};
+
+    /// Three unknowns per vertex not in `fixed`, and their values.
+    fn unknowns(mesh: &PolyMesh, fixed: &[usize]) -> (Vec<u32>, Vec<f64>) {
+        let (mut var_of, mut x) = (Vec::new(), Vec::new());
+        for (v, p) in mesh.positions.iter().enumerate() {
+            if fixed.contains(&v) {
+                var_of.push(FIXED);
+            } else {
+                var_of.push(x.len() as u32);
+                x.extend(p.iter());
+            }
+        }
+        (var_of, x)
+    }
+
+    /// An `n x n` grid over a translational surface z = f(x) + g(y), whose grid quads are
+    /// planar, with vertex `(i, j)` at index `j (n + 1) + i`.
+    fn translational_grid(n: usize) -> PolyMesh {
+        let positions = (0..=n)
+            .flat_map(|j| (0..=n).map(move |i| (i as f64 / n as f64, j as f64 / n as f64)))
+            .map(|(x, y)| Vec3::new(x, y, 0.3 * x * x - 0.2 * (3.0 * y).sin()))
+            .collect();
+        PolyMesh::quad_grid(positions, n, n).unwrap()
+    }
+
+    /// One step is the least move (Euclidean) of the free vertices onto the linearised
+    /// constraints, `Δ = -Jᵀ (J Jᵀ)⁻¹ c`, as a dense solve computes it; the fixed vertices
+    /// keep their bits.
+    #[test]
+    fn a_step_is_the_least_move_onto_the_linearised_constraints() {
+        let n = 5;
+        let mut mesh = translational_grid(n);
+        let mut seed = 7u64;
+        for p in &mut mesh.positions {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
+            p.z += 1e-3 * ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5);
+        }
+        let fixed = [0, n, n * (n + 1), (n + 1) * (n + 1) - 1];
+        let (var_of, mut x) = unknowns(&mesh, &fixed);
+        let x0 = x.clone();
+        // The dense least move from the determinants and their gradients.
+        let nf = mesh.num_faces();
+        let mut j = DMatrix::zeros(nf, x.len());
+        let mut c = DVector::zeros(nf);
+        for (q, f) in mesh.faces().enumerate() {
+            let (d, g) = quad_det_grad(std::array::from_fn(|k| mesh.positions[f[k] as usize]));
+            c[q] = d;
+            for (k, &v) in f.iter().enumerate() {
+                if var_of[v as usize] != FIXED {
+                    for a in 0..3 {
+                        j[(q, var_of[v as usize] as usize + a)] = g[k][a];
+                    }
+                }
+            }
+        }
+        let jjt = &j * j.transpose();
+        let dense = -(j.transpose() * jjt.lu().solve(&c).unwrap());
+        let mut p = QuadProjection::new(&mesh, &var_of, usize::MAX).unwrap();
+        let mut work = mesh.positions.clone();
+        p.step(&mesh, &mut work, &var_of, &mut x).unwrap();
+        let step = DVector::from_iterator(x.len(), x.iter().zip(&x0).map(|(a, b)| a - b));
+        assert!(
+            (&step - &dense).norm() <= 1e-9 * dense.norm(),
+            "{:e} against {:e}",
+            (&step - &dense).norm(),
+            dense.norm()
+        );
+        for &v in &fixed {
+            assert_eq!(work[v], mesh.positions[v]);
+        }
+    }
+
+    /// From a planar quad mesh with one vertex held a third of an edge away, the steps
+    /// converge quadratically (residual r to at most 10 r² once below 1e-2) to planarity
+    /// 1e-13 in a few steps, the held vertex and the boundary corners unmoved.
+    #[test]
+    fn steps_converge_quadratically_to_planar_quads() {
+        let n = 12;
+        let mut mesh = translational_grid(n);
+        assert!(max_planarity(&mesh) < 1e-14);
+        let held = 6 * (n + 1) + 5;
+        mesh.positions[held].z += 0.3 / n as f64;
+        let fixed = [held, 0, n, n * (n + 1), (n + 1) * (n + 1) - 1];
+        let (var_of, mut x) = unknowns(&mesh, &fixed);
+        let mut p = QuadProjection::new(&mesh, &var_of, usize::MAX).unwrap();
+        let mut work = mesh.positions.clone();
+        let residual = |w: &[Vec3]| {
+            mesh.faces()
+                .map(|f| {
+                    quad_det_grad(std::array::from_fn(|k| w[f[k] as usize]))
+                        .0
+                        .abs()
+                })
+                .fold(0.0, f64::max)
+        };
+        let mut r = residual(&work);
+        let mut steps = 0;
+        while r > 1e-14 {
+            p.step(&mesh, &mut work, &var_of, &mut x).unwrap();
+            steps += 1;
+            let next = residual(&work);
+            if r < 1e-2 {
+                assert!(
+                    next <= 10.0 * r * r + 1e-14,
+                    "step {steps}: {r:e} to {next:e}"
+                );
+            }
+            r = next;
+            assert!(steps <= 6, "residual {r:e} after {steps} steps");
+        }
+        let moved = PolyMesh::new(work.clone(), mesh.faces().map(|f| f.to_vec())).unwrap();
+        assert!(
+            max_planarity(&moved) <= 1e-13,
+            "{:e}",
+            max_planarity(&moved)
+        );
+        for &v in &fixed {
+            assert_eq!(work[v], mesh.positions[v]);
+        }
+        assert_eq!(p.factorizations(), steps);
+    }
+}
