@@ -83,6 +83,27 @@ fn committed_grid(n: usize) -> (PqSceneStepper, usize) {
     (s, (n / 2) * (n + 1) + n / 2)
 }
 
+/// An `n x n` grid of 0.05 edges on a saddle, its heights with seeded noise of 8% of an edge
+/// (the wasm-against-native workload of `tests/workloads_wasm.rs`).
+fn noisy_curved_grid(n: usize) -> dupin_core::mesh::PolyMesh {
+    let mut seed: u64 = 10_000;
+    let mut rnd = move || {
+        seed = seed
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut points = vec![];
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (i as f64 * 0.05, j as f64 * 0.05);
+            let z = 0.3 * ((x - 2.5).powi(2) - (y - 2.5).powi(2)) / 20.0;
+            points.push(Vec3::new(x, y, z + 0.004 * (rnd() - 0.5)));
+        }
+    }
+    dupin_core::mesh::PolyMesh::quad_grid(points, n, n).unwrap()
+}
+
 /// A drag of 1.2 edge lengths (five quarter-edge stages), in and out of the grid's plane.
 const DRAG: [f64; 3] = [1.8, 1.2, 1.2];
 
@@ -162,6 +183,19 @@ fn bench(c: &mut Criterion) {
     });
     g.bench_function("conical optimisation 5913 vertices (subdivided)", |b| {
         b.iter(|| pq_perturb(black_box(&vase), conical.clone()).unwrap())
+    });
+    // A design near planar kept (face space, what `dupin planarize` does) beside the paper's
+    // way (penalty phase, then vertices and planes) on the same 10 000 quads.
+    let noisy = noisy_curved_grid(100);
+    let keep = PqOptions {
+        keep_design: true,
+        ..PqOptions::default()
+    };
+    g.bench_function("planarize a noisy 100x100 grid keeping the design", |b| {
+        b.iter(|| pq_perturb(black_box(&noisy), keep.clone()).unwrap())
+    });
+    g.bench_function("planarize a noisy 100x100 grid the paper's way", |b| {
+        b.iter(|| pq_perturb(black_box(&noisy), planar.clone()).unwrap())
     });
     g.bench_function("drag a vertex of a 100x100 quad grid 1.2 edges", |b| {
         b.iter_batched(

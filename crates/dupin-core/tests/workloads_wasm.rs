@@ -46,8 +46,23 @@ fn hex_delaunay_16k_points_extended() {
     );
 }
 
+/// The 10k-quad noisy grid of [`planarize_10k_quads`] planarised as `dupin planarize` and the
+/// page's opened panels do, keeping the design: the least move in face space.
 #[test]
-fn planarize_10k_quads() {
+fn planarize_10k_quads_keeping_the_design() {
+    let mesh = noisy_grid_10k();
+    let options = PqOptions {
+        keep_design: true,
+        ..PqOptions::default()
+    };
+    let out = pq_perturb(&mesh, options).unwrap();
+    assert!(out.converged, "{:?}", out.reason);
+    assert!(max_planarity(&out.mesh) <= 1e-10);
+    assert!(out.max_move <= 0.004, "max_move {}", out.max_move);
+}
+
+/// A 100 x 100 quad grid on a saddle with seeded height noise of 8% of its edge.
+fn noisy_grid_10k() -> PolyMesh {
     let n = 100;
     let mut r = lcg(10_000);
     let positions: Vec<Vec3> = (0..=n)
@@ -60,7 +75,13 @@ fn planarize_10k_quads() {
         .collect();
     let mesh = PolyMesh::quad_grid(positions, n, n).unwrap();
     assert!(max_planarity(&mesh) > 1e-4, "the input is not planar");
-    let out = pq_perturb(&mesh, PqOptions::default()).unwrap();
+    mesh
+}
+
+/// The paper's way (penalty phase, then the exact phase on vertices and planes).
+#[test]
+fn planarize_10k_quads() {
+    let out = pq_perturb(&noisy_grid_10k(), PqOptions::default()).unwrap();
     assert!(out.converged, "{:?}", out.reason);
     assert!(max_planarity(&out.mesh) <= 1e-10);
 }
