@@ -1,5 +1,6 @@
-//! The least move onto planar quads, solved in face space: the exact phase of a live edit of
-//! a quad mesh (conical paper, Sec. 2.2: "a PQ mesh near the given one").
+//! The least move onto planar quads, solved in face space (conical paper, Sec. 2.2: "a PQ mesh
+//! near the given one"): the exact phase of a live edit of a quad mesh, and of a design kept
+//! near planar ([`super::PqOptions::keep_design`]) from its first step.
 //!
 //! Input: the solver-frame positions of an all-quad mesh, its free vertices (the anchors and
 //! held vertices have no unknowns) and the unknowns' layout; output: one Gauss-Newton step on
@@ -14,10 +15,11 @@
 //! problem on the vertex positions and one plane per face, its normal matrix one 3 x 3 block
 //! per vertex after the planes are eliminated: three times the unknowns on the same graph, so
 //! its supernodal factor takes about 27 times the floating-point work of this one (a
-//! 10 000-quad grid: 60 ms natively per factorisation against a few here, and in wasm, whose
-//! dense kernels run two lanes without fused multiply-add against AVX-512's eight, 0.25 s).
-//! A live edit moves a vertex of a planar mesh, so every Newton step is near the constraints,
-//! where the determinants are as good a measure of planarity as the planes.
+//! 10 000-quad grid: 60 ms natively per factorisation, and in wasm, whose dense kernels run
+//! two lanes without fused multiply-add against AVX-512's eight, 0.25 s; a whole step here,
+//! evaluation and assembly included, takes about 15 ms natively). A live edit moves a vertex
+//! of a planar mesh and a kept design is near planar, so every Newton step is near the
+//! constraints, where the determinants are as good a measure of planarity as the planes.
 //!
 //! Only planar mode on meshes of quads: a polygon of `n` vertices needs `n - 3` determinants,
 //! whose conditioning depends on which vertices they take, and the conical and circular
