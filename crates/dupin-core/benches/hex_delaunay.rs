@@ -1,11 +1,12 @@
 //! Criterion benchmarks of the hexagonal Delaunay triangulation (simple and extended
 //! refinement) on seeded uniform points, with spade's constrained Delaunay refinement at its default 30° bound on the
-//! same points as the peer, and the paper's PSLG data set (the IMR letters fixture, both modes).
+//! same points as the peer, the quality check of the extended result, and the paper's PSLG data
+//! set (the IMR letters fixture, both modes).
 //! Run: `cargo bench -p dupin-core --bench hex_delaunay -- --quick`.
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use dupin_core::Vec2;
-use dupin_core::hex_delaunay::{HexDelaunayMode, hex_delaunay};
+use dupin_core::hex_delaunay::{HexDelaunayMode, hex_delaunay, triangulation_quality};
 use dupin_core::mesh::{parse_points, parse_segments};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -58,6 +59,12 @@ fn bench(c: &mut Criterion) {
         });
         g.bench_with_input(BenchmarkId::new("spade_refine_30deg", n), &pts, |b, p| {
             b.iter(|| spade_refine(black_box(p)))
+        });
+        // The check every result gets in the tests and the CLI report: angles, edges, the
+        // Delaunay property edge by edge.
+        let t = hex_delaunay(&pts, &[], HexDelaunayMode::Extended).expect("valid input");
+        g.bench_with_input(BenchmarkId::new("quality_extended", n), &t, |b, t| {
+            b.iter(|| triangulation_quality(black_box(&t.vertices), &t.triangles))
         });
     }
     // The paper's data set 4: the letters IMR as a PSLG (75 points, 75 segments).
