@@ -8,7 +8,7 @@ for (const n of (process.argv.slice(2).length ? process.argv.slice(2) : ['32', '
   const { browser, page } = await openPage();
   try {
     const r = await dragImportedGrid(page, n, { pause: Number(process.env.PAUSE_MS ?? 25) });
-    console.log(`${n * n} quads: ${r.perSecond.toFixed(1)} states/s while dragging; ${r.settle.phase} (max planarity ${r.settle.maxPlanarity.toExponential(2)}) ${r.settle.ms.toFixed(0)} ms after release`);
+    console.log(`${n * n} quads: ${r.perSecond.toFixed(1)} states/s while dragging (pointer moves ${r.movesPerSecond.toFixed(1)}/s); ${r.settle.phase} (max planarity ${r.settle.maxPlanarity.toExponential(2)}) ${r.settle.ms.toFixed(0)} ms after release`);
   } finally {
     await browser.close();
   }

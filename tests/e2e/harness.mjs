@@ -289,7 +289,7 @@ export async function dragImportedGrid(page, n, { dx = 12, dy = -8, moves = 20, 
     const e = window.dupin.stepLog.find((x) => x.dragSeq === window.dupin.dragSeq && x.phase !== 'perturb');
     return { ms: Math.max(0, e.at - window.__up), phase: e.phase, maxPlanarity: e.maxPlanarity };
   });
-  return { middle, pointer: [at.x + dx, at.y + dy], perSecond: states / seconds, settle };
+  return { middle, pointer: [at.x + dx, at.y + dy], perSecond: states / seconds, movesPerSecond: moves / seconds, settle };
 }
 
 /** The serious and critical violations; every violation is tallied by impact in the log. */
