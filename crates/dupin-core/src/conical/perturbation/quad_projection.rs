@@ -25,13 +25,11 @@
 //! whose conditioning depends on which vertices they take, and the conical and circular
 //! conditions are not determinants.
 
+use super::problem::NONE as FIXED;
 use crate::Vec3;
 use crate::conical::discrete_terms::quad_det_grad;
 use crate::mesh::PolyMesh;
 use crate::solver::{SolverError, SparseCholesky, csc_pattern, fill_reducing_ordering};
-
-/// Marks a vertex without unknowns.
-const FIXED: u32 = u32::MAX;
 
 /// Relative Levenberg damping of the face-space matrix: it keeps a quad whose four vertices
 /// are all held (a zero row) from making the matrix singular and is far below the
