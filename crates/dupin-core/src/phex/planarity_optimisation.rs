@@ -108,15 +108,17 @@ pub struct PlanarityStep {
 
 /// Initial Levenberg-Marquardt damping, relative to the largest diagonal entry of JᵀJ.
 const INITIAL_DAMPING: f64 = 1e-8;
-/// The same for a run that takes exact steps from the start (open or tangled meshes): their
-/// first step from the dual mesh at 1e-8 raised the cost on the NURBS roof at every size
-/// measured (1k, 2k and 10k faces), and the retry at 1e-7 was the step kept, one
-/// factorisation later (a quarter of a 10k run).
+/// The same for an open mesh without self-intersecting faces (which takes exact steps from
+/// the start): its first step from the dual mesh at 1e-8 raised the cost on the NURBS roof at
+/// every size measured (1k, 2k and 10k faces), and the retry at 1e-7 was the step kept, one
+/// factorisation later (a quarter of a 10k run). A tangled start keeps 1e-8: from 1e-7 the
+/// torus at field angle -15 degrees (551 faces) kept 2 self-intersecting faces.
 const INITIAL_DIRECT_DAMPING: f64 = 1e-7;
 /// Factor by which λ and μ shrink after an iteration of truncated-CG steps (the paper shrinks
 /// λ; the CG path's safeguards were tuned with this rate).
 const CG_SHRINK: f64 = 10.0;
-/// Factor by which λ and μ shrink after an iteration of exact (Cholesky) steps. An exact step
+/// Factor by which λ and μ shrink after an iteration of exact (Cholesky) steps that leaves no
+/// self-intersecting face (untangling needs the fairness term's weight). An exact step
 /// resolves the volumes down to what the compromise with λ F_s + μ F_d leaves, so
 /// `max_planarity` follows λ: measured on the NURBS roof (10k faces), it fell by 10.2-11.2x per
 /// iteration at a 10x shrink (six iterations to 3e-11) and by 47-120x at 100x (four).
@@ -279,6 +281,11 @@ fn vertex_amd_ordering(pattern: &BlockPattern) -> Vec<u32> {
     fwd
 }
 
+/// Whether some face of `mesh` is self-intersecting (not a simple polygon in its plane).
+fn is_tangled(mesh: &PolyMesh) -> bool {
+    (0..mesh.num_faces()).any(|i| !super::report::face_info(mesh, i, 0.0).simple)
+}
+
 /// Tetrahedron volume of four points and its gradients with respect to each of them.
 #[inline]
 fn volume_and_gradients(a: Vec3, b: Vec3, c: Vec3, d: Vec3) -> (f64, [Vec3; 4]) {
@@ -395,7 +402,7 @@ impl PlanarityOptimiser {
         // with self-intersecting faces (untangling is the fairness term's job; CG can converge
         // to planar but still self-intersecting faces) and a mesh with boundary, whose boundary
         // vertices have more such freedom (CG let boundary edges shrink to a third).
-        let tangled = (0..mesh.num_faces()).any(|i| !super::report::face_info(mesh, i, 0.0).simple);
+        let tangled = is_tangled(mesh);
         let mut edge_faces: rustc_hash::FxHashMap<(u32, u32), u8> = Default::default();
         for f in mesh.faces() {
             for i in 0..f.len() {
@@ -422,7 +429,7 @@ impl PlanarityOptimiser {
             pattern,
             factor: None,
             direct: tangled || open,
-            damping: if tangled || open {
+            damping: if open && !tangled {
                 INITIAL_DIRECT_DAMPING
             } else {
                 INITIAL_DAMPING
@@ -876,7 +883,9 @@ impl PlanarityOptimiser {
             }
         }
         self.iteration += 1;
-        let shrink = if self.direct {
+        // Untangling self-intersecting faces is the fairness term's job: it keeps its weight
+        // while some are left.
+        let shrink = if self.direct && !is_tangled(mesh) {
             DIRECT_SHRINK
         } else {
             CG_SHRINK
