@@ -120,8 +120,9 @@ const CG_SHRINK: f64 = 10.0;
 /// Factor by which λ and μ shrink after an iteration of exact (Cholesky) steps that leaves no
 /// self-intersecting face (untangling needs the fairness term's weight). An exact step
 /// resolves the volumes down to what the compromise with λ F_s + μ F_d leaves, so
-/// `max_planarity` follows λ: measured on the NURBS roof (10k faces), it fell by 10.2-11.2x per
-/// iteration at a 10x shrink (six iterations to 3e-11) and by 47-120x at 100x (four).
+/// `max_planarity` follows λ: measured on the NURBS roof (10k faces), it fell by 10.6-11.5x per
+/// iteration at a 10x shrink (six iterations to 3e-11) and by 70-160x at 100x (four; 20x in
+/// the iterations a chord step takes).
 const DIRECT_SHRINK: f64 = 100.0;
 /// A chord step (the last factorisation reused for the new gradient) is kept when it lowers
 /// the cost and divides `max_planarity` by at least 1 / this; otherwise the iteration
@@ -355,6 +356,7 @@ pub struct PlanarityOptimiser {
     forcing: f64,
     /// Whether `factor` holds a numeric factorisation (of an earlier iteration's matrix).
     factored: bool,
+    /// Iterations that took a chord step.
     chords: usize,
 }
 
@@ -1144,7 +1146,8 @@ mod tests {
     /// [`DIRECT_SHRINK`], so every exact iteration divides `max_planarity` by far more than the
     /// CG path's 10, and once near planar the iterations reuse the last factorisation (chord
     /// steps) instead of factorising again: the NURBS roof at about 1k faces, 4 iterations
-    /// with 2 factorisations where a 10x shrink with a factorisation per iteration took 6 and 7.
+    /// with 2 factorisations (at 10k faces, a 10x shrink and a factorisation per iteration
+    /// took 6 iterations and 7 factorisations).
     #[test]
     fn an_open_mesh_shrinks_fast_and_reuses_its_factorisation() {
         use crate::phex::{PhexConfig, PhexPipeline, TriangulationMethod};
