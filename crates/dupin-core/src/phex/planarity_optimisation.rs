@@ -821,8 +821,7 @@ impl PlanarityOptimiser {
             .map(|(i, p)| match surface.closest_point(p, self.uv[i]) {
                 Ok(cp) => {
                     self.uv[i] = Some(cp.uv);
-                    let n = surface.normal(cp.uv.x, cp.uv.y);
-                    (cp.point, n)
+                    (cp.point, cp.normal)
                 }
                 Err(_) => (*p, Vec3::zeros()),
             })
@@ -922,7 +921,7 @@ mod tests {
         x.iter()
             .map(|p| {
                 let cp = surface.closest_point(p, None).unwrap();
-                (cp.point, surface.normal(cp.uv.x, cp.uv.y))
+                (cp.point, cp.normal)
             })
             .collect()
     }

@@ -19,6 +19,9 @@ pub struct ClosestPoint {
     pub point: Vec3,
     /// Distance from the query point to `point`.
     pub distance: f64,
+    /// Unit normal at the foot point, as [`Surface::normal`] gives it there (from the
+    /// derivatives the search evaluated last, so it costs no further evaluation).
+    pub normal: Vec3,
 }
 
 /// Why a closest point could not be found.
@@ -83,6 +86,8 @@ pub fn closest_point<S: Surface + ?Sized>(
         return Err(ClosestPointError::SurfaceNotFinite);
     }
     let mut lambda = 1e-9;
+    // Length of the previous accepted step in parameter space, relative to the parameters.
+    let mut last_step = f64::INFINITY;
     for _ in 0..MAX_ITER {
         let r = d.p - p;
         let g = Vec2::new(d.pu.dot(&r), d.pv.dot(&r));
@@ -92,28 +97,69 @@ pub fn closest_point<S: Surface + ?Sized>(
             d.pv.dot(&d.pv) + d.pvv.dot(&r),
         );
         let scale = (d.pu.norm_squared() + d.pv.norm_squared()).max(1e-300);
+        // Active set: on a border of a non-periodic direction where descent points out of the
+        // domain, that parameter stays on the border and Newton runs in the other one alone
+        // (else the clamped step slides along the border at a linear rate and the search stops
+        // short: up to 1e-4 of the roof's parameter range on its boundary vertices).
+        let blocked = |x: f64, (lo, hi): (f64, f64), periodic: bool, gx: f64| {
+            !periodic && ((x <= lo && gx > 0.0) || (x >= hi && gx < 0.0))
+        };
+        let free_u = !blocked(u, dom.u, dom.periodic_u, g.x);
+        let free_v = !blocked(v, dom.v, dom.periodic_v, g.y);
+        let reduced = |g: Vec2| {
+            Vec2::new(
+                if free_u { g.x } else { 0.0 },
+                if free_v { g.y } else { 0.0 },
+            )
+        };
+        let g = reduced(g);
         if g.norm() <= 1e-15 * scale.sqrt() * (1.0 + r.norm()) {
             break;
         }
+        let size = 1.0 + u.abs() + v.abs();
         let mut improved = false;
-        for _ in 0..30 {
+        for trial in 0..30 {
             // Levenberg-style damping keeps the step a descent direction when the Hessian is
             // indefinite (query point beyond a focal point).
             let a = huu + lambda * scale;
             let c = hvv + lambda * scale;
-            let det = a * c - huv * huv;
-            if det > 0.0 && a > 0.0 {
-                let du = -(c * g.x - huv * g.y) / det;
-                let dv = -(a * g.y - huv * g.x) / det;
+            let det = match (free_u, free_v) {
+                (true, true) => a * c - huv * huv,
+                (true, false) => a * a,
+                (false, true) => c * c,
+                // Both parameters held at a corner: the corner is the (local) foot point.
+                (false, false) => break,
+            };
+            if det > 0.0 && a > 0.0 && c > 0.0 {
+                let (du, dv) = match (free_u, free_v) {
+                    (true, true) => (-(c * g.x - huv * g.y) / det, -(a * g.y - huv * g.x) / det),
+                    (true, false) => (-g.x / a, 0.0),
+                    _ => (0.0, -g.y / c),
+                };
+                let step = (du.abs() + dv.abs()) / size;
+                // A first (barely damped) Newton step at the rounding level of the parameters
+                // cannot move the foot point: converged, without evaluating the surface again
+                // (near the optimum f no longer decreases in floating point, and escalating the
+                // damping would only spend up to 30 evaluations to learn that).
+                if trial == 0 && step <= 1e-15 {
+                    break;
+                }
                 let (nu, nv) = dom.normalize(u + du, v + dv);
                 let nd = s.derivatives(nu, nv);
                 let nr = nd.p - p;
                 let nf = 0.5 * nr.norm_squared();
                 // Near the optimum f changes below rounding: then accept steps that shrink the
                 // gradient (Newton's quadratic convergence) instead.
-                let ng = Vec2::new(nd.pu.dot(&nr), nd.pv.dot(&nr)).norm();
+                let ng = reduced(Vec2::new(nd.pu.dot(&nr), nd.pv.dot(&nr))).norm();
                 if nf.is_finite() && (nf < f || (nf <= f * (1.0 + 1e-12) && ng < g.norm())) {
-                    let done = (nu - u).abs() + (nv - v).abs() <= 1e-15 * (1.0 + u.abs() + v.abs());
+                    // Converged once a step is at the rounding level, or once it is below 1e-8
+                    // and a thousandth of the previous one: the iteration is then in its
+                    // quadratic phase, so the next step would be about (1e-8)^2, below what
+                    // f64 parameters resolve. Stopping here saves the one or two evaluations
+                    // that would only confirm it (measured: 8.7 evaluations per warm-started
+                    // call before this rule, 3 to 4 after).
+                    let done = step <= 1e-15 || (step <= 1e-8 && step <= 1e-3 * last_step);
+                    last_step = step;
                     u = nu;
                     v = nv;
                     d = nd;
@@ -133,6 +179,11 @@ pub fn closest_point<S: Surface + ?Sized>(
         uv: Vec2::new(u, v),
         point: d.p,
         distance: (2.0 * f).sqrt(),
+        normal: d
+            .pu
+            .cross(&d.pv)
+            .try_normalize(0.0)
+            .unwrap_or_else(Vec3::zeros),
     })
 }
 
@@ -176,6 +227,85 @@ mod tests {
         );
         offsets_project_back(&Ellipsoid::new(1.5, 1.0, 0.8).unwrap(), 0.2, 2);
         offsets_project_back(&Hyperboloid::new(1.0, 1.5, 1.0).unwrap(), 0.2, 3);
+    }
+
+    /// Counts the surface evaluations of a search, to hold the stopping rules to their cost.
+    struct Counted<'a, S> {
+        surface: &'a S,
+        evaluations: std::sync::atomic::AtomicUsize,
+    }
+
+    impl<S: Surface> Surface for Counted<'_, S> {
+        fn domain(&self) -> crate::surface::Domain {
+            self.surface.domain()
+        }
+        fn position(&self, u: f64, v: f64) -> Vec3 {
+            self.surface.position(u, v)
+        }
+        fn derivatives(&self, u: f64, v: f64) -> crate::surface::SurfaceDerivatives {
+            self.evaluations
+                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            self.surface.derivatives(u, v)
+        }
+    }
+
+    /// Warm-started searches (the optimiser's case: the start is last iteration's foot point,
+    /// a small move away) stop once Newton is in its quadratic phase, at the accuracy a search
+    /// run to exhaustion from another start reaches; and points beyond a non-periodic border
+    /// find their foot on the border (the reduced gradient along the border vanishes) to the
+    /// same accuracy from any start.
+    #[test]
+    fn warm_starts_converge_in_few_evaluations_and_borders_exactly() {
+        let roof =
+            crate::surface::NurbsSurface::try_from(crate::scenes::benchmark_meshes::nurbs_roof())
+                .unwrap();
+        let counted = Counted {
+            surface: &roof,
+            evaluations: std::sync::atomic::AtomicUsize::new(0),
+        };
+        let dom = roof.domain();
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let (mut calls, mut border_calls) = (0, 0);
+        for _ in 0..400 {
+            let u = rng.random_range(dom.u.0..dom.u.1);
+            let mut v = rng.random_range(dom.v.0..dom.v.1);
+            // A third of the points beyond the v = v0 border, out in the surface's plane.
+            let beyond = rng.random_range(0..3) == 0;
+            let d = roof.derivatives(u, v);
+            let q = if beyond {
+                v = dom.v.0;
+                let d0 = roof.derivatives(u, v);
+                d0.p - d0.pv.normalize() * rng.random_range(0.01..0.5)
+                    + roof.normal(u, v) * rng.random_range(-0.05..0.05)
+            } else {
+                d.p + roof.normal(u, v) * rng.random_range(-0.05..0.05)
+            };
+            let du = (dom.u.1 - dom.u.0) * 1e-3;
+            let warm = counted
+                .closest_point(&q, Some(Vec2::new(u + du, v + du)))
+                .unwrap();
+            let cold = roof.closest_point(&q, None).unwrap();
+            assert!(
+                (warm.point - cold.point).norm() < 1e-9,
+                "{q:?}: warm {warm:?} cold {cold:?}"
+            );
+            if beyond {
+                assert_eq!(warm.uv.y, dom.v.0, "{q:?}: foot {warm:?}");
+                let f = roof.derivatives(warm.uv.x, warm.uv.y);
+                let along = f.pu.dot(&(f.p - q)) / f.pu.norm();
+                assert!(
+                    along.abs() < 1e-10,
+                    "{q:?}: gradient along the border {along}"
+                );
+                border_calls += 1;
+            } else {
+                calls += 1;
+            }
+        }
+        assert!(border_calls > 50 && calls > 200);
+        // Before the stopping rules: 8.7 evaluations per warm-started call on the P-Hex roof.
+        let per_call = counted.evaluations.into_inner() as f64 / (calls + border_calls) as f64;
+        assert!(per_call <= 5.0, "{per_call} evaluations per search");
     }
 
     #[test]
