@@ -423,7 +423,7 @@ impl PlanarityOptimiser {
         // options' weights the 10k-face NURBS roof went only from 2.2e-5 to 5.1e-6 and needed
         // a second factorisation. Its faces are near planar already (the tangent-duality
         // start) and need no untangling, so its first iteration takes the weights one exact
-        // shrink further: 1.3e-7, then only chord steps (one factorisation in all).
+        // shrink further: 6e-8, then only chord steps (one factorisation in all).
         let start_shrink = if open && !tangled { DIRECT_SHRINK } else { 1.0 };
         Ok(PlanarityOptimiser {
             options,

@@ -123,19 +123,18 @@ pub fn closest_point<S: Surface + ?Sized>(
             // indefinite (query point beyond a focal point).
             let a = huu + lambda * scale;
             let c = hvv + lambda * scale;
-            let det = match (free_u, free_v) {
-                (true, true) => a * c - huv * huv,
-                (true, false) => a * a,
-                (false, true) => c * c,
+            let newton = match (free_u, free_v) {
+                (true, true) => {
+                    let det = a * c - huv * huv;
+                    (det > 0.0 && a > 0.0)
+                        .then(|| (-(c * g.x - huv * g.y) / det, -(a * g.y - huv * g.x) / det))
+                }
+                (true, false) => (a > 0.0).then(|| (-g.x / a, 0.0)),
+                (false, true) => (c > 0.0).then(|| (0.0, -g.y / c)),
                 // Both parameters held at a corner: the corner is the (local) foot point.
                 (false, false) => break,
             };
-            if det > 0.0 && a > 0.0 && c > 0.0 {
-                let (du, dv) = match (free_u, free_v) {
-                    (true, true) => (-(c * g.x - huv * g.y) / det, -(a * g.y - huv * g.x) / det),
-                    (true, false) => (-g.x / a, 0.0),
-                    _ => (0.0, -g.y / c),
-                };
+            if let Some((du, dv)) = newton {
                 let step = (du.abs() + dv.abs()) / size;
                 // A first (barely damped) Newton step at the rounding level of the parameters
                 // cannot move the foot point: converged, without evaluating the surface again
