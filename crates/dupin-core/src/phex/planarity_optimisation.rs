@@ -12,8 +12,8 @@
 //! too lets the planarity reach 1e-10 instead of settling at a compromise with the distance
 //! term, whose size stays bounded because μ starts from a moderate value and the geometry
 //! moves little; an exact step resolves the volumes down to that compromise, so its
-//! `max_planarity` follows λ). An open start without self-intersecting faces, which takes exact
-//! steps from the first iteration, starts at λ / 100 and μ / 100.
+//! `max_planarity` follows λ). An open start without self-intersecting faces within 1e-3 of
+//! planar, which takes exact steps from the first iteration, starts at λ / 100 and μ / 100.
 //!
 //! Solved by Gauss-Newton with a small Levenberg-Marquardt damping on the sparse normal
 //! equations (JᵀJ + δ) h = -Jᵀr. The stopping rule is the contract's `max_planarity` (a
@@ -74,8 +74,8 @@ use nalgebra::Matrix3;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlanarityOptions {
     /// Initial fairness weight λ (section 7; relative; shrinks by 10 after an iteration of
-    /// truncated-CG steps, by 100 after an exact one; an open start without self-intersecting
-    /// faces begins at λ / 100, see the module documentation).
+    /// truncated-CG steps, by 100 after an exact one; an open, near-planar start without
+    /// self-intersecting faces begins at λ / 100, see the module documentation).
     pub lambda: f64,
     /// Initial surface-distance weight μ (section 7; relative; shrinks and starts as λ does).
     pub mu: f64,
@@ -112,13 +112,19 @@ pub struct PlanarityStep {
 /// Initial Levenberg-Marquardt damping, relative to the largest diagonal entry of JᵀJ.
 const INITIAL_DAMPING: f64 = 1e-8;
 /// The same for an open mesh without self-intersecting faces (which takes exact steps from
-/// the start, with λ and μ already shrunk once): its first step from the dual mesh at 1e-8
-/// raised the cost on the NURBS roof at 10k faces and the retry was one factorisation more;
-/// 3e-8 was kept at the first try at 1k to 10k faces and gives the chord steps that follow
-/// more to gain than 1e-7 (10k faces: 1 factorisation and 3 chords against 2 and 4). A
-/// tangled start keeps 1e-8: from 1e-7 the torus at field angle -15 degrees (551 faces) kept
-/// 2 self-intersecting faces.
-const INITIAL_DIRECT_DAMPING: f64 = 3e-8;
+/// the start): its first step from the dual mesh at 1e-8 raised the cost on the NURBS roof at
+/// every size measured (1k, 2k and 10k faces), and the retry at 1e-7 was the step kept, one
+/// factorisation later (a quarter of a 10k run). A tangled start keeps 1e-8: from 1e-7 the
+/// torus at field angle -15 degrees (551 faces) kept 2 self-intersecting faces.
+const INITIAL_DIRECT_DAMPING: f64 = 1e-7;
+/// The same when such a start is also within [`SHRUNK_START_PLANARITY`] of planar (λ and μ
+/// then start one [`DIRECT_SHRINK`] lower): 3e-8 was kept at the first try on the roof at 1k
+/// to 10k faces and leaves the chord steps that follow more to gain than 1e-7 (10k faces: 1
+/// factorisation and 3 chords against 2 and 4); at 1e-8 the first step raised the cost.
+const INITIAL_SHRUNK_DAMPING: f64 = 3e-8;
+/// `max_planarity` up to which an open start without self-intersecting faces begins with λ and
+/// μ shrunk once (see [`PlanarityOptimiser::new`]).
+const SHRUNK_START_PLANARITY: f64 = 1e-3;
 /// Factor by which λ and μ shrink after an iteration of truncated-CG steps (the paper shrinks
 /// λ; the CG path's safeguards were tuned with this rate).
 const CG_SHRINK: f64 = 10.0;
@@ -421,10 +427,15 @@ impl PlanarityOptimiser {
         // An open start without self-intersecting faces takes exact steps from its first
         // iteration, and an exact step stops at the compromise with λ F_s + μ F_d: at the
         // options' weights the 10k-face NURBS roof went only from 2.2e-5 to 5.1e-6 and needed
-        // a second factorisation. Its faces are near planar already (the tangent-duality
-        // start) and need no untangling, so its first iteration takes the weights one exact
-        // shrink further: 6e-8, then only chord steps (one factorisation in all).
-        let start_shrink = if open && !tangled { DIRECT_SHRINK } else { 1.0 };
+        // a second factorisation. Where its faces are also near planar already (the
+        // tangent-duality start away from parabolic lines) they have little to move and
+        // nothing to untangle, so its first iteration takes the weights one exact shrink
+        // further: 6e-8, then only chord steps (one factorisation in all). A start farther
+        // from planar keeps the weights (the approximate Dupin-duality start of the Enneper
+        // surface at size 0.15, 1.4e-3 from planar, came out with 2 self-intersecting faces).
+        let start_planarity = max_planarity(mesh);
+        let shrunk_start = open && !tangled && start_planarity <= SHRUNK_START_PLANARITY;
+        let start_shrink = if shrunk_start { DIRECT_SHRINK } else { 1.0 };
         Ok(PlanarityOptimiser {
             options,
             neighbours,
@@ -437,13 +448,15 @@ impl PlanarityOptimiser {
             lambda: options.lambda / start_shrink,
             mu: options.mu / start_shrink,
             iteration: 0,
-            max_planarity: max_planarity(mesh),
+            max_planarity: start_planarity,
             num_faces: mesh.num_faces(),
             values: vec![0.0; pattern.nnz()],
             pattern,
             factor: None,
             direct: tangled || open,
-            damping: if open && !tangled {
+            damping: if shrunk_start {
+                INITIAL_SHRUNK_DAMPING
+            } else if open && !tangled {
                 INITIAL_DIRECT_DAMPING
             } else {
                 INITIAL_DAMPING
@@ -1191,6 +1204,29 @@ mod tests {
         let report = super::super::report::phex_report(&d.mesh, p.surface(), &[], &d.vertex_uv, 0);
         assert_eq!(report.invalid_faces, 0);
         assert!(report.max_surface_distance <= 0.005 * report.bbox_diagonal);
+    }
+
+    /// Only a near-planar open start begins with the weights shrunk: a start farther than
+    /// [`SHRUNK_START_PLANARITY`] from planar keeps them (the Enneper surface's Dupin-duality
+    /// start at size 0.15, 1.4e-3 from planar, came out with 2 self-intersecting faces from
+    /// shrunk weights).
+    #[test]
+    fn a_start_far_from_planar_keeps_the_weights_and_its_faces_valid() {
+        use crate::phex::{Initialisation, PhexConfig, TriangulationMethod};
+        let mut cfg =
+            PhexConfig::for_surface("enneper", &[], TriangulationMethod::Prescribed, Some(0.15));
+        cfg.initialisation = Initialisation::DupinDuality;
+        let mut start = cfg.clone();
+        start.optimize = false;
+        let start = phex_run(start).unwrap().report.max_planarity;
+        assert!(start > SHRUNK_START_PLANARITY, "{start}");
+        let r = phex_run(cfg).unwrap();
+        assert!(
+            r.report.max_planarity <= 1e-10,
+            "{}",
+            r.report.max_planarity
+        );
+        assert_eq!(r.report.invalid_faces, 0);
     }
 
     #[test]
