@@ -179,11 +179,7 @@ pub fn closest_point<S: Surface + ?Sized>(
         uv: Vec2::new(u, v),
         point: d.p,
         distance: (2.0 * f).sqrt(),
-        normal: d
-            .pu
-            .cross(&d.pv)
-            .try_normalize(0.0)
-            .unwrap_or_else(Vec3::zeros),
+        normal: d.normal(),
     })
 }
 

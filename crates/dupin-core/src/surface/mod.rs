@@ -119,6 +119,16 @@ pub struct SurfaceDerivatives {
     pub pvv: Vec3,
 }
 
+impl SurfaceDerivatives {
+    /// Unit normal along Pu x Pv (zero where the parametrisation is singular).
+    pub fn normal(&self) -> Vec3 {
+        self.pu
+            .cross(&self.pv)
+            .try_normalize(0.0)
+            .unwrap_or_else(Vec3::zeros)
+    }
+}
+
 /// First and second fundamental forms at one point (P-Hex paper, section 3: the Dupin indicatrix
 /// is built from them).
 ///
@@ -145,10 +155,7 @@ pub struct FundamentalForms {
 impl FundamentalForms {
     /// Computes both forms from derivatives.
     pub fn from_derivatives(d: &SurfaceDerivatives) -> Self {
-        let normal =
-            d.pu.cross(&d.pv)
-                .try_normalize(0.0)
-                .unwrap_or_else(Vec3::zeros);
+        let normal = d.normal();
         FundamentalForms {
             e: d.pu.dot(&d.pu),
             f: d.pu.dot(&d.pv),
@@ -183,10 +190,7 @@ pub trait Surface: Send + Sync {
 
     /// Unit normal along Pu x Pv (zero where the parametrisation is singular).
     fn normal(&self, u: f64, v: f64) -> Vec3 {
-        let d = self.derivatives(u, v);
-        d.pu.cross(&d.pv)
-            .try_normalize(0.0)
-            .unwrap_or_else(Vec3::zeros)
+        self.derivatives(u, v).normal()
     }
 
     /// First and second fundamental forms at (u, v).
