@@ -12,7 +12,7 @@ use super::triangulation::{
     triangulate_along_fields,
 };
 use crate::Stepper;
-use crate::mesh::{PolyMesh, max_planarity};
+use crate::mesh::PolyMesh;
 use crate::surface::{
     FREEFORM, FreeformSurface, NurbsSurface, Surface, TwistedSurface, surface_by_name,
 };
@@ -506,20 +506,25 @@ impl PhexPipeline {
     /// The report of the current hexagonal mesh (`None` before it exists).
     pub fn report(&self) -> Option<PhexReport> {
         let d = self.dual.as_ref()?;
+        // The optimiser's last foot points seed the distance searches: the vertices have moved
+        // since the dual mesh's parameters.
+        let seeds: Vec<crate::Vec2> = match &self.optimiser {
+            Some(o) => o
+                .foot_parameters()
+                .iter()
+                .zip(&d.vertex_uv)
+                .map(|(foot, &start)| foot.unwrap_or(start))
+                .collect(),
+            None => d.vertex_uv.clone(),
+        };
         Some(phex_report(
             &d.mesh,
             self.surface.as_ref(),
             &self.face_gaussian(d),
-            &d.vertex_uv,
+            &seeds,
             self.optimiser.as_ref().map_or(0, |o| o.iteration()),
         ))
     }
-}
-
-fn count_invalid(mesh: &PolyMesh) -> usize {
-    (0..mesh.num_faces())
-        .filter(|&i| !super::report::face_info(mesh, i, 0.0).simple)
-        .count()
 }
 
 /// One step reveals a triangulation layer, builds the dual mesh, or runs one Gauss-Newton
@@ -550,13 +555,13 @@ impl Stepper for PhexPipeline {
                 let d = self.initial_dual_mesh()?;
                 self.metrics.faces = d.mesh.num_faces();
                 self.metrics.vertices = d.mesh.num_vertices();
-                self.metrics.max_planarity = max_planarity(&d.mesh);
-                self.metrics.invalid_faces = count_invalid(&d.mesh);
                 let opt = PlanarityOptimiser::new(
                     &d.mesh,
                     Some(&d.vertex_uv),
                     self.config.planarity_options(),
                 )?;
+                self.metrics.max_planarity = opt.max_planarity();
+                self.metrics.invalid_faces = opt.invalid_faces();
                 self.phase = if self.config.optimize && !opt.is_done() {
                     PhexPhase::Optimisation
                 } else {
@@ -573,7 +578,7 @@ impl Stepper for PhexPipeline {
                 let s = opt.step(&mut d.mesh, self.surface.as_ref())?;
                 self.metrics.iteration = s.iteration;
                 self.metrics.max_planarity = s.max_planarity;
-                self.metrics.invalid_faces = count_invalid(&d.mesh);
+                self.metrics.invalid_faces = opt.invalid_faces();
                 if opt.is_done() {
                     self.phase = PhexPhase::Done;
                 }

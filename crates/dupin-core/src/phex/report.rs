@@ -52,8 +52,13 @@ pub struct PhexReport {
     pub per_face: Vec<FaceInfo>,
 }
 
-/// Projects a face onto its Newell-normal plane; returns the 2D points and the normal.
-fn project(pts: &[Vec3]) -> (Vec<Vec2>, Vec3) {
+/// Face `i` of `mesh` projected onto its Newell-normal plane (2D points in face order).
+fn projected_face(mesh: &PolyMesh, i: usize) -> Vec<Vec2> {
+    let pts: Vec<Vec3> = mesh
+        .face(i)
+        .iter()
+        .map(|&v| mesh.positions[v as usize])
+        .collect();
     let c = pts.iter().sum::<Vec3>() / pts.len() as f64;
     let mut n = Vec3::zeros();
     for i in 0..pts.len() {
@@ -61,22 +66,21 @@ fn project(pts: &[Vec3]) -> (Vec<Vec2>, Vec3) {
     }
     let n = n.try_normalize(0.0).unwrap_or(Vec3::z());
     let (e1, e2) = crate::mesh::plane_basis(n);
-    (
-        pts.iter()
-            .map(|p| Vec2::new((p - c).dot(&e1), (p - c).dot(&e2)))
-            .collect(),
-        n,
-    )
+    pts.iter()
+        .map(|p| Vec2::new((p - c).dot(&e1), (p - c).dot(&e2)))
+        .collect()
+}
+
+/// Whether face `i` of `mesh`, projected to its plane, is a simple polygon: `FaceInfo::simple`
+/// alone (the validity test run after every optimisation step, without the planarity and
+/// shape figures of [`face_info`]).
+fn is_simple_face(mesh: &PolyMesh, i: usize) -> bool {
+    is_simple_polygon(&projected_face(mesh, i)).unwrap_or(false)
 }
 
 /// Diagnostics of face `i` of `mesh`, with `gaussian` the curvature there.
 pub fn face_info(mesh: &PolyMesh, i: usize, gaussian: f64) -> FaceInfo {
-    let pts: Vec<Vec3> = mesh
-        .face(i)
-        .iter()
-        .map(|&v| mesh.positions[v as usize])
-        .collect();
-    let (q, _) = project(&pts);
+    let q = projected_face(mesh, i);
     let n = q.len();
     let simple = is_simple_polygon(&q).unwrap_or(false);
     let turns: Vec<f64> = (0..n)
@@ -114,7 +118,7 @@ pub fn face_info(mesh: &PolyMesh, i: usize, gaussian: f64) -> FaceInfo {
 /// self-intersect), for any polygon mesh.
 pub fn count_invalid_faces(mesh: &PolyMesh) -> usize {
     (0..mesh.num_faces())
-        .filter(|&i| !face_info(mesh, i, 0.0).simple)
+        .filter(|&i| !is_simple_face(mesh, i))
         .count()
 }
 
