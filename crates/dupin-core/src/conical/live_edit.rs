@@ -33,7 +33,7 @@
 //! there to bring a mesh from far, and a stage after the first continues the perturbation
 //! that finished the one before; its stages are a [`FAST_STAGE`] long. On a mesh of quads the
 //! exact phase runs in face space (one unknown per quad, the least Euclidean move onto planar
-//! quads: `perturbation/quad_projection.rs`), whose factor is about 27 times less work than
+//! quads: `perturbation/planar_projection.rs`), whose factor is about 27 times less work than
 //! the vertex-and-plane one; on other meshes a stage's first steps are chord steps on the last
 //! stage's factorisation (one evaluation and two triangular solves each). Measured natively on
 //! a 100 x 100 quad grid, its middle vertex moved 1.2 edge lengths (`cargo bench --bench pq --

@@ -23,6 +23,9 @@ mod discrete_terms;
 mod live_edit;
 mod offset;
 mod perturbation;
+#[cfg(test)]
+pub(crate) use perturbation::FAIL_STEPS;
+pub(crate) use perturbation::PlanarProjection;
 mod principal_quads;
 mod refinement;
 mod support;

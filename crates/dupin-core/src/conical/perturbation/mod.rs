@@ -41,7 +41,7 @@
 //!
 //! Keeping a design ([`PqOptions::keep_design`]) on a mesh of quads in planar mode, the run
 //! starts with phase 2 in face space instead: Newton steps of least Euclidean length onto the
-//! quads' planarity determinants, one unknown per quad (`quad_projection.rs`), kept when the
+//! quads' planarity determinants, one unknown per quad (`planar_projection.rs`), kept when the
 //! first one divides the planarity by 10 or more (otherwise phase 1 from the input). Its
 //! matrix has a third of the unknowns of the vertex-and-plane system on the same graph,
 //! which is what makes 200 000 quads fit in 0.35 GB and 3 s, and a live drag of 10 000 quads
@@ -55,14 +55,15 @@
 //! |---|---|---|
 //! | 2.2, 5 | mode, weights, caps, exact-phase solver, errors | `options.rs` |
 //! | 2.2 (eqs. (3), (5)), 3.2 (eq. (6)), 5 (eq. (7)) | unknowns, penalty rows, exact constraints | `problem.rs` |
-//! | 2.2 | a live edit's exact phase on quad meshes: the least move in face space | `quad_projection.rs` |
+//! | 2.2 | a live edit's exact phase on quad meshes: the least move in face space | `planar_projection.rs` |
 //! | 2.2 | the stepper (penalty phase, then exact phase), its metrics and result, the one-shot run | `stepper.rs` |
 
 mod options;
+mod planar_projection;
 mod problem;
-mod quad_projection;
 #[cfg(test)]
-pub(crate) use quad_projection::FAIL_STEPS;
+pub(crate) use planar_projection::FAIL_STEPS;
+pub(crate) use planar_projection::PlanarProjection;
 mod stepper;
 
 pub use options::{PqError, PqMode, PqOptions, Refinement};

@@ -3,8 +3,8 @@
 //! run to its end.
 
 use super::options::{PqError, PqMode, PqOptions, Refinement};
+use super::planar_projection::PlanarProjection;
 use super::problem::{Feasibility, NONE, Problem, Terms};
-use super::quad_projection::QuadProjection;
 use crate::conical::circular_residual;
 use crate::conical::conical_residual;
 use crate::mesh::MeshTopology;
@@ -116,17 +116,17 @@ pub struct PqPerturbation {
     /// The iteration at which the run stops: [`PqOptions::max_iterations`] after its start,
     /// or after the start of its last [`PqPerturbation::restage`].
     iteration_cap: usize,
-    /// The exact phase runs in face space ([`QuadProjection`]: the least move onto planar
+    /// The exact phase runs in face space ([`PlanarProjection`]: the least move onto planar
     /// quads, one unknown per quad) instead of [`Self::exact`]: a live edit of a quad mesh in
     /// planar mode ([`PqPerturbation::start_exact`]), or a run that keeps a design
     /// ([`LEAST_MOVE_CONTRACTION`]).
     face_space: bool,
     /// Its analysed pattern, made at its first step.
-    projection: Option<QuadProjection>,
+    projection: Option<PlanarProjection>,
     /// A face-space analysis taken over from another perturbation
     /// ([`PqPerturbation::adopt_analyses`]), used when it covers this mesh and its held
     /// vertices.
-    spare_projection: Option<QuadProjection>,
+    spare_projection: Option<PlanarProjection>,
     /// The unknowns at the start while a run that keeps a design takes its first steps in
     /// face space ([`LEAST_MOVE_CONTRACTION`]); the penalty phase starts from them again if
     /// face space does not get there.
@@ -138,7 +138,7 @@ pub struct PqPerturbation {
 pub(crate) struct PqAnalyses {
     lm: Option<LmAnalysis>,
     exact: Option<LmAnalysis>,
-    projection: Option<QuadProjection>,
+    projection: Option<PlanarProjection>,
 }
 
 impl PqAnalyses {
@@ -185,7 +185,7 @@ const CHORD_RATE: f64 = 0.05;
 const PROBE_CONTRACTION: f64 = 0.1;
 
 /// A run that keeps a design ([`PqOptions::keep_design`]) on a mesh of quads in planar mode
-/// starts with a least-move step in face space ([`QuadProjection`]) and goes on so when it
+/// starts with a least-move step in face space ([`PlanarProjection`]) and goes on so when it
 /// divides `max_planarity` by at least this much: the design is then near a planar one, and
 /// its nearest is what keeping it asks for. Otherwise (and if a later step fails) the run
 /// starts again from its input, penalty phase first. Measured on a 100 x 100 curved grid with
@@ -310,7 +310,7 @@ impl PqPerturbation {
         } else if s.options.keep_design
             && s.options.mode == PqMode::Planar
             && s.options.refinement == Refinement::GaussNewton
-            && QuadProjection::applies(&s.work)
+            && PlanarProjection::applies(&s.work)
         {
             s.face_space = true;
             s.phase = PqPhase::Sqp;
@@ -395,7 +395,7 @@ impl PqPerturbation {
     /// from a planar mesh a quarter edge away its first step only costs a factorisation.
     ///
     /// A quad mesh in planar mode takes its exact phase in face space instead
-    /// ([`QuadProjection`]): every step a least-move Gauss-Newton step on the quads'
+    /// ([`PlanarProjection`]): every step a least-move Gauss-Newton step on the quads'
     /// determinants, from the first (no probe, no penalty step; a step that fails ends the run
     /// not converged).
     pub(crate) fn start_exact(&mut self) -> bool {
@@ -410,7 +410,7 @@ impl PqPerturbation {
         if self.phase != PqPhase::Penalty {
             return false;
         }
-        if self.options.mode == PqMode::Planar && QuadProjection::applies(&self.work) {
+        if self.options.mode == PqMode::Planar && PlanarProjection::applies(&self.work) {
             self.face_space = true;
             self.phase = PqPhase::Sqp;
         } else {
@@ -427,7 +427,7 @@ impl PqPerturbation {
             let spare = self.spare_projection.take();
             self.projection = Some(match spare {
                 Some(p) if p.covers(&self.work, &self.terms.var_of) => p,
-                _ => QuadProjection::new(
+                _ => PlanarProjection::new(
                     &self.work,
                     &self.terms.var_of,
                     self.options.max_factor_bytes,
@@ -436,7 +436,9 @@ impl PqPerturbation {
         }
         let projection = self.projection.as_mut().expect("made above");
         let mut work = self.work.positions.clone();
-        let step = projection.step(&self.work, &mut work, &self.terms.var_of, x);
+        let step = projection
+            .step(&mut work, &self.terms.var_of, x)
+            .map(|_| ());
         if step.is_ok() && self.iteration == 0 && self.least_move_start.is_some() {
             let mut after = self.work.clone();
             after.positions = work;
@@ -691,7 +693,7 @@ impl PqPerturbation {
             + self
                 .projection
                 .as_ref()
-                .map_or(0, QuadProjection::factorizations)
+                .map_or(0, PlanarProjection::factorizations)
     }
 }
 

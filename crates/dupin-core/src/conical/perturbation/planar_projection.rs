@@ -1,17 +1,19 @@
-//! The least move onto planar quads, solved in face space (conical paper, Sec. 2.2: "a PQ mesh
-//! near the given one"): the exact phase of a live edit of a quad mesh, and of a design kept
-//! near planar ([`super::PqOptions::keep_design`]) from its first step.
+//! The least move onto planar faces, solved in face space (conical paper, Sec. 2.2: "a PQ mesh
+//! near the given one"): the exact phase of a live edit of a quad mesh, of a design kept near
+//! planar ([`super::PqOptions::keep_design`]) from its first step, and of a P-Hex mesh that
+//! starts near planar (`phex/planarity_optimisation.rs`).
 //!
-//! Input: the solver-frame positions of an all-quad mesh, its free vertices (the anchors and
+//! Input: the solver-frame positions of a polygon mesh, its free vertices (the anchors and
 //! held vertices have no unknowns) and the unknowns' layout; output: one Gauss-Newton step on
 //! the constraints `det(ê₀, ê₁, ê₂) = 0` per quad (unit vectors along three consecutive edges,
-//! zero exactly when the quad is planar), of least Euclidean length:
+//! zero exactly when the quad is planar), `n - 3` of them per polygon of `n > 4` vertices (see
+//! [`planarity_rows`]), of least Euclidean length:
 //!
 //! `Δx = -Jᵀ λ`, `(J Jᵀ) λ = c`,
 //!
 //! with `c` the determinants and `J` their gradients with respect to the free vertices. The
-//! matrix `J Jᵀ` has one unknown per quad (its multiplier `λ`), coupled to the quads sharing a
-//! vertex with it. The exact phase of [`super::PqPerturbation`] solves the same least-move
+//! matrix `J Jᵀ` has one unknown per determinant (its multiplier `λ`), coupled to those
+//! sharing a vertex with it. The exact phase of [`super::PqPerturbation`] solves the same least-move
 //! problem on the vertex positions and one plane per face, its normal matrix one 3 x 3 block
 //! per vertex after the planes are eliminated: three times the unknowns on the same graph, so
 //! its supernodal factor takes about 27 times the floating-point work of this one (a
@@ -21,9 +23,11 @@
 //! of a planar mesh and a kept design is near planar, so every Newton step is near the
 //! constraints, where the determinants are as good a measure of planarity as the planes.
 //!
-//! Only planar mode on meshes of quads: a polygon of `n` vertices needs `n - 3` determinants,
-//! whose conditioning depends on which vertices they take, and the conical and circular
-//! conditions are not determinants.
+//! Only planar mode: the conical and circular conditions are not determinants. The P-Hex
+//! optimiser's vertex-space normal matrix (3 unknowns per vertex, two vertices per hexagon,
+//! every pair of a hexagon's vertices coupled) factors about 6x slower than this one (3
+//! unknowns per hexagon, coupled to its six neighbours): on the 10k-face NURBS roof one
+//! factorisation took 0.24 s there and the whole least-move run, two steps, 0.23 s.
 
 use super::problem::NONE as FIXED;
 use crate::Vec3;
@@ -31,8 +35,8 @@ use crate::conical::discrete_terms::quad_det_grad;
 use crate::mesh::PolyMesh;
 use crate::solver::{SolverError, SparseCholesky, csc_pattern, fill_reducing_ordering};
 
-/// Relative Levenberg damping of the face-space matrix: it keeps a quad whose four vertices
-/// are all held (a zero row) from making the matrix singular and is far below the
+/// Relative Levenberg damping of the face-space matrix: it keeps a determinant whose four
+/// vertices are all held (a zero row) from making the matrix singular and is far below the
 /// determinants' curvature, so the steps stay Newton steps.
 const DAMPING: f64 = 1e-12;
 
@@ -46,13 +50,15 @@ thread_local! {
     pub(crate) static FAIL_STEPS: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
-/// The face-space least-move projection of one all-quad mesh with fixed free vertices (the
+/// The face-space least-move projection of one polygon mesh with fixed free vertices (the
 /// pattern of `J Jᵀ` and its analysed Cholesky factor, kept across steps and stages).
-pub(super) struct QuadProjection {
-    /// What the pattern was made for: the quads and the unknowns of their vertices.
+pub(crate) struct PlanarProjection {
+    /// What the pattern was made for: the faces and the unknowns of their vertices.
     faces: Vec<u32>,
     var_of: Vec<u32>,
-    /// For every free vertex, its incident (quad, corner) pairs, `incident[start[v]..start[v+1]]`.
+    /// The four vertices of every determinant (see [`planarity_rows`]).
+    rows: Vec<[u32; 4]>,
+    /// For every free vertex, its incident (row, corner) pairs, `incident[start[v]..start[v+1]]`.
     start: Vec<u32>,
     incident: Vec<(u32, u8)>,
     /// For every pair of corners at one free vertex (in the order [`Self::assemble`] walks
@@ -67,24 +73,26 @@ pub(super) struct QuadProjection {
     factorizations: usize,
 }
 
-impl QuadProjection {
-    /// Whether `mesh` can be projected so: every face a quad.
+impl PlanarProjection {
+    /// Whether the PQ perturbation projects `mesh` so: every face a quad (its keep-design and
+    /// live-edit figures were measured on quads).
     pub(super) fn applies(mesh: &PolyMesh) -> bool {
         mesh.num_faces() > 0 && mesh.faces().all(|f| f.len() == 4)
     }
 
-    /// The pattern and its analysis for `mesh` (all quads) whose vertex `v` has its unknowns at
+    /// The pattern and its analysis for `mesh` whose vertex `v` has its unknowns at
     /// `var_of[v] .. + 3` (`u32::MAX` for none). Refused like the other solvers when the factor
     /// would take more than `max_factor_bytes`.
-    pub(super) fn new(
+    pub(crate) fn new(
         mesh: &PolyMesh,
         var_of: &[u32],
         max_factor_bytes: usize,
     ) -> Result<Self, SolverError> {
-        let nf = mesh.num_faces();
+        let rows = planarity_rows(mesh);
+        let nf = rows.len();
         let nv = mesh.num_vertices();
         let mut start = vec![0u32; nv + 1];
-        for f in mesh.faces() {
+        for f in &rows {
             for &v in f {
                 if var_of[v as usize] != FIXED {
                     start[v as usize + 1] += 1;
@@ -96,7 +104,7 @@ impl QuadProjection {
         }
         let mut fill = start.clone();
         let mut incident = vec![(0u32, 0u8); start[nv] as usize];
-        for (q, f) in mesh.faces().enumerate() {
+        for (q, f) in rows.iter().enumerate() {
             for (k, &v) in f.iter().enumerate() {
                 if var_of[v as usize] != FIXED {
                     incident[fill[v as usize] as usize] = (q as u32, k as u8);
@@ -121,9 +129,10 @@ impl QuadProjection {
         let diagonal = (0..nf).map(slot).collect();
         let slots = (nf..pairs.len()).map(slot).collect();
         let values = vec![0.0; cholesky.nnz()];
-        Ok(QuadProjection {
+        Ok(PlanarProjection {
             faces: mesh.faces().flatten().copied().collect(),
             var_of: var_of.to_vec(),
+            rows,
             start,
             incident,
             slots,
@@ -136,21 +145,21 @@ impl QuadProjection {
         })
     }
 
-    /// Whether this projection was made for `mesh`'s quads with these unknowns.
+    /// Whether this projection was made for `mesh`'s faces with these unknowns.
     pub(super) fn covers(&self, mesh: &PolyMesh, var_of: &[u32]) -> bool {
         self.var_of == var_of && mesh.faces().flatten().eq(self.faces.iter())
     }
 
     /// Sparse factorisations so far.
-    pub(super) fn factorizations(&self) -> usize {
+    pub(crate) fn factorizations(&self) -> usize {
         self.factorizations
     }
 
-    /// The quads' determinants and their gradients at the positions `p` (the solver's frame):
-    /// the squared residual norm, or an error for a degenerate quad (an edge of length zero).
-    fn evaluate(&mut self, mesh: &PolyMesh, p: &[Vec3]) -> Result<f64, SolverError> {
+    /// The determinants and their gradients at the positions `p` (the solver's frame): the
+    /// squared residual norm, or an error for a degenerate face (an edge of length zero).
+    fn evaluate(&mut self, p: &[Vec3]) -> Result<f64, SolverError> {
         let mut cost = 0.0;
-        for (q, f) in mesh.faces().enumerate() {
+        for (q, f) in self.rows.iter().enumerate() {
             let (d, g) = quad_det_grad(std::array::from_fn(|k| p[f[k] as usize]));
             if !d.is_finite() || g.iter().any(|g| !g.iter().all(|c| c.is_finite())) {
                 return Err(SolverError::NonFinite);
@@ -162,32 +171,32 @@ impl QuadProjection {
         Ok(cost)
     }
 
-    /// One least-move Gauss-Newton step of the free vertices of `x` (the unknowns of
-    /// [`super::PqPerturbation`]: three per free vertex at `var_of`) towards planar quads, its
-    /// length halved up to [`HALVINGS`] times until it lowers the determinants' squared sum;
-    /// `work` holds the positions of `x` (the solver's frame) and follows it. Fails when no
-    /// step lowers it (or the factorisation fails), `x` unchanged then.
-    pub(super) fn step(
+    /// One least-move Gauss-Newton step of the free vertices of `x` (three unknowns per free
+    /// vertex at `var_of`, as in [`super::PqPerturbation`]) towards planar faces, its length
+    /// halved up to [`HALVINGS`] times until it lowers the determinants' squared sum; `work`
+    /// holds the positions of `x` (the solver's frame) and follows it. Returns that sum before
+    /// and after the step. Fails when no step lowers it (or the factorisation fails), `x`
+    /// unchanged then.
+    pub(crate) fn step(
         &mut self,
-        mesh: &PolyMesh,
         work: &mut [Vec3],
         var_of: &[u32],
         x: &mut [f64],
-    ) -> Result<(), SolverError> {
+    ) -> Result<(f64, f64), SolverError> {
         #[cfg(test)]
         if FAIL_STEPS.get() {
             return Err(SolverError::Factorization("failing on purpose".into()));
         }
-        let before = self.evaluate(mesh, work)?;
+        let before = self.evaluate(work)?;
         if before == 0.0 {
-            return Ok(());
+            return Ok((0.0, 0.0));
         }
         self.assemble();
         self.cholesky.factorize(&self.values)?;
         self.factorizations += 1;
         let mut lambda = self.residual.clone();
         self.cholesky.solve_in_place(&mut lambda)?;
-        // Δv = -Σ λ_q ∇_v c_q over the quads at v.
+        // Δv = -Σ λ_q ∇_v c_q over the determinants at v.
         let nv = work.len();
         let mut delta = vec![Vec3::zeros(); nv];
         for (v, d) in delta.iter_mut().enumerate() {
@@ -203,7 +212,9 @@ impl QuadProjection {
                     work[v] = start[v] + delta[v] * t;
                 }
             }
-            if self.evaluate(mesh, work).is_ok_and(|after| after < before) {
+            if let Ok(after) = self.evaluate(work)
+                && after < before
+            {
                 for v in 0..nv {
                     let b = var_of[v];
                     if b != FIXED {
@@ -211,13 +222,13 @@ impl QuadProjection {
                         x[b..b + 3].copy_from_slice(work[v].as_slice());
                     }
                 }
-                return Ok(());
+                return Ok((before, after));
             }
             t *= 0.5;
         }
         work.copy_from_slice(&start);
         Err(SolverError::Factorization(
-            "no least-move step lowers the quads' non-planarity".into(),
+            "no least-move step lowers the faces' non-planarity".into(),
         ))
     }
 
@@ -249,6 +260,33 @@ impl QuadProjection {
     }
 }
 
+/// The determinants that make `mesh` planar: a quad's four vertices in order; for a polygon
+/// of `n > 4` vertices, `n - 3` of them, every vertex not in the polygon's sharpest corner
+/// `(a, a + 1, a + 2)` (largest sine between its unit edges) against that corner, so that each
+/// determinant is a well-conditioned measure of that vertex's distance from the corner's plane.
+fn planarity_rows(mesh: &PolyMesh) -> Vec<[u32; 4]> {
+    let mut rows = Vec::new();
+    for f in mesh.faces() {
+        let n = f.len();
+        if n == 4 {
+            rows.push([f[0], f[1], f[2], f[3]]);
+        } else if n > 4 {
+            let p = |k: usize| mesh.positions[f[k % n] as usize];
+            let sine = |a: usize| {
+                let (e0, e1) = (p(a + 1) - p(a), p(a + 2) - p(a + 1));
+                e0.cross(&e1).norm() / (e0.norm() * e1.norm())
+            };
+            let a = (0..n)
+                .max_by(|&x, &y| sine(x).total_cmp(&sine(y)))
+                .unwrap_or(0);
+            for k in 3..n {
+                rows.push([f[a], f[(a + 1) % n], f[(a + 2) % n], f[(a + k) % n]]);
+            }
+        }
+    }
+    rows
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -267,6 +305,118 @@ mod tests {
             }
         }
         (var_of, x)
+    }
+
+    /// A small P-Hex mesh (the tangent-duality start of `sphere-radial`: pentagons and
+    /// hexagons, planar) with every coordinate moved by up to 5e-4 of the mean edge (seeded).
+    fn noisy_hexagons(size: f64) -> PolyMesh {
+        let mut cfg = crate::scenes::phex_scene("sphere-radial").unwrap().config;
+        cfg.optimize = false;
+        cfg.size = Some(size);
+        let mut mesh = crate::phex::phex_run(cfg).unwrap().mesh;
+        let e = mesh.mean_edge();
+        let mut seed = 3u64;
+        for p in &mut mesh.positions {
+            for c in 0..3 {
+                seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
+                p[c] += 1e-3 * e * ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5);
+            }
+        }
+        mesh
+    }
+
+    /// On polygons too, a step is the dense least move onto the linearised determinants,
+    /// `n - 3` of them per face of `n` vertices, each a corner and a further vertex.
+    #[test]
+    fn a_polygon_step_is_the_least_move_onto_its_determinants() {
+        let mesh = noisy_hexagons(0.5);
+        let rows = planarity_rows(&mesh);
+        let sizes = mesh.face_sizes();
+        assert!(sizes.keys().any(|&n| n > 4), "{sizes:?}");
+        let wanted: usize = mesh.faces().map(|f| f.len().saturating_sub(3)).sum();
+        assert_eq!(rows.len(), wanted);
+        for (r, f) in rows.iter().zip(
+            mesh.faces()
+                .flat_map(|f| std::iter::repeat_n(f, f.len().saturating_sub(3))),
+        ) {
+            assert!(r.iter().all(|v| f.contains(v)), "{r:?} not in {f:?}");
+        }
+        let fixed = [0, 7];
+        let (var_of, mut x) = unknowns(&mesh, &fixed);
+        let x0 = x.clone();
+        let mut j = DMatrix::<f64>::zeros(rows.len(), x.len());
+        let mut c = DVector::zeros(rows.len());
+        for (q, r) in rows.iter().enumerate() {
+            let (d, g) = quad_det_grad(r.map(|v| mesh.positions[v as usize]));
+            c[q] = d;
+            for (k, &v) in r.iter().enumerate() {
+                if var_of[v as usize] != FIXED {
+                    for a in 0..3 {
+                        j[(q, var_of[v as usize] as usize + a)] += g[k][a];
+                    }
+                }
+            }
+        }
+        let jjt = &j * j.transpose();
+        let dense = -(j.transpose() * jjt.lu().solve(&c).unwrap());
+        let mut p = PlanarProjection::new(&mesh, &var_of, usize::MAX).unwrap();
+        let mut work = mesh.positions.clone();
+        p.step(&mut work, &var_of, &mut x).unwrap();
+        let step = DVector::from_iterator(x.len(), x.iter().zip(&x0).map(|(a, b)| a - b));
+        assert!(
+            (&step - &dense).norm() <= 1e-9 * dense.norm(),
+            "{:e} against {:e}",
+            (&step - &dense).norm(),
+            dense.norm()
+        );
+        for &v in &fixed {
+            assert_eq!(work[v], mesh.positions[v]);
+        }
+    }
+
+    /// From polygons 5e-4 edges from planar, the steps converge quadratically to planarity
+    /// 1e-13, moving the vertices about as far as the noise.
+    #[test]
+    fn steps_converge_quadratically_to_planar_polygons() {
+        let mesh = noisy_hexagons(0.2);
+        let (var_of, mut x) = unknowns(&mesh, &[]);
+        let mut p = PlanarProjection::new(&mesh, &var_of, usize::MAX).unwrap();
+        let mut work = mesh.positions.clone();
+        let rows = planarity_rows(&mesh);
+        let residual = |w: &[Vec3]| {
+            rows.iter()
+                .map(|r| quad_det_grad(r.map(|v| w[v as usize])).0.abs())
+                .fold(0.0, f64::max)
+        };
+        let mut r = residual(&work);
+        let mut steps = 0;
+        while r > 1e-14 {
+            let (before, after) = p.step(&mut work, &var_of, &mut x).unwrap();
+            assert!(after < before);
+            steps += 1;
+            let next = residual(&work);
+            if r < 1e-2 {
+                assert!(
+                    next <= 10.0 * r * r + 1e-14,
+                    "step {steps}: {r:e} to {next:e}"
+                );
+            }
+            r = next;
+            assert!(steps <= 4, "residual {r:e} after {steps} steps");
+        }
+        let moved = PolyMesh::new(work.clone(), mesh.faces().map(|f| f.to_vec())).unwrap();
+        assert!(
+            max_planarity(&moved) <= 1e-13,
+            "{:e}",
+            max_planarity(&moved)
+        );
+        let e = mesh.mean_edge();
+        let moves = work
+            .iter()
+            .zip(&mesh.positions)
+            .map(|(a, b)| (a - b).norm());
+        let largest = moves.fold(0.0, f64::max);
+        assert!(largest <= 1e-3 * e, "moved {:e} edges", largest / e);
     }
 
     /// An `n x n` grid over a translational surface z = f(x) + g(y), whose grid quads are
@@ -311,9 +461,9 @@ mod tests {
         }
         let jjt = &j * j.transpose();
         let dense = -(j.transpose() * jjt.lu().solve(&c).unwrap());
-        let mut p = QuadProjection::new(&mesh, &var_of, usize::MAX).unwrap();
+        let mut p = PlanarProjection::new(&mesh, &var_of, usize::MAX).unwrap();
         let mut work = mesh.positions.clone();
-        p.step(&mesh, &mut work, &var_of, &mut x).unwrap();
+        p.step(&mut work, &var_of, &mut x).unwrap();
         let step = DVector::from_iterator(x.len(), x.iter().zip(&x0).map(|(a, b)| a - b));
         assert!(
             (&step - &dense).norm() <= 1e-9 * dense.norm(),
@@ -338,7 +488,7 @@ mod tests {
         mesh.positions[held].z += 0.3 / n as f64;
         let fixed = [held, 0, n, n * (n + 1), (n + 1) * (n + 1) - 1];
         let (var_of, mut x) = unknowns(&mesh, &fixed);
-        let mut p = QuadProjection::new(&mesh, &var_of, usize::MAX).unwrap();
+        let mut p = PlanarProjection::new(&mesh, &var_of, usize::MAX).unwrap();
         let mut work = mesh.positions.clone();
         let residual = |w: &[Vec3]| {
             mesh.faces()
@@ -352,7 +502,7 @@ mod tests {
         let mut r = residual(&work);
         let mut steps = 0;
         while r > 1e-14 {
-            p.step(&mesh, &mut work, &var_of, &mut x).unwrap();
+            p.step(&mut work, &var_of, &mut x).unwrap();
             steps += 1;
             let next = residual(&work);
             if r < 1e-2 {
