@@ -31,6 +31,7 @@ pub(crate) use block_system::{BlockLayout, BlockSystem};
 pub(crate) use cholesky::SparseCholesky;
 pub(crate) use gauss_newton::{BlockLeastSquares, LmAnalysis};
 pub use gauss_newton::{LevenbergMarquardt, LmOptions, LmStep, NonlinearLeastSquares};
+pub(crate) use nested_dissection::amd_ordering;
 pub(crate) use pattern::csc_pattern;
 pub use sqp::{ConstrainedLeastSquares, Sqp, SqpOptions, SqpStep};
 

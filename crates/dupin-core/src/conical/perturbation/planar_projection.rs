@@ -33,7 +33,9 @@ use super::problem::NONE as FIXED;
 use crate::Vec3;
 use crate::conical::discrete_terms::quad_det_grad;
 use crate::mesh::PolyMesh;
-use crate::solver::{SolverError, SparseCholesky, csc_pattern, fill_reducing_ordering};
+use crate::solver::{
+    SolverError, SparseCholesky, amd_ordering, csc_pattern, fill_reducing_ordering,
+};
 
 /// Relative Levenberg damping of the face-space matrix: it keeps a determinant whose four
 /// vertices are all held (a zero row) from making the matrix singular and is far below the
@@ -81,12 +83,15 @@ impl PlanarProjection {
     }
 
     /// The pattern and its analysis for `mesh` whose vertex `v` has its unknowns at
-    /// `var_of[v] .. + 3` (`u32::MAX` for none). Refused like the other solvers when the factor
-    /// would take more than `max_factor_bytes`.
+    /// `var_of[v] .. + 3` (`u32::MAX` for none), ordered by AMD, and with `dissection` by
+    /// whichever of AMD and nested dissection gives the smaller factor
+    /// ([`fill_reducing_ordering`]: on quad grids the dissection's, on hexagons AMD's). Refused
+    /// like the other solvers when the factor would take more than `max_factor_bytes`.
     pub(crate) fn new(
         mesh: &PolyMesh,
         var_of: &[u32],
         max_factor_bytes: usize,
+        dissection: bool,
     ) -> Result<Self, SolverError> {
         let rows = planarity_rows(mesh);
         let nf = rows.len();
@@ -123,7 +128,11 @@ impl PlanarProjection {
             }
         }
         let (pattern, csc_slot) = csc_pattern(nf, &pairs)?;
-        let order = fill_reducing_ordering(nf, &pattern)?;
+        let order = if dissection {
+            fill_reducing_ordering(nf, &pattern)?
+        } else {
+            amd_ordering(&pattern)?
+        };
         let cholesky = SparseCholesky::analyse_within(pattern.as_ref(), &order, max_factor_bytes)?;
         let slot = |k: usize| cholesky.positions()[csc_slot[k] as usize];
         let diagonal = (0..nf).map(slot).collect();
@@ -359,7 +368,7 @@ mod tests {
         }
         let jjt = &j * j.transpose();
         let dense = -(j.transpose() * jjt.lu().solve(&c).unwrap());
-        let mut p = PlanarProjection::new(&mesh, &var_of, usize::MAX).unwrap();
+        let mut p = PlanarProjection::new(&mesh, &var_of, usize::MAX, true).unwrap();
         let mut work = mesh.positions.clone();
         p.step(&mut work, &var_of, &mut x).unwrap();
         let step = DVector::from_iterator(x.len(), x.iter().zip(&x0).map(|(a, b)| a - b));
@@ -380,7 +389,7 @@ mod tests {
     fn steps_converge_quadratically_to_planar_polygons() {
         let mesh = noisy_hexagons(0.2);
         let (var_of, mut x) = unknowns(&mesh, &[]);
-        let mut p = PlanarProjection::new(&mesh, &var_of, usize::MAX).unwrap();
+        let mut p = PlanarProjection::new(&mesh, &var_of, usize::MAX, true).unwrap();
         let mut work = mesh.positions.clone();
         let rows = planarity_rows(&mesh);
         let residual = |w: &[Vec3]| {
@@ -461,7 +470,7 @@ mod tests {
         }
         let jjt = &j * j.transpose();
         let dense = -(j.transpose() * jjt.lu().solve(&c).unwrap());
-        let mut p = PlanarProjection::new(&mesh, &var_of, usize::MAX).unwrap();
+        let mut p = PlanarProjection::new(&mesh, &var_of, usize::MAX, true).unwrap();
         let mut work = mesh.positions.clone();
         p.step(&mut work, &var_of, &mut x).unwrap();
         let step = DVector::from_iterator(x.len(), x.iter().zip(&x0).map(|(a, b)| a - b));
@@ -488,7 +497,7 @@ mod tests {
         mesh.positions[held].z += 0.3 / n as f64;
         let fixed = [held, 0, n, n * (n + 1), (n + 1) * (n + 1) - 1];
         let (var_of, mut x) = unknowns(&mesh, &fixed);
-        let mut p = PlanarProjection::new(&mesh, &var_of, usize::MAX).unwrap();
+        let mut p = PlanarProjection::new(&mesh, &var_of, usize::MAX, true).unwrap();
         let mut work = mesh.positions.clone();
         let residual = |w: &[Vec3]| {
             mesh.faces()

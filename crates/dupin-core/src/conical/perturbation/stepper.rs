@@ -431,6 +431,7 @@ impl PqPerturbation {
                     &self.work,
                     &self.terms.var_of,
                     self.options.max_factor_bytes,
+                    true,
                 )?,
             });
         }
