@@ -4,9 +4,9 @@
 // points of z = 2 sin(x / 5) + 0.06 y², 20 m x 15 m), opened with the file input and panelled
 // at size 0.22 m (10 203 faces), `runs` times (Reset, then Play).
 //   DUPIN_URL=http://127.0.0.1:8094/ node tests/e2e/bench-import.mjs [runs]
-// Prints per run: the worker's solver time summed over the run's states (`timing.solve`), its
-// steps' time as `session.step()` measures it (solver and metrics, `ms`), and the wall time from
-// Play to `done` (every state also drawn and posted).
+// Prints per run: the worker's time summed over the run's states, split as `timing` splits it
+// (solver, metrics, render buffers), its steps' time as `session.step()` measures it (solver and
+// metrics, `ms`), and the wall time from Play to `done` (every state also drawn and posted).
 import { byId, openPage, waitDone } from './harness.mjs';
 
 function roofJson() {
@@ -53,6 +53,8 @@ try {
         maxPlanarity: last.maxPlanarity,
         states: log.length,
         solveMs: Math.round(sum((s) => s.timing?.solve)),
+        metricsMs: Math.round(sum((s) => s.timing?.metrics)),
+        meshMs: Math.round(sum((s) => s.timing?.mesh)),
         stepMs: Math.round(sum((s) => s.ms)),
         wallMs: Math.round(last.at - since),
       };
