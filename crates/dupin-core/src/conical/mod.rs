@@ -23,12 +23,14 @@ mod discrete_terms;
 mod live_edit;
 mod offset;
 mod perturbation;
-#[cfg(test)]
-pub(crate) use perturbation::FAIL_STEPS;
-pub(crate) use perturbation::PlanarProjection;
 mod principal_quads;
 mod refinement;
 mod support;
+
+// The least move onto planar faces, shared with the P-Hex optimiser's near-planar starts.
+#[cfg(test)]
+pub(crate) use perturbation::FAIL_STEPS;
+pub(crate) use perturbation::PlanarProjection;
 
 pub use circular::{circular_residual, quad_circularity};
 pub use cones::{

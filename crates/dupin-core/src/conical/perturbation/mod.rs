@@ -55,7 +55,7 @@
 //! |---|---|---|
 //! | 2.2, 5 | mode, weights, caps, exact-phase solver, errors | `options.rs` |
 //! | 2.2 (eqs. (3), (5)), 3.2 (eq. (6)), 5 (eq. (7)) | unknowns, penalty rows, exact constraints | `problem.rs` |
-//! | 2.2 | a live edit's exact phase on quad meshes: the least move in face space | `planar_projection.rs` |
+//! | 2.2 | a live edit's exact phase on quad meshes (and P-Hex's near-planar starts): the least move onto planar faces in face space | `planar_projection.rs` |
 //! | 2.2 | the stepper (penalty phase, then exact phase), its metrics and result, the one-shot run | `stepper.rs` |
 
 mod options;

@@ -48,7 +48,8 @@ const HALVINGS: usize = 4;
 #[cfg(test)]
 thread_local! {
     /// Tests only: every step fails (to exercise what a live edit does when its fast way
-    /// misses, which no move found by a search over the library's quad meshes does).
+    /// misses, which no move found by a search over the library's quad meshes does, and the
+    /// P-Hex optimiser's hand-over to its weighted steps).
     pub(crate) static FAIL_STEPS: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
