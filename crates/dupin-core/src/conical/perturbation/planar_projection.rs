@@ -13,15 +13,16 @@
 //!
 //! with `c` the determinants and `J` their gradients with respect to the free vertices. The
 //! matrix `J Jᵀ` has one unknown per determinant (its multiplier `λ`), coupled to those
-//! sharing a vertex with it. The exact phase of [`super::PqPerturbation`] solves the same least-move
-//! problem on the vertex positions and one plane per face, its normal matrix one 3 x 3 block
-//! per vertex after the planes are eliminated: three times the unknowns on the same graph, so
-//! its supernodal factor takes about 27 times the floating-point work of this one (a
-//! 10 000-quad grid: 60 ms natively per factorisation, and in wasm, whose dense kernels run
-//! two lanes without fused multiply-add against AVX-512's eight, 0.25 s; a whole step here,
-//! evaluation and assembly included, takes about 15 ms natively). A live edit moves a vertex
-//! of a planar mesh and a kept design is near planar, so every Newton step is near the
-//! constraints, where the determinants are as good a measure of planarity as the planes.
+//! sharing a vertex with it. The exact phase of [`super::PqPerturbation`] solves the same
+//! least-move problem on the vertex positions and one plane per face, its normal matrix one
+//! 3 x 3 block per vertex after the planes are eliminated: on quads three times the unknowns
+//! on the same graph, so its supernodal factor takes about 27 times the floating-point work of
+//! this one (a 10 000-quad grid: 60 ms natively per factorisation, and in wasm, whose dense
+//! kernels run two lanes without fused multiply-add against AVX-512's eight, 0.25 s; a whole
+//! step here, evaluation and assembly included, takes about 15 ms natively). A live edit
+//! moves a vertex of a planar mesh and a kept design is near planar, so every Newton step is
+//! near the constraints, where the determinants are as good a measure of planarity as the
+//! planes.
 //!
 //! Only planar mode: the conical and circular conditions are not determinants. The P-Hex
 //! optimiser's vertex-space normal matrix (3 unknowns per vertex, two vertices per hexagon,
@@ -67,7 +68,7 @@ pub(crate) struct PlanarProjection {
     /// For every pair of corners at one free vertex (in the order [`Self::assemble`] walks
     /// them), where its product lands in the factor's values.
     slots: Vec<u32>,
-    /// Where each quad's diagonal entry lands.
+    /// Where each determinant's diagonal entry lands.
     diagonal: Vec<u32>,
     cholesky: SparseCholesky,
     values: Vec<f64>,
@@ -95,7 +96,7 @@ impl PlanarProjection {
         dissection: bool,
     ) -> Result<Self, SolverError> {
         let rows = planarity_rows(mesh);
-        let nf = rows.len();
+        let nr = rows.len();
         let nv = mesh.num_vertices();
         let mut start = vec![0u32; nv + 1];
         for f in &rows {
@@ -118,8 +119,9 @@ impl PlanarProjection {
                 }
             }
         }
-        // The upper triangle's entries: every quad's diagonal, then the pairs at each vertex.
-        let mut pairs: Vec<(u32, u32)> = (0..nf as u32).map(|q| (q, q)).collect();
+        // The upper triangle's entries: every determinant's diagonal, then the pairs at each
+        // vertex.
+        let mut pairs: Vec<(u32, u32)> = (0..nr as u32).map(|q| (q, q)).collect();
         for v in 0..nv {
             let at = &incident[start[v] as usize..start[v + 1] as usize];
             for (i, &(a, _)) in at.iter().enumerate() {
@@ -128,16 +130,16 @@ impl PlanarProjection {
                 }
             }
         }
-        let (pattern, csc_slot) = csc_pattern(nf, &pairs)?;
+        let (pattern, csc_slot) = csc_pattern(nr, &pairs)?;
         let order = if dissection {
-            fill_reducing_ordering(nf, &pattern)?
+            fill_reducing_ordering(nr, &pattern)?
         } else {
             amd_ordering(&pattern)?
         };
         let cholesky = SparseCholesky::analyse_within(pattern.as_ref(), &order, max_factor_bytes)?;
         let slot = |k: usize| cholesky.positions()[csc_slot[k] as usize];
-        let diagonal = (0..nf).map(slot).collect();
-        let slots = (nf..pairs.len()).map(slot).collect();
+        let diagonal = (0..nr).map(slot).collect();
+        let slots = (nr..pairs.len()).map(slot).collect();
         let values = vec![0.0; cholesky.nnz()];
         Ok(PlanarProjection {
             faces: mesh.faces().flatten().copied().collect(),
@@ -149,8 +151,8 @@ impl PlanarProjection {
             diagonal,
             cholesky,
             values,
-            grads: vec![[Vec3::zeros(); 4]; nf],
-            residual: vec![0.0; nf],
+            grads: vec![[Vec3::zeros(); 4]; nr],
+            residual: vec![0.0; nr],
             factorizations: 0,
         })
     }
