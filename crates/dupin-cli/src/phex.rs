@@ -169,10 +169,10 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
         .map(|(k, v)| (k.to_string(), json!(v)))
         .collect();
     let reason = goals.shortfall(
+        &r.mesh,
         rep.max_planarity,
         rep.iterations,
         rep.invalid_faces,
-        rep.faces,
     );
     let mut report = json!({
         "vertices": rep.vertices,

@@ -94,10 +94,10 @@ fn phex_on_a_fitted_mixed_curvature_mesh_reports_what_it_misses() {
     );
     assert!(gaussian(1.0) > 10 && gaussian(-1.0) > 10, "both signs of K");
     let missed = goals.shortfall(
+        &r.mesh,
         rep.max_planarity,
         rep.iterations,
         rep.invalid_faces,
-        rep.faces,
     );
     if rep.invalid_faces > 0 || rep.max_planarity > 1e-10 {
         let missed = missed.expect("a run that misses says so");
@@ -245,10 +245,10 @@ fn a_cylinder_mesh_is_cut_open_along_a_seam_fitted_and_panelled() {
     );
     assert!(rep.max_planarity <= 1e-10, "{}", rep.max_planarity);
     let missed = goals.shortfall(
+        &r.mesh,
         rep.max_planarity,
         rep.iterations,
         rep.invalid_faces,
-        rep.faces,
     );
     assert_eq!(
         missed.is_some(),

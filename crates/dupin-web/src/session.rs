@@ -1125,9 +1125,7 @@ impl Session {
                 let m = p.metrics();
                 let reason = p
                     .is_done()
-                    .then(|| {
-                        goals.shortfall(m.max_planarity, m.iteration, m.invalid_faces, m.faces)
-                    })
+                    .then(|| goals.shortfall(&mesh, m.max_planarity, m.iteration, m.invalid_faces))
                     .flatten();
                 Metrics {
                     phase: if reason.is_some() {

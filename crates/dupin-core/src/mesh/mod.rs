@@ -35,9 +35,9 @@ pub use frame::SolverFrame;
 pub use io::{ObjError, PointSetError, parse_obj, parse_points, parse_segments, write_obj};
 pub use picking::{VertexPick, VertexStarError, pick_vertex, vertex_ring};
 pub use planarity::{
-    PLANARITY_HIST_BINS, PLANARITY_HIST_HI, PLANARITY_HIST_LO, face_planarities, face_planarity,
-    flipped_faces, least_squares_plane, max_planarity, mean_planarity, planarity_histogram,
-    plane_basis, representable_planarity,
+    PLANARITY_HIST_BINS, PLANARITY_HIST_HI, PLANARITY_HIST_LO, coordinate_precision_note,
+    face_planarities, face_planarity, flipped_faces, least_squares_plane, max_planarity,
+    mean_planarity, planarity_histogram, plane_basis, representable_planarity,
 };
 pub use polygon::{PolygonError, is_simple_polygon, segments_intersect, strictly_inside_triangle};
 pub use polymesh::{MeshError, PolyMesh};

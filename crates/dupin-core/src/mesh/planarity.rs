@@ -160,6 +160,22 @@ pub fn representable_planarity(mesh: &PolyMesh) -> f64 {
     }
 }
 
+/// When `mesh`'s coordinates cannot hold `tolerance` (a design far from the origin for its
+/// size: [`representable_planarity`] above a tenth of it), the clause an unconverged reason
+/// ends with, naming that precision and what to do; otherwise empty.
+pub fn coordinate_precision_note(mesh: &PolyMesh, tolerance: f64) -> String {
+    let floor = representable_planarity(mesh);
+    if floor > 0.1 * tolerance {
+        format!(
+            "; the coordinates' precision at this distance from the origin allows \
+             planarity of about {floor:.1e} only: move the design near the origin \
+             (subtract a reference point, add it back after)"
+        )
+    } else {
+        String::new()
+    }
+}
+
 /// [`face_planarity`] of every face of `mesh`, in face order.
 pub fn face_planarities(mesh: &PolyMesh) -> Vec<f64> {
     (0..mesh.num_faces())

@@ -2,7 +2,7 @@
 //! and 7): planarity, validity (simple polygon), convexity and the shape deviation from the
 //! affine regular (K > 0) or affine quasi-regular (K < 0) hexagon, plus the surface distance.
 
-use crate::mesh::{PolyMesh, face_planarity, is_simple_polygon};
+use crate::mesh::{PolyMesh, coordinate_precision_note, face_planarity, is_simple_polygon};
 
 use crate::surface::Surface;
 
@@ -191,13 +191,15 @@ impl PhexGoals {
     }
 
     /// What a finished run with these figures misses, each miss in a sentence (joined by `; `);
-    /// `None` when it meets every goal. A NaN planarity is a miss.
+    /// `None` when it meets every goal. A NaN planarity is a miss. `mesh` is the run's result:
+    /// a planarity miss on a design too far from the origin for its size names the
+    /// coordinates' precision as the cause ([`coordinate_precision_note`]).
     pub fn shortfall(
         &self,
+        mesh: &PolyMesh,
         max_planarity: f64,
         iterations: usize,
         invalid_faces: usize,
-        faces: usize,
     ) -> Option<String> {
         let mut missed = Vec::new();
         if let Some(tolerance) = self.planarity
@@ -205,13 +207,15 @@ impl PhexGoals {
         {
             missed.push(format!(
                 "max_planarity {max_planarity:.3e} is above the tolerance {tolerance:.0e} after \
-                 {iterations} iterations"
+                 {iterations} iterations{}",
+                coordinate_precision_note(mesh, tolerance)
             ));
         }
         if self.valid && invalid_faces > 0 {
             missed.push(format!(
-                "{invalid_faces} of {faces} faces are self-intersecting (invalid); try a larger \
-                 size or another method"
+                "{invalid_faces} of {} faces are self-intersecting (invalid); try a larger \
+                 size or another method",
+                mesh.num_faces()
             ));
         }
         (!missed.is_empty()).then(|| missed.join("; "))
@@ -221,6 +225,16 @@ impl PhexGoals {
 #[cfg(test)]
 mod goal_tests {
     use super::PhexGoals;
+    use crate::Vec3;
+    use crate::mesh::PolyMesh;
+
+    /// A planar 10 x 10 grid of unit quads (100 faces) with its corner at `origin`.
+    fn grid(origin: Vec3) -> PolyMesh {
+        let positions = (0..11)
+            .flat_map(|j| (0..11).map(move |i| origin + Vec3::new(i as f64, j as f64, 0.0)))
+            .collect();
+        PolyMesh::quad_grid(positions, 10, 10).unwrap()
+    }
 
     #[test]
     fn shortfall_names_each_missed_goal_and_nan_misses() {
@@ -228,15 +242,39 @@ mod goal_tests {
             planarity: Some(1e-10),
             valid: true,
         };
-        assert_eq!(goals.shortfall(1e-12, 4, 0, 100), None);
-        let both = goals.shortfall(1e-6, 10, 3, 100).unwrap();
+        let mesh = grid(Vec3::zeros());
+        assert_eq!(goals.shortfall(&mesh, 1e-12, 4, 0), None);
+        let both = goals.shortfall(&mesh, 1e-6, 10, 3).unwrap();
         assert!(both.contains("1.000e-6 is above the tolerance 1e-10 after 10 iterations"));
         assert!(both.contains("3 of 100 faces are self-intersecting"));
-        assert!(goals.shortfall(f64::NAN, 1, 0, 1).is_some());
+        assert!(!both.contains("precision"), "{both}");
+        assert!(goals.shortfall(&mesh, f64::NAN, 1, 0).is_some());
         let lax = PhexGoals {
             planarity: None,
             valid: false,
         };
-        assert_eq!(lax.shortfall(f64::NAN, 0, 50, 100), None);
+        assert_eq!(lax.shortfall(&mesh, f64::NAN, 0, 50), None);
+    }
+
+    /// At state-plane offsets unit panels cannot be planar to 1e-10 in f64 (coordinates 2e-9
+    /// apart at 1e7): the miss names the coordinates' precision and what to do.
+    #[test]
+    fn far_from_the_origin_a_planarity_miss_names_the_coordinate_precision() {
+        let goals = PhexGoals {
+            planarity: Some(1e-10),
+            valid: true,
+        };
+        let far = grid(Vec3::new(3e6, 5e6, 0.0));
+        let why = goals.shortfall(&far, 9.2e-9, 10, 0).unwrap();
+        assert!(
+            why.contains("precision")
+                && why.contains("about 1.1e-9")
+                && why.contains("near the origin"),
+            "{why}"
+        );
+        // The same miss near the origin is the solver's, not the coordinates'.
+        let near = grid(Vec3::zeros());
+        let why = goals.shortfall(&near, 9.2e-9, 10, 0).unwrap();
+        assert!(!why.contains("precision"), "{why}");
     }
 }

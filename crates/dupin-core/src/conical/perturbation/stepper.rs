@@ -10,8 +10,8 @@ use crate::conical::conical_residual;
 use crate::mesh::MeshTopology;
 use crate::mesh::PolyMesh;
 use crate::mesh::SolverFrame;
+use crate::mesh::coordinate_precision_note;
 use crate::mesh::max_planarity;
-use crate::mesh::representable_planarity;
 use crate::solver::{
     LevenbergMarquardt, LmAnalysis, LmOptions, LmStep, SolverError, Sqp, SqpOptions,
 };
@@ -652,16 +652,7 @@ impl PqPerturbation {
     /// When the user's coordinates cannot hold the tolerance (a design far from the origin
     /// for its size), a note saying so and what to do; otherwise nothing.
     fn precision_note(&self) -> String {
-        let floor = representable_planarity(&self.mesh);
-        if floor > 0.1 * self.options.tolerance {
-            format!(
-                "; the coordinates' precision at this distance from the origin allows \
-                 planarity of about {floor:.1e} only: move the design near the origin \
-                 (subtract a reference point, add it back after)"
-            )
-        } else {
-            String::new()
-        }
+        coordinate_precision_note(&self.mesh, self.options.tolerance)
     }
 
     /// Switches to the exact phase; `probe`: its first step is the trial of
@@ -779,6 +770,7 @@ pub fn pq_perturb(mesh: &PolyMesh, options: PqOptions) -> Result<PqResult, PqErr
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::representable_planarity;
     use crate::scenes::benchmark_meshes::{noisy_vase, skew_quad_grid, torus_centroid_dual};
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
