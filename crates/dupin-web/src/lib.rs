@@ -27,6 +27,8 @@ mod schema;
 #[cfg(feature = "configurator")]
 mod session;
 #[cfg(feature = "configurator")]
+mod shown_mesh;
+#[cfg(feature = "configurator")]
 mod teach;
 // The canvas viewer needs wgpu's browser backends, which exist only on wasm32.
 #[cfg(target_arch = "wasm32")]

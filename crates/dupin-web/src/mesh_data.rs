@@ -1,8 +1,8 @@
 //! Triangle buffers handed to JavaScript as typed arrays.
 
 use dupin_core::mesh::{
-    PolyMesh, TriangleBuffers, face_planarity, planarity_color, polymesh_buffers, polymesh_edges,
-    write_obj,
+    PanelBuffers, PolyMesh, TriangleBuffers, face_planarity, planarity_color, polymesh_buffers,
+    polymesh_edges, write_obj,
 };
 
 use dupin_core::surface::{Torus, sample_surface};
@@ -45,6 +45,17 @@ impl MeshData {
             buffers,
             colors,
             edges: polymesh_edges(&mesh),
+            panels: Some(mesh),
+            panel_arrays: None,
+        }
+    }
+
+    /// Flat panels of `mesh` from its [`PanelBuffers`].
+    pub(crate) fn from_panel_buffers(mesh: PolyMesh, panels: PanelBuffers) -> Self {
+        MeshData {
+            buffers: panels.buffers,
+            colors: panels.colors,
+            edges: panels.edges,
             panels: Some(mesh),
             panel_arrays: None,
         }

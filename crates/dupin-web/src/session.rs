@@ -3,6 +3,7 @@
 use crate::import::Imported;
 use crate::js::{err, refuse_unknown_keys, to_js};
 use crate::mesh_data::MeshData;
+use crate::shown_mesh::ShownMesh;
 use dupin_core::Stepper;
 use dupin_core::conical::{
     PqMode, PqSceneMeasures, PqSceneStepInfo, PqSceneStepper, offset_mesh, pq_scene_shortfall,
@@ -14,8 +15,8 @@ use dupin_core::fabrication::{
 };
 use dupin_core::mesh::{
     ColorMode, NOT_HEX, PLANARITY_HIST_HI, PLANARITY_HIST_LO, PLANARITY_LEGEND_LOG10, PolyMesh,
-    REGULARITY_LEGEND, convexity_color, face_planarities, max_planarity, mean_planarity,
-    planarity_color, planarity_histogram, regularity_color, write_obj,
+    REGULARITY_LEGEND, convexity_color, max_planarity, mean_planarity, planarity_color,
+    planarity_histogram, regularity_color, write_obj,
 };
 use dupin_core::phex::{
     Initialisation, LayerRule, PhexConfig, PhexGoals, PhexPipeline, TriangulationMethod, face_info,
@@ -192,10 +193,9 @@ enum Run {
 pub struct Session {
     run: Run,
     config: SessionConfig,
-    /// Per-face planarity of the current mesh, computed by the first reader after a step and
-    /// cleared by the next step: the metrics and the planarity colours of the render buffers
-    /// both need it (a worker step asks for both).
-    per_face: Option<Vec<f64>>,
+    /// The current mesh's per-face figures and render buffers, for the metrics and `mesh()`
+    /// (a worker step asks for both), carried over the faces a state shares with the last.
+    shown: ShownMesh,
     /// Extra layers drawn with the panels (`setLayers`).
     layers: LayerConfig,
     /// The opened design (`Session.fromFile`), shown with the metrics.
@@ -397,7 +397,7 @@ impl Session {
         Ok(Session {
             run,
             config: cfg,
-            per_face: None,
+            shown: ShownMesh::default(),
             layers: LayerConfig::default(),
             design: None,
             nurbs: None,
@@ -421,7 +421,7 @@ impl Session {
                 imported: Some(name.to_string()),
                 ..SessionConfig::default()
             },
-            per_face: None,
+            shown: ShownMesh::default(),
             layers: LayerConfig::default(),
             design: Some(design),
         })
@@ -458,7 +458,6 @@ impl Session {
             .map_err(|e| JsError::new(&e))?;
         self.run = imported_run(imported);
         self.design = Some(design);
-        self.per_face = None;
         Ok(())
     }
 
@@ -473,7 +472,6 @@ impl Session {
     /// [`Session::step`] without building the metrics (the worker times the solver and the
     /// metrics separately, then calls `metrics()`).
     pub fn advance(&mut self) -> Result<(), JsError> {
-        self.per_face = None;
         match &mut self.run {
             Run::Phex(p, _) => {
                 if !p.is_done() {
@@ -842,7 +840,6 @@ impl Session {
             .hold_group(vertex, dupin_core::Vec3::new(x, y, z), &group)
             .map_err(err)?;
         *started = true;
-        self.per_face = None;
         Ok(())
     }
 
@@ -993,13 +990,10 @@ impl Session {
     /// [`Session::mesh`] for Rust callers: `None` is planarity colours.
     pub fn mesh_in(&mut self, mode: Option<&str>) -> Result<MeshData, JsError> {
         let mode = ColorMode::parse(mode.unwrap_or("")).map_err(err)?;
-        let m = self.current_mesh().unwrap_or_default();
+        self.sync_shown();
+        let m = self.shown.mesh().clone();
         let colors: Vec<[f32; 3]> = match mode {
-            ColorMode::Planarity => self
-                .face_planarities(&m)
-                .iter()
-                .map(|&p| planarity_color(p))
-                .collect(),
+            ColorMode::Planarity => Vec::new(),
             ColorMode::Convexity => (0..m.num_faces())
                 .map(|i| {
                     let f = face_info(&m, i, 0.0);
@@ -1024,7 +1018,13 @@ impl Session {
                     .collect()
             }
         };
-        let mut data = MeshData::panels(m.clone(), &colors);
+        let mut data = match mode {
+            // Planarity colours are kept from state to state (see `ShownMesh`).
+            ColorMode::Planarity => {
+                MeshData::from_panel_buffers(m.clone(), self.shown.planarity_panels().clone())
+            }
+            _ => MeshData::panels(m.clone(), &colors),
+        };
         // The held vertices of a panel mesh: the opened design's anchors and every dragged one.
         if let Run::Pq { stepper, .. } = &self.run
             && !stepper.anchors().is_empty()
@@ -1043,16 +1043,10 @@ impl Session {
         Ok(data)
     }
 
-    /// Per-face planarity of `mesh` (the current mesh), cached until the next step.
-    fn face_planarities(&mut self, mesh: &PolyMesh) -> Vec<f64> {
-        match &self.per_face {
-            Some(v) if v.len() == mesh.num_faces() => v.clone(),
-            _ => {
-                let v = face_planarities(mesh);
-                self.per_face = Some(v.clone());
-                v
-            }
-        }
+    /// Brings [`Session::shown`] up to the current mesh.
+    fn sync_shown(&mut self) {
+        let mesh = self.current_mesh().unwrap_or_default();
+        self.shown.sync(mesh);
     }
 
     /// Why this run has no offset layer (see `offsetUnavailable`).
@@ -1102,30 +1096,25 @@ impl Session {
     }
 
     fn metrics_struct(&mut self) -> Metrics {
-        let mesh = self.current_mesh().unwrap_or_default();
-        let per_face = self.face_planarities(&mesh);
-        let mean_planarity = mean_planarity(&per_face);
-        let histogram = planarity_histogram(&per_face);
+        self.sync_shown();
+        let mesh = self.shown.mesh();
+        let per_face = self.shown.planarity();
+        let mean_planarity = mean_planarity(per_face);
+        let histogram = planarity_histogram(per_face);
         let hist_log10 = [PLANARITY_HIST_LO, PLANARITY_HIST_HI];
-        // One pass over the faces: self-intersecting ones, and simple ones that are not convex.
-        let (mut self_intersecting, mut non_convex_faces) = (0, 0);
-        for i in 0..mesh.num_faces() {
-            let f = face_info(&mesh, i, 0.0);
-            self_intersecting += usize::from(!f.simple);
-            non_convex_faces += usize::from(f.simple && !f.convex);
-        }
+        let (self_intersecting, non_convex_faces) = self.shown.shape_counts();
         let mean_edge = mesh.mean_edge();
         let mean_edge_m = self
             .design
             .as_ref()
             .map(|d| mean_edge * d.unit.parse::<LengthUnit>().unwrap_or_default().to_m());
-        let extent = extent(&mesh);
+        let extent = extent(mesh);
         match &self.run {
             Run::Phex(p, goals) => {
                 let m = p.metrics();
                 let reason = p
                     .is_done()
-                    .then(|| goals.shortfall(&mesh, m.max_planarity, m.iteration, m.invalid_faces))
+                    .then(|| goals.shortfall(mesh, m.max_planarity, m.iteration, m.invalid_faces))
                     .flatten();
                 Metrics {
                     phase: if reason.is_some() {
@@ -1207,7 +1196,7 @@ impl Session {
                     max_determinant,
                     singular_points_inside,
                     design: self.design.clone(),
-                    deviation_mm: self.design.as_ref().and_then(|d| d.deviation_mm(&mesh)),
+                    deviation_mm: self.design.as_ref().and_then(|d| d.deviation_mm(mesh)),
                     non_convex_faces,
                     mean_edge_m,
                     // The first step only shows the control mesh.
@@ -1305,7 +1294,7 @@ mod tests {
         Session {
             run: Run::Phex(Box::new(PhexPipeline::new(cfg).unwrap()), goals),
             config: serde_json::from_str(r#"{"surface": "torus"}"#).unwrap(),
-            per_face: None,
+            shown: ShownMesh::default(),
             layers: LayerConfig::default(),
             design: None,
             nurbs: None,
@@ -1345,8 +1334,9 @@ mod tests {
         assert!(m.reason.unwrap().contains("faces are self-intersecting"));
     }
 
-    /// The per-face planarity cache follows every step: the metrics' mean and histogram and
-    /// the planarity colours always match a fresh computation on the current mesh.
+    /// The per-face figures kept from state to state follow every step: the metrics' mean and
+    /// histogram and the planarity colours always match a fresh computation on the current
+    /// mesh.
     #[test]
     fn cached_face_planarity_follows_every_step() {
         let mut cfg =
@@ -1368,7 +1358,7 @@ mod tests {
             };
             assert_eq!(m.mean_planarity, mean);
             assert_eq!(m.histogram, planarity_histogram(&fresh));
-            assert_eq!(session.face_planarities(&mesh), fresh);
+            assert_eq!(session.shown.planarity(), fresh.as_slice());
             optimised += usize::from(m.phase == "optimisation" || m.phase == "done");
         }
         assert!(optimised >= 2, "the run optimised");
@@ -1381,7 +1371,7 @@ mod tests {
                 started: false,
             },
             config: serde_json::from_str(&format!(r#"{{"scene": "{scene}"}}"#)).unwrap(),
-            per_face: None,
+            shown: ShownMesh::default(),
             layers: LayerConfig::default(),
             design: None,
             nurbs: None,

@@ -45,12 +45,24 @@ pub enum MeshError {
 ///
 /// Faces are stored as one flat index array with offsets, so a mesh of 50k hexagons is two
 /// allocations, not 50k.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct PolyMesh {
     /// Vertex positions.
     pub positions: Vec<Vec3>,
+    /// Where each face starts in `face_verts`, then where the last one ends (so never empty).
     face_start: Vec<u32>,
     face_verts: Vec<u32>,
+}
+
+/// The empty mesh, as `PolyMesh::new` builds it from no vertices and no faces.
+impl Default for PolyMesh {
+    fn default() -> Self {
+        PolyMesh {
+            positions: Vec::new(),
+            face_start: vec![0],
+            face_verts: Vec::new(),
+        }
+    }
 }
 
 impl PolyMesh {
@@ -223,6 +235,18 @@ mod tests {
         assert_eq!(m.face_sizes().get(&4), Some(&1));
         assert!((m.bbox_diagonal() - 2f64.sqrt()).abs() < 1e-15);
         assert!((m.face_mean_edge(0) - 1.0).abs() < 1e-15);
+    }
+
+    /// The default mesh is the empty one `new` builds: no faces, no vertices (not a panic).
+    #[test]
+    fn the_default_mesh_is_the_empty_one() {
+        let empty = PolyMesh::default();
+        assert_eq!(
+            empty,
+            PolyMesh::new(vec![], Vec::<[u32; 3]>::new()).unwrap()
+        );
+        assert_eq!((empty.num_faces(), empty.num_vertices()), (0, 0));
+        assert_eq!(empty.faces().count(), 0);
     }
 
     #[test]

@@ -37,46 +37,141 @@ pub fn polymesh_buffers(
 ) -> (TriangleBuffers, Vec<f32>) {
     let mut out = TriangleBuffers::default();
     let mut colors = Vec::new();
-    for (fi, f) in mesh.faces().enumerate() {
-        let p: Vec<Vec3> = f.iter().map(|&v| mesh.positions[v as usize]).collect();
-        // Newell's normal: robust for non-planar and non-convex polygons.
-        let mut n = Vec3::zeros();
-        for k in 0..p.len() {
-            n += p[k].cross(&p[(k + 1) % p.len()]);
-        }
-        let n = n.try_normalize(0.0).unwrap_or_else(Vec3::z);
-        let base = out.vertex_count() as u32;
-        for q in &p {
-            out.positions.extend([q.x as f32, q.y as f32, q.z as f32]);
-            out.normals.extend([n.x as f32, n.y as f32, n.z as f32]);
-            if let Some(c) = face_colors.and_then(|c| c.get(fi)) {
-                colors.extend(c);
-            }
-        }
-        for k in 1..p.len() as u32 - 1 {
-            out.indices.extend([base, base + k, base + k + 1]);
-        }
-    }
+    push_faces(mesh, 0, face_colors, &mut out, &mut colors);
     (out, colors)
 }
 
-/// Every edge of a polygon mesh once, as pairs of `[x, y, z]` endpoints (6 floats an edge), for
-/// drawing panel frames.
-pub fn polymesh_edges(mesh: &PolyMesh) -> Vec<f32> {
-    let mut seen = std::collections::HashSet::new();
-    let mut out = Vec::new();
-    for f in mesh.faces() {
+/// Appends faces `from..` of `mesh` to `out` and (with `face_colors`) their colours to
+/// `colors`, as [`polymesh_buffers`] lays them out.
+fn push_faces(
+    mesh: &PolyMesh,
+    from: usize,
+    face_colors: Option<&[[f32; 3]]>,
+    out: &mut TriangleBuffers,
+    colors: &mut Vec<f32>,
+) {
+    // The page rebuilds these at every state of a run, so nothing is allocated per face.
+    let faces = from..mesh.num_faces();
+    let corners: usize = faces.clone().map(|i| mesh.face(i).len()).sum();
+    let triangles: usize = faces
+        .clone()
+        .map(|i| mesh.face(i).len().saturating_sub(2))
+        .sum();
+    out.positions.reserve(3 * corners);
+    out.normals.reserve(3 * corners);
+    out.indices.reserve(3 * triangles);
+    if face_colors.is_some() {
+        colors.reserve(3 * corners);
+    }
+    for fi in faces {
+        let f = mesh.face(fi);
+        let at = |k: usize| mesh.positions[f[k] as usize];
+        // Newell's normal: robust for non-planar and non-convex polygons.
+        let mut n = Vec3::zeros();
         for k in 0..f.len() {
-            let (a, b) = (f[k], f[(k + 1) % f.len()]);
-            if seen.insert((a.min(b), a.max(b))) {
-                for v in [a, b] {
-                    let q = mesh.positions[v as usize];
-                    out.extend([q.x as f32, q.y as f32, q.z as f32]);
-                }
+            n += at(k).cross(&at((k + 1) % f.len()));
+        }
+        let n = n.try_normalize(0.0).unwrap_or_else(Vec3::z);
+        let base = out.vertex_count() as u32;
+        let color = face_colors.and_then(|c| c.get(fi));
+        for k in 0..f.len() {
+            let q = at(k);
+            out.positions.extend([q.x as f32, q.y as f32, q.z as f32]);
+            out.normals.extend([n.x as f32, n.y as f32, n.z as f32]);
+            if let Some(c) = color {
+                colors.extend(c);
             }
         }
+        for k in 1..f.len() as u32 - 1 {
+            out.indices.extend([base, base + k, base + k + 1]);
+        }
     }
+}
+
+/// Every edge of a polygon mesh once, as pairs of `[x, y, z]` endpoints (6 floats an edge), for
+/// drawing panel frames. Edges come in the order of their (lower, higher) vertex pairs, from
+/// the lower vertex.
+pub fn polymesh_edges(mesh: &PolyMesh) -> Vec<f32> {
+    let mut out = Vec::new();
+    push_edge_segments(mesh, &edge_keys(mesh, 0), &mut out);
     out
+}
+
+/// The edges of faces `from..` of `mesh` as (lower, higher) vertex pairs in a `u64`, sorted,
+/// each once. Sorting finds each edge once at a fraction of hashing's cost.
+fn edge_keys(mesh: &PolyMesh, from: usize) -> Vec<u64> {
+    let mut keys: Vec<u64> = (from..mesh.num_faces())
+        .flat_map(|i| {
+            let f = mesh.face(i);
+            (0..f.len()).map(move |k| {
+                let (a, b) = (f[k], f[(k + 1) % f.len()]);
+                (u64::from(a.min(b)) << 32) | u64::from(a.max(b))
+            })
+        })
+        .collect();
+    keys.sort_unstable();
+    keys.dedup();
+    keys
+}
+
+/// Appends the segments of the edges `keys` ([`edge_keys`]) to `out`, from the lower vertex.
+fn push_edge_segments(mesh: &PolyMesh, keys: &[u64], out: &mut Vec<f32>) {
+    out.reserve(6 * keys.len());
+    for &key in keys {
+        for v in [key >> 32, key & u64::from(u32::MAX)] {
+            let q = mesh.positions[v as usize];
+            out.extend([q.x as f32, q.y as f32, q.z as f32]);
+        }
+    }
+}
+
+/// [`polymesh_buffers`] and [`polymesh_edges`] of a mesh that grows by faces, kept from one
+/// state to the next: a P-Hex run reveals its triangulation a layer at a time and the page draws
+/// every layer, so rebuilding at every state visited each face once per later layer (1.1 M face
+/// visits for the 10 203-panel roof's 111 states). [`PanelBuffers::extend`] adds only the new
+/// faces.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PanelBuffers {
+    /// The faces' triangles, as [`polymesh_buffers`] lays them out.
+    pub buffers: TriangleBuffers,
+    /// One RGB triple per vertex of `buffers`.
+    pub colors: Vec<f32>,
+    /// Every edge once (6 floats an edge), in the order the faces brought them.
+    pub edges: Vec<f32>,
+    /// Every edge so far as [`edge_keys`] has them, sorted.
+    edge_keys: Vec<u64>,
+    /// How many faces are in.
+    faces: usize,
+}
+
+impl PanelBuffers {
+    /// How many faces are in: the first `faces()` of the meshes given to `extend`.
+    pub fn faces(&self) -> usize {
+        self.faces
+    }
+
+    /// Adds faces `self.faces()..` of `mesh`, face `i` coloured `face_colors[i]` (one triple
+    /// per face of `mesh`). `mesh`'s first `self.faces()` faces must be the ones already in,
+    /// at the same positions (the caller checks: the buffers cannot).
+    pub fn extend(&mut self, mesh: &PolyMesh, face_colors: &[[f32; 3]]) {
+        let from = self.faces.min(mesh.num_faces());
+        push_faces(
+            mesh,
+            from,
+            Some(face_colors),
+            &mut self.buffers,
+            &mut self.colors,
+        );
+        let mut fresh = edge_keys(mesh, from);
+        fresh.retain(|k| self.edge_keys.binary_search(k).is_err());
+        push_edge_segments(mesh, &fresh, &mut self.edges);
+        if !fresh.is_empty() {
+            self.edge_keys.extend(fresh);
+            // Two sorted runs: the sort merges them in linear time.
+            self.edge_keys.sort();
+        }
+        self.faces = mesh.num_faces();
+    }
 }
 
 #[cfg(test)]
@@ -99,7 +194,84 @@ mod tests {
         assert_eq!(c.len(), 21);
         assert_eq!(&c[12..15], &[0.0, 1.0, 0.0]);
         assert!(b.normals.chunks(3).all(|n| n == [0.0, 0.0, 1.0]));
-        // 4 + 3 edges, the shared edge 1-2 once.
-        assert_eq!(polymesh_edges(&m).len(), 6 * 6);
+        // 4 + 3 edges, the shared edge 1-2 once, each from its lower vertex.
+        let edges = polymesh_edges(&m);
+        let pairs: Vec<[usize; 2]> = edges
+            .chunks(6)
+            .map(|e| {
+                let find = |q: &[f32]| {
+                    (0..5)
+                        .find(|&v| {
+                            let p = m.positions[v];
+                            [p.x as f32, p.y as f32, p.z as f32] == q
+                        })
+                        .unwrap()
+                };
+                [find(&e[..3]), find(&e[3..])]
+            })
+            .collect();
+        assert_eq!(pairs, [[0, 1], [0, 3], [1, 2], [1, 4], [2, 3], [2, 4]]);
+    }
+
+    /// A 6 x 5 grid of quads, each split into two triangles with the odd ones reversed, so
+    /// shared edges come both ways.
+    fn triangles() -> PolyMesh {
+        let positions = (0..6)
+            .flat_map(|j| (0..7).map(move |i| Vec3::new(i as f64, j as f64, (i * j) as f64 * 0.1)))
+            .collect();
+        let faces: Vec<[u32; 3]> = (0..5u32)
+            .flat_map(|j| {
+                (0..6u32).flat_map(move |i| {
+                    let v = |a: u32, b: u32| b * 7 + a;
+                    [
+                        [v(i, j), v(i + 1, j), v(i + 1, j + 1)],
+                        [v(i, j), v(i + 1, j + 1), v(i, j + 1)],
+                    ]
+                })
+            })
+            .collect();
+        PolyMesh::new(positions, faces).unwrap()
+    }
+
+    /// The first `n` faces of `mesh`.
+    fn first(mesh: &PolyMesh, n: usize) -> PolyMesh {
+        PolyMesh::new(
+            mesh.positions.clone(),
+            (0..n).map(|i| mesh.face(i).to_vec()).collect::<Vec<_>>(),
+        )
+        .unwrap()
+    }
+
+    /// Grown a layer at a time, the buffers are the one-shot ones bit for bit and the edges
+    /// the same set, each once; in one go, the edges too are the one-shot ones.
+    #[test]
+    fn panel_buffers_grown_by_layers_are_the_one_shot_ones() {
+        let mesh = triangles();
+        let colors: Vec<[f32; 3]> = (0..mesh.num_faces())
+            .map(|i| [i as f32 / 60.0, 0.5, 1.0 - i as f32 / 60.0])
+            .collect();
+        let (buffers, vertex_colors) = polymesh_buffers(&mesh, Some(&colors));
+        let mut grown = PanelBuffers::default();
+        for n in [0, 7, 12, 12, 31, 60] {
+            grown.extend(&first(&mesh, n), &colors[..n]);
+            assert_eq!(grown.faces(), n);
+        }
+        assert_eq!(grown.buffers, buffers);
+        assert_eq!(grown.colors, vertex_colors);
+        let segments = |e: &[f32]| {
+            let mut s: Vec<Vec<u32>> = e
+                .chunks(6)
+                .map(|c| c.iter().map(|x| x.to_bits()).collect())
+                .collect();
+            s.sort();
+            s
+        };
+        let one_shot = polymesh_edges(&mesh);
+        assert_eq!(one_shot.len(), 6 * (6 * 6 + 7 * 5 + 30));
+        assert_eq!(segments(&grown.edges), segments(&one_shot));
+        let mut once = PanelBuffers::default();
+        once.extend(&mesh, &colors);
+        assert_eq!(once.edges, one_shot);
+        assert_eq!(once.buffers, buffers);
     }
 }

@@ -31,7 +31,10 @@ pub use duality::{
 };
 pub use pipeline::{PhexConfig, PhexMetrics, PhexPhase, PhexPipeline, PhexResult, phex_run};
 pub use planarity_optimisation::{PlanarityOptimiser, PlanarityOptions, PlanarityStep};
-pub use report::{FaceInfo, PhexGoals, PhexReport, count_invalid_faces, face_info, phex_report};
+pub use report::{
+    FaceInfo, PhexGoals, PhexReport, count_invalid_and_non_convex_faces, count_invalid_faces,
+    face_info, phex_report,
+};
 pub use triangulation::{
     ConjugateFields, DEFAULT_BOUND, LayerRule, MAX_PHEX_FACES, MAX_RATIO, MAX_RATIO_ELLIPTIC,
     Triangulation, TriangulationMethod, TriangulationSpec, bounded_ratio,

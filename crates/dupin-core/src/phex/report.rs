@@ -52,42 +52,58 @@ pub struct PhexReport {
     pub per_face: Vec<FaceInfo>,
 }
 
-/// Face `i` of `mesh` projected onto its Newell-normal plane (2D points in face order).
-fn projected_face(mesh: &PolyMesh, i: usize) -> Vec<Vec2> {
-    let pts: Vec<Vec3> = mesh
-        .face(i)
-        .iter()
-        .map(|&v| mesh.positions[v as usize])
-        .collect();
-    let c = pts.iter().sum::<Vec3>() / pts.len() as f64;
+/// Face `i` of `mesh` projected onto its Newell-normal plane (2D points in face order), into
+/// `out` (cleared first: callers that visit every face reuse one buffer).
+fn project_face_into(mesh: &PolyMesh, i: usize, out: &mut Vec<Vec2>) {
+    let f = mesh.face(i);
+    let at = |k: usize| mesh.positions[f[k] as usize];
+    let c = f.iter().map(|&v| mesh.positions[v as usize]).sum::<Vec3>() / f.len() as f64;
     let mut n = Vec3::zeros();
-    for i in 0..pts.len() {
-        n += (pts[i] - c).cross(&(pts[(i + 1) % pts.len()] - c));
+    for k in 0..f.len() {
+        n += (at(k) - c).cross(&(at((k + 1) % f.len()) - c));
     }
     let n = n.try_normalize(0.0).unwrap_or(Vec3::z());
     let (e1, e2) = crate::mesh::plane_basis(n);
-    pts.iter()
-        .map(|p| Vec2::new((p - c).dot(&e1), (p - c).dot(&e2)))
-        .collect()
+    out.clear();
+    out.extend((0..f.len()).map(|k| {
+        let d = at(k) - c;
+        Vec2::new(d.dot(&e1), d.dot(&e2))
+    }));
 }
 
-/// Whether face `i` of `mesh`, projected to its plane, is a simple polygon: `FaceInfo::simple`
-/// alone (the validity test run after every optimisation step, without the planarity and
-/// shape figures of [`face_info`]).
-fn is_simple_face(mesh: &PolyMesh, i: usize) -> bool {
-    is_simple_polygon(&projected_face(mesh, i)).unwrap_or(false)
+/// `(simple, convex)` of the projected polygon `q`, as [`FaceInfo`] has them.
+fn simple_and_convex(q: &[Vec2]) -> (bool, bool) {
+    let n = q.len();
+    let simple = is_simple_polygon(q).unwrap_or(false);
+    let turn = |k: usize| (q[(k + 1) % n] - q[k]).perp(&(q[(k + 2) % n] - q[(k + 1) % n]));
+    let convex = simple && ((0..n).all(|k| turn(k) > 0.0) || (0..n).all(|k| turn(k) < 0.0));
+    (simple, convex)
+}
+
+/// `(self-intersecting, simple but not convex)` counts of the faces `faces` of `mesh`
+/// ([`FaceInfo::simple`] and [`FaceInfo::convex`], without the planarity and shape figures: the
+/// page counts them at every state of a run).
+pub fn count_invalid_and_non_convex_faces(
+    mesh: &PolyMesh,
+    faces: std::ops::Range<usize>,
+) -> (usize, usize) {
+    let mut q = Vec::new();
+    let (mut invalid, mut non_convex) = (0, 0);
+    for i in faces {
+        project_face_into(mesh, i, &mut q);
+        let (simple, convex) = simple_and_convex(&q);
+        invalid += usize::from(!simple);
+        non_convex += usize::from(simple && !convex);
+    }
+    (invalid, non_convex)
 }
 
 /// Diagnostics of face `i` of `mesh`, with `gaussian` the curvature there.
 pub fn face_info(mesh: &PolyMesh, i: usize, gaussian: f64) -> FaceInfo {
-    let q = projected_face(mesh, i);
-    let n = q.len();
-    let simple = is_simple_polygon(&q).unwrap_or(false);
-    let turns: Vec<f64> = (0..n)
-        .map(|k| (q[(k + 1) % n] - q[k]).perp(&(q[(k + 2) % n] - q[(k + 1) % n])))
-        .collect();
-    let convex = simple && (turns.iter().all(|&t| t > 0.0) || turns.iter().all(|&t| t < 0.0));
-    let shape_deviation = (n == 6).then(|| {
+    let mut q = Vec::new();
+    project_face_into(mesh, i, &mut q);
+    let (simple, convex) = simple_and_convex(&q);
+    let shape_deviation = (q.len() == 6).then(|| {
         let c = q.iter().sum::<Vec2>() / 6.0;
         let r: Vec<Vec2> = q.iter().map(|p| p - c).collect();
         let scale = r.iter().map(|v| v.norm()).fold(0.0, f64::max).max(1e-300);
@@ -117,8 +133,14 @@ pub fn face_info(mesh: &PolyMesh, i: usize, gaussian: f64) -> FaceInfo {
 /// the report's `invalid_faces` (P-Hex paper, section 4.1: a valid hexagon does not
 /// self-intersect), for any polygon mesh.
 pub fn count_invalid_faces(mesh: &PolyMesh) -> usize {
+    // `FaceInfo::simple` alone: the validity test run after every optimisation step, without
+    // the planarity and shape figures of [`face_info`].
+    let mut q = Vec::new();
     (0..mesh.num_faces())
-        .filter(|&i| !is_simple_face(mesh, i))
+        .filter(|&i| {
+            project_face_into(mesh, i, &mut q);
+            !is_simple_polygon(&q).unwrap_or(false)
+        })
         .count()
 }
 
@@ -219,6 +241,51 @@ impl PhexGoals {
             ));
         }
         (!missed.is_empty()).then(|| missed.join("; "))
+    }
+}
+
+#[cfg(test)]
+mod shape_tests {
+    use super::*;
+
+    /// The counts the page shows at every state are `face_info`'s, face for face: a convex
+    /// quad, a dart (simple, not convex), a bow tie (self-intersecting), a triangle and a
+    /// collinear triangle (not simple).
+    #[test]
+    fn the_counts_are_face_info_s() {
+        let p = |x: f64, y: f64, z: f64| Vec3::new(x, y, z);
+        let positions = vec![
+            p(0.0, 0.0, 0.0),
+            p(1.0, 0.0, 0.0),
+            p(1.0, 1.0, 0.0),
+            p(0.0, 1.0, 0.0),
+            p(0.3, 0.3, 0.0),
+            p(2.0, 0.0, 0.0),
+            p(3.0, 0.0, 0.0),
+        ];
+        let faces = [
+            vec![0u32, 1, 2, 3],
+            vec![0, 1, 4, 3],
+            vec![0, 2, 1, 3],
+            vec![1, 5, 2],
+            vec![1, 5, 6],
+        ];
+        let mesh = PolyMesh::new(positions, faces).unwrap();
+        let infos: Vec<FaceInfo> = (0..5).map(|i| face_info(&mesh, i, 0.0)).collect();
+        let shape: Vec<(bool, bool)> = infos.iter().map(|f| (f.simple, f.convex)).collect();
+        assert_eq!(
+            shape,
+            [
+                (true, true),
+                (true, false),
+                (false, false),
+                (true, true),
+                (false, false)
+            ]
+        );
+        assert_eq!(count_invalid_and_non_convex_faces(&mesh, 0..5), (2, 1));
+        assert_eq!(count_invalid_and_non_convex_faces(&mesh, 2..4), (1, 0));
+        assert_eq!(count_invalid_faces(&mesh), 2);
     }
 }
 
