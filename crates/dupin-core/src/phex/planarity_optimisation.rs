@@ -72,11 +72,10 @@ use crate::conical::PlanarProjection;
 use crate::mesh::{PolyMesh, max_planarity};
 use crate::solver::SolverError;
 use crate::solver::SparseCholesky;
+use crate::solver::amd_ordering;
 use crate::surface::Surface;
 use crate::{Vec2, Vec3};
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::sparse::linalg::amd;
-use faer::sparse::{SymbolicSparseColMat, SymbolicSparseColMatRef};
+use faer::sparse::SymbolicSparseColMat;
 use nalgebra::Matrix3;
 
 /// Settings of the planarity optimisation.
@@ -211,13 +210,12 @@ impl BlockPattern {
         let mut col_ptr = Vec::with_capacity(3 * nv + 1);
         block_ptr.push(0);
         col_ptr.push(0);
-        for (j, l) in lists.iter_mut().enumerate() {
+        for l in &mut lists {
             l.sort_unstable();
             l.dedup();
             blocks.extend_from_slice(l);
             block_ptr.push(blocks.len());
             let below = 3 * (l.len() - 1);
-            let _ = j;
             for c in 0..3 {
                 let last = *col_ptr.last().expect("starts with 0");
                 col_ptr.push(last + below + c + 1);
@@ -284,30 +282,14 @@ impl BlockPattern {
 /// 3 x 3 blocks), as the scalar permutation `fwd[new] = old`.
 fn vertex_amd_ordering(pattern: &BlockPattern) -> Vec<u32> {
     let nv = pattern.block_ptr.len() - 1;
-    let col_ptr: Vec<u32> = pattern.block_ptr.iter().map(|&c| c as u32).collect();
-    let graph = SymbolicSparseColMatRef::new_checked(nv, nv, &col_ptr, None, &pattern.blocks);
-    let mut perm = vec![0u32; nv];
-    let mut perm_inv = vec![0u32; nv];
-    let mut mem = MemBuffer::new(amd::order_maybe_unsorted_scratch::<u32>(
-        nv,
-        pattern.blocks.len(),
-    ));
-    if amd::order_maybe_unsorted(
-        &mut perm,
-        &mut perm_inv,
-        graph,
-        amd::Control::default(),
-        MemStack::new(&mut mem),
-    )
-    .is_err()
-    {
-        perm = (0..nv as u32).collect();
-    }
-    let mut fwd = Vec::with_capacity(3 * nv);
-    for &v in &perm {
-        fwd.extend([3 * v, 3 * v + 1, 3 * v + 2]);
-    }
-    fwd
+    let col_ptr = pattern.block_ptr.iter().map(|&c| c as u32).collect();
+    let graph = SymbolicSparseColMat::new_checked(nv, nv, col_ptr, None, pattern.blocks.clone());
+    // An ordering that fails (its workspace could not be had) leaves the vertices in order:
+    // the factorisation is then slower, not wrong.
+    let perm = amd_ordering(&graph).unwrap_or_else(|_| (0..nv as u32).collect());
+    perm.iter()
+        .flat_map(|&v| [3 * v, 3 * v + 1, 3 * v + 2])
+        .collect()
 }
 
 /// Tetrahedron volume of four points and its gradients with respect to each of them.
