@@ -151,7 +151,7 @@ fn bench_dupin_start(
     let p = PhexPipeline::new(cfg.clone()).unwrap();
     let d = p.initial_dual_mesh().unwrap();
     let options = cfg.planarity_options();
-    let run = |d: &DualMesh| optimise(&mut d.mesh.clone(), d, p.surface(), options);
+    let run = |d: &DualMesh| optimise(&mut d.mesh.clone(), d, p.solver_surface(), options);
     let c0 = thread_cpu_seconds();
     let o = run(&d);
     eprintln!(

@@ -1112,9 +1112,20 @@ impl Session {
         match &self.run {
             Run::Phex(p, goals) => {
                 let m = p.metrics();
+                // Measured on the mesh shown, in the user's coordinates: an imported design
+                // is solved in its own frame (`PhexPipeline::frame`), and far from the origin
+                // the user's coordinates hold less than the solver's.
+                // A NaN face makes the whole NaN (a miss), as the optimiser's figure did.
+                let max_planarity = per_face.iter().fold(0.0, |a: f64, &b| {
+                    if a.is_nan() || b.is_nan() {
+                        f64::NAN
+                    } else {
+                        a.max(b)
+                    }
+                });
                 let reason = p
                     .is_done()
-                    .then(|| goals.shortfall(mesh, m.max_planarity, m.iteration, m.invalid_faces))
+                    .then(|| goals.shortfall(mesh, max_planarity, m.iteration, m.invalid_faces))
                     .flatten();
                 Metrics {
                     phase: if reason.is_some() {
@@ -1127,7 +1138,7 @@ impl Session {
                     iteration: m.iteration,
                     faces: m.faces,
                     vertices: m.vertices,
-                    max_planarity: m.max_planarity,
+                    max_planarity,
                     mean_planarity,
                     invalid_faces: m.invalid_faces,
                     histogram,

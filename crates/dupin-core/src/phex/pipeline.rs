@@ -12,7 +12,7 @@ use super::triangulation::{
     triangulate_along_fields,
 };
 use crate::Stepper;
-use crate::mesh::PolyMesh;
+use crate::mesh::{PolyMesh, SolverFrame};
 use crate::surface::{
     FREEFORM, FreeformSurface, NurbsSurface, Surface, TwistedSurface, surface_by_name,
 };
@@ -187,7 +187,14 @@ pub struct PhexMetrics {
 /// surface at once); [`Stepper::step`] then reveals it one layer per step, builds the dual
 /// mesh, and runs one Gauss-Newton iteration per step.
 pub struct PhexPipeline {
+    /// The surface in the solver's frame: what the triangulation, the dual mesh and the
+    /// optimisation work on.
     surface: Box<dyn Surface>,
+    /// Where the solver works (see [`PhexPipeline::frame`]).
+    frame: SolverFrame,
+    /// With a frame other than the identity: the user's surface, and the triangulation in the
+    /// user's coordinates (what `surface()` and `triangulation()` hand out).
+    user: Option<(Box<dyn Surface>, Triangulation)>,
     config: PhexConfig,
     tri: Triangulation,
     /// Number of triangles complete after each layer.
@@ -210,7 +217,25 @@ pub struct PhexResult {
     pub report: PhexReport,
 }
 
-fn build_surface(config: &PhexConfig) -> Result<Box<dyn Surface>, PhexError> {
+/// The frame an imported design is solved in: the unit box of its control net
+/// ([`SolverFrame::unit_box`]: centred, scaled by a power of two into about `[-1, 1]^3`). P-Hex's
+/// absolute thresholds (the paper's parabolic |K| < 1e-8, the optimiser's weights λ and μ) are
+/// set for the library's surfaces, a few units across: a design drawn in millimetres or at
+/// state-plane offsets must be panelled as the same design in metres near the origin. The
+/// library surfaces (and a twisted import, whose twist is about the user's axis) keep the
+/// identity.
+fn solver_frame(config: &PhexConfig) -> SolverFrame {
+    match &config.nurbs {
+        Some(n) if config.twist == 0.0 => {
+            let (lo, hi) = n.control_bounds();
+            SolverFrame::unit_box(&[lo, hi])
+        }
+        _ => SolverFrame::identity(),
+    }
+}
+
+/// `config`'s surface in `frame` (the identity: the user's).
+fn build_surface(config: &PhexConfig, frame: &SolverFrame) -> Result<Box<dyn Surface>, PhexError> {
     let params: Vec<(&str, f64)> = config
         .params
         .iter()
@@ -222,7 +247,11 @@ fn build_surface(config: &PhexConfig) -> Result<Box<dyn Surface>, PhexError> {
                 "an imported surface has no parameters to set".into(),
             ));
         }
-        Box::new(NurbsSurface::clone(nurbs))
+        if *frame == SolverFrame::identity() {
+            Box::new(NurbsSurface::clone(nurbs))
+        } else {
+            Box::new(nurbs.in_frame(frame))
+        }
     } else if config.surface == FREEFORM {
         let (mut amplitude, mut curl) = (0.4, 0.3);
         for (k, v) in &params {
@@ -262,7 +291,8 @@ fn build_surface(config: &PhexConfig) -> Result<Box<dyn Surface>, PhexError> {
 
 impl PhexPipeline {
     /// The hexagonal mesh dual to the current triangulation, by the configured initialisation
-    /// (section 6), before any optimisation.
+    /// (section 6), before any optimisation, in the solver's frame (with
+    /// [`PhexPipeline::solver_surface`]).
     pub fn initial_dual_mesh(&self) -> Result<DualMesh, PhexError> {
         dual_mesh(
             &self.tri,
@@ -298,10 +328,13 @@ impl PhexPipeline {
                 "lower bound b = {bound} must be in [0, 1]"
             )));
         }
-        let surface = build_surface(&config)?;
+        let frame = solver_frame(&config);
+        let surface = build_surface(&config, &frame)?;
         if config.loop_subdivision {
             return Self::from_loop(config, surface);
         }
+        // Lengths in the user's unit, for messages.
+        let user_len = |l: f64| crate::math::Num(l * frame.scale());
         let dom = surface.domain();
         let (along_dom, across_dom) = if config.swap {
             (dom.v, dom.u)
@@ -331,21 +364,22 @@ impl PhexPipeline {
                 "the base curve has zero or non-finite length: change the region".into(),
             ));
         }
-        let size = config.size.unwrap_or(base_len / 48.0);
+        let size = config.size.map_or(base_len / 48.0, |s| s / frame.scale());
         if !(size.is_finite() && size > 0.0) {
             return Err(PhexError::BadSize(format!(
                 "size {} must be a positive length",
-                crate::math::Num(size)
+                user_len(size)
             )));
         }
         let samples_f = (base_len / size).round();
         if !(6.0..=4000.0).contains(&samples_f) {
             return Err(PhexError::BadSize(format!(
-                "size {} gives {samples_f} samples on a base curve of length {base_len:.3}; \
+                "size {} gives {samples_f} samples on a base curve of length {:.3}; \
                  use a size between {:.3e} and {:.3e}",
-                crate::math::Num(size),
-                base_len / 4000.0,
-                base_len / 6.0
+                user_len(size),
+                base_len * frame.scale(),
+                base_len / 4000.0 * frame.scale(),
+                base_len / 6.0 * frame.scale()
             )));
         }
         let spec = TriangulationSpec {
@@ -398,7 +432,19 @@ impl PhexPipeline {
         for j in 1..layer_triangles.len() {
             layer_triangles[j] += layer_triangles[j - 1];
         }
-        Ok(Self::at_start(surface, config, tri, layer_triangles))
+        let mut pipeline = Self::at_start(surface, config, tri, layer_triangles);
+        if frame != SolverFrame::identity() {
+            let mut user_tri = pipeline.tri.clone();
+            for p in &mut user_tri.positions {
+                *p = frame.to_user(*p);
+            }
+            pipeline.user = Some((
+                build_surface(&pipeline.config, &SolverFrame::identity())?,
+                user_tri,
+            ));
+            pipeline.frame = frame;
+        }
+        Ok(pipeline)
     }
 
     /// A pipeline before its first step: no layer shown, no dual mesh, no optimiser.
@@ -410,6 +456,8 @@ impl PhexPipeline {
     ) -> Self {
         PhexPipeline {
             surface,
+            frame: SolverFrame::identity(),
+            user: None,
             config,
             tri,
             layer_triangles,
@@ -464,38 +512,69 @@ impl PhexPipeline {
         &self.config
     }
 
-    /// The surface being meshed.
+    /// The surface being meshed, in the user's coordinates.
     pub fn surface(&self) -> &dyn Surface {
+        match &self.user {
+            Some((s, _)) => s.as_ref(),
+            None => self.surface.as_ref(),
+        }
+    }
+
+    /// The frame the solver works in: the identity for a library surface, the unit box of the
+    /// control net for an imported design (see `solver_frame`). Everything the pipeline hands
+    /// out is in the user's coordinates, but for [`PhexPipeline::solver_surface`] and
+    /// [`PhexPipeline::initial_dual_mesh`].
+    pub fn frame(&self) -> SolverFrame {
+        self.frame
+    }
+
+    /// The surface as the solver sees it, in [`PhexPipeline::frame`].
+    pub fn solver_surface(&self) -> &dyn Surface {
         self.surface.as_ref()
     }
 
-    /// The full triangulation.
+    /// The full triangulation, in the user's coordinates.
     pub fn triangulation(&self) -> &Triangulation {
-        &self.tri
+        match &self.user {
+            Some((_, t)) => t,
+            None => &self.tri,
+        }
     }
 
-    /// The current mesh: the triangles of the layers shown so far, then the hexagonal mesh.
+    /// `mesh` (in the solver's frame) in the user's coordinates.
+    fn to_user(&self, mut mesh: PolyMesh) -> PolyMesh {
+        if self.user.is_some() {
+            for p in &mut mesh.positions {
+                *p = self.frame.to_user(*p);
+            }
+        }
+        mesh
+    }
+
+    /// The current mesh, in the user's coordinates: the triangles of the layers shown so far,
+    /// then the hexagonal mesh.
     pub fn mesh(&self) -> PolyMesh {
         match &self.dual {
-            Some(d) => d.mesh.clone(),
+            Some(d) => self.to_user(d.mesh.clone()),
             None => {
                 let k = if self.shown == 0 {
                     0
                 } else {
                     self.layer_triangles[self.shown - 1]
                 };
-                PolyMesh::new(self.tri.positions.clone(), &self.tri.triangles[..k])
-                    .unwrap_or_default()
+                let tri = self.triangulation();
+                PolyMesh::new(tri.positions.clone(), &tri.triangles[..k]).unwrap_or_default()
             }
         }
     }
 
+    /// The Gaussian curvature (in the user's unit) at every face's triangulation vertex.
     fn face_gaussian(&self, d: &DualMesh) -> Vec<f64> {
         d.face_vertex
             .iter()
             .map(|&v| {
                 let uv = self.tri.uv[v as usize];
-                self.surface
+                self.surface()
                     .curvature(uv.x, uv.y)
                     .map(|c| c.gaussian)
                     .unwrap_or(0.0)
@@ -503,7 +582,8 @@ impl PhexPipeline {
             .collect()
     }
 
-    /// The report of the current hexagonal mesh (`None` before it exists).
+    /// The report of the current hexagonal mesh (`None` before it exists), measured in the
+    /// user's coordinates: the mesh a fabricator gets, not the solver's.
     pub fn report(&self) -> Option<PhexReport> {
         let d = self.dual.as_ref()?;
         // The optimiser's last foot points seed the distance searches: the vertices have moved
@@ -518,8 +598,8 @@ impl PhexPipeline {
             None => d.vertex_uv.clone(),
         };
         Some(phex_report(
-            &d.mesh,
-            self.surface.as_ref(),
+            &self.to_user(d.mesh.clone()),
+            self.surface(),
             &self.face_gaussian(d),
             &seeds,
             self.optimiser.as_ref().map_or(0, |o| o.iteration()),
@@ -630,9 +710,13 @@ impl Stepper for PhexPipeline {
         let dual = self.dual.take().ok_or_else(|| {
             PhexError::NoValidTriangulation("no hexagonal mesh was produced".into())
         })?;
+        let mesh = self.to_user(dual.mesh);
         Ok(PhexResult {
-            mesh: dual.mesh,
-            triangulation: self.tri,
+            mesh,
+            triangulation: match self.user {
+                Some((_, t)) => t,
+                None => self.tri,
+            },
             report,
         })
     }

@@ -1307,7 +1307,7 @@ mod tests {
             PlanarityOptimiser::new(&d.mesh, Some(&d.vertex_uv), cfg.planarity_options()).unwrap();
         assert!(!opt.direct && opt.max_planarity() > 1e-3);
         while !opt.is_done() {
-            opt.step(&mut d.mesh, p.surface()).unwrap();
+            opt.step(&mut d.mesh, p.solver_surface()).unwrap();
         }
         assert!(opt.max_planarity() <= 1e-10, "{:e}", opt.max_planarity());
         assert!(opt.iteration() <= 5, "{} iterations", opt.iteration());
@@ -1342,7 +1342,11 @@ mod tests {
         assert!(opt.least_move);
         let mut planarity = vec![opt.max_planarity()];
         while !opt.is_done() {
-            planarity.push(opt.step(&mut d.mesh, p.surface()).unwrap().max_planarity);
+            planarity.push(
+                opt.step(&mut d.mesh, p.solver_surface())
+                    .unwrap()
+                    .max_planarity,
+            );
         }
         assert!(opt.least_move, "{planarity:?}");
         assert!(opt.max_planarity() <= options.tolerance, "{planarity:?}");
@@ -1384,7 +1388,11 @@ mod tests {
         let mut opt = PlanarityOptimiser::new(&d.mesh, Some(&d.vertex_uv), options).unwrap();
         let mut planarity = vec![opt.max_planarity()];
         while !opt.is_done() {
-            planarity.push(opt.step(&mut d.mesh, p.surface()).unwrap().max_planarity);
+            planarity.push(
+                opt.step(&mut d.mesh, p.solver_surface())
+                    .unwrap()
+                    .max_planarity,
+            );
         }
         assert!(
             opt.max_planarity() <= PRECISION_MARGIN * floor,
@@ -1402,7 +1410,7 @@ mod tests {
         let mut opt = PlanarityOptimiser::new(&d.mesh, Some(&d.vertex_uv), options).unwrap();
         crate::conical::FAIL_STEPS.set(true);
         while !opt.is_done() {
-            opt.step(&mut d.mesh, p.surface()).unwrap();
+            opt.step(&mut d.mesh, p.solver_surface()).unwrap();
         }
         crate::conical::FAIL_STEPS.set(false);
         assert!(!opt.least_move);
@@ -1427,7 +1435,11 @@ mod tests {
         opt.least_move = false;
         let mut planarity = vec![opt.max_planarity()];
         while !opt.is_done() {
-            planarity.push(opt.step(&mut d.mesh, p.surface()).unwrap().max_planarity);
+            planarity.push(
+                opt.step(&mut d.mesh, p.solver_surface())
+                    .unwrap()
+                    .max_planarity,
+            );
         }
         assert!(opt.max_planarity() <= options.tolerance, "{planarity:?}");
         assert!(planarity[1] <= planarity[0] / 1000.0, "{planarity:?}");
@@ -1438,7 +1450,8 @@ mod tests {
         assert_eq!(opt.factorizations() + opt.chord_steps(), opt.iteration());
         assert_eq!(opt.factorizations(), 1, "{planarity:?}");
         assert!(opt.iteration() <= 3, "{} iterations", opt.iteration());
-        let report = super::super::report::phex_report(&d.mesh, p.surface(), &[], &d.vertex_uv, 0);
+        let report =
+            super::super::report::phex_report(&d.mesh, p.solver_surface(), &[], &d.vertex_uv, 0);
         assert_eq!(report.invalid_faces, 0);
         assert!(report.max_surface_distance <= 0.005 * report.bbox_diagonal);
         // The near-planar iterations keep their foot points (FOOT_REUSE), and the tangent-plane
@@ -1454,7 +1467,7 @@ mod tests {
         let mut worst = 0.0f64;
         for (i, x) in d.mesh.positions.iter().enumerate() {
             let (foot, normal) = opt.feet[i];
-            let exact = p.surface().closest_point(x, opt.uv[i]).unwrap();
+            let exact = p.solver_surface().closest_point(x, opt.uv[i]).unwrap();
             let d = (x - exact.point).dot(&exact.normal);
             worst = worst.max(((x - foot).dot(&normal) - d).abs());
         }

@@ -15,6 +15,7 @@ use super::{Domain, Surface, SurfaceDerivatives};
 use crate::Vec3;
 use crate::fabrication::{LengthUnit, UnknownUnit};
 use crate::math::Num;
+use crate::mesh::SolverFrame;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -518,6 +519,28 @@ impl NurbsSurface {
         Ok(())
     }
 
+    /// This surface with every control point mapped into `frame`, weights and knots kept: the
+    /// same surface in the solver's coordinates (a NURBS surface follows an affine map of its
+    /// control points, The NURBS Book, Sec. 4.4), exactly but for rounding, with the same
+    /// parameters.
+    pub fn in_frame(&self, frame: &SolverFrame) -> NurbsSurface {
+        let points: Vec<[f64; 3]> = self
+            .points
+            .iter()
+            .map(|&p| frame.to_solver(Vec3::from(p)).into())
+            .collect();
+        let homogeneous = points
+            .iter()
+            .zip(&self.homogeneous)
+            .map(|(p, h)| [h[3] * p[0], h[3] * p[1], h[3] * p[2], h[3]])
+            .collect();
+        NurbsSurface {
+            points,
+            homogeneous,
+            ..self.clone()
+        }
+    }
+
     /// Axis-aligned bounds of the control points (the surface lies in their convex hull).
     pub fn control_bounds(&self) -> (Vec3, Vec3) {
         let mut lo = Vec3::repeat(f64::INFINITY);
@@ -770,6 +793,39 @@ mod tests {
             "{e}"
         );
         assert_eq!(s, moved);
+    }
+
+    /// In a frame the surface is the same one mapped: positions map with the frame, unit
+    /// normals are kept and curvatures scale with the frame's unit, at the same parameters.
+    #[test]
+    fn a_surface_in_a_frame_is_the_same_surface_mapped() {
+        let text = json_with(|v| {
+            v["weights"] = serde_json::json!([[1, 0.5, 2], [1.5, 1, 0.7]]);
+        });
+        let mut def = NurbsSurface::from_json(&text).unwrap().definition();
+        let far = |p: [f64; 3]| (Vec3::from(p) * 1000.0 + Vec3::new(3e6, 5e6, 0.0)).into();
+        for row in &mut def.control_points {
+            row.iter_mut().for_each(|p| *p = far(*p));
+        }
+        let user = NurbsSurface::try_from(def).unwrap();
+        let points: Vec<Vec3> = user.control_points().iter().map(|&p| p.into()).collect();
+        let frame = SolverFrame::unit_box(&points);
+        let solver = user.in_frame(&frame);
+        for (u, v) in [(0.0, 0.0), (0.3, 0.7), (1.0, 0.5)] {
+            let (a, b) = (user.position(u, v), frame.to_user(solver.position(u, v)));
+            assert!((a - b).norm() <= 1e-9 * 1e3, "{a} vs {b}");
+            let (ca, cb) = (
+                user.curvature(u, v).unwrap(),
+                solver.curvature(u, v).unwrap(),
+            );
+            assert!((ca.normal - cb.normal).norm() < 1e-9);
+            let unit = frame.scale();
+            assert!(
+                (ca.gaussian * unit * unit - cb.gaussian).abs()
+                    <= 1e-9 * cb.gaussian.abs().max(1.0)
+            );
+        }
+        assert_eq!(solver.domain(), user.domain());
     }
 
     #[test]
