@@ -138,7 +138,11 @@ impl MeshData {
     /// `panelFaces` (per face its corner count, then its corners); empty for a smooth surface.
     #[wasm_bindgen(getter, js_name = panelPositions)]
     pub fn panel_positions(&self) -> js_sys::Float64Array {
-        let (flat, _) = self.panels.as_ref().map(panel_arrays).unwrap_or_default();
+        let flat = self
+            .panels
+            .as_ref()
+            .map(panel_position_array)
+            .unwrap_or_default();
         js_sys::Float64Array::from(flat.as_slice())
     }
 
@@ -152,7 +156,11 @@ impl MeshData {
     /// See [`MeshData::panel_positions`].
     #[wasm_bindgen(getter, js_name = panelFaces)]
     pub fn panel_faces(&self) -> js_sys::Uint32Array {
-        let (_, flat) = self.panels.as_ref().map(panel_arrays).unwrap_or_default();
+        let flat = self
+            .panels
+            .as_ref()
+            .map(panel_face_array)
+            .unwrap_or_default();
         js_sys::Uint32Array::from(flat.as_slice())
     }
 
@@ -232,18 +240,19 @@ impl MeshData {
     }
 }
 
-/// `mesh` as the `panelPositions`/`panelFaces` arrays (see [`MeshData::panel_faces`]).
-fn panel_arrays(mesh: &PolyMesh) -> (Vec<f64>, Vec<u32>) {
-    let positions = mesh
-        .positions
+/// `mesh`'s `panelPositions` array (see [`MeshData::panel_faces`]).
+fn panel_position_array(mesh: &PolyMesh) -> Vec<f64> {
+    mesh.positions
         .iter()
         .flat_map(|p| [p.x, p.y, p.z])
-        .collect();
-    let faces = mesh
-        .faces()
+        .collect()
+}
+
+/// `mesh`'s `panelFaces` array (see [`MeshData::panel_faces`]).
+fn panel_face_array(mesh: &PolyMesh) -> Vec<u32> {
+    mesh.faces()
         .flat_map(|f| std::iter::once(f.len() as u32).chain(f.iter().copied()))
-        .collect();
-    (positions, faces)
+        .collect()
 }
 
 /// A polygon mesh from `panelPositions`/`panelFaces` arrays (see [`MeshData::panel_faces`]).
@@ -306,7 +315,8 @@ mod tests {
         let m = dupin_core::scenes::benchmark_meshes::torus_centroid_dual(12, 6, 2.0, 0.7);
         let colors = vec![[1.0f32; 3]; m.num_faces()];
         let data = MeshData::panels(m.clone(), &colors);
-        let (p, f) = panel_arrays(data.panels.as_ref().unwrap());
+        let panels = data.panels.as_ref().unwrap();
+        let (p, f) = (panel_position_array(panels), panel_face_array(panels));
         let mut rebuilt = MeshData::smooth(data.buffers.clone());
         rebuilt.set_panels(p.clone(), f.clone());
         let back = rebuilt.to_polymesh().unwrap();
