@@ -1330,8 +1330,23 @@ mod tests {
         (p, d, cfg.planarity_options())
     }
 
+    /// Steps `opt` on `d`'s mesh over `p`'s solver surface until it is done: the start's
+    /// `max_planarity`, then every step's.
+    fn planarity_until_done(
+        opt: &mut PlanarityOptimiser,
+        d: &mut DualMesh,
+        p: &PhexPipeline,
+    ) -> Vec<f64> {
+        let mut planarity = vec![opt.max_planarity()];
+        while !opt.is_done() {
+            let step = opt.step(&mut d.mesh, p.solver_surface()).unwrap();
+            planarity.push(step.max_planarity);
+        }
+        planarity
+    }
+
     /// A near-planar open start takes least-move steps in face space: quadratic convergence
-    /// (measured: 3.9e-5, 4.4e-9, 5.2e-15), one factorisation each, no chord step, and the
+    /// (measured: 3.9e-5, 4.4e-9, 5.1e-15), one factorisation each, no chord step, and the
     /// vertices move about as far as the faces are from planar (at most 2.5e-4 edges, 6.5
     /// times the start's planarity), not more.
     #[test]
@@ -1340,14 +1355,7 @@ mod tests {
         let start = d.mesh.clone();
         let mut opt = PlanarityOptimiser::new(&d.mesh, Some(&d.vertex_uv), options).unwrap();
         assert!(opt.least_move);
-        let mut planarity = vec![opt.max_planarity()];
-        while !opt.is_done() {
-            planarity.push(
-                opt.step(&mut d.mesh, p.solver_surface())
-                    .unwrap()
-                    .max_planarity,
-            );
-        }
+        let planarity = planarity_until_done(&mut opt, &mut d, &p);
         assert!(opt.least_move, "{planarity:?}");
         assert!(opt.max_planarity() <= options.tolerance, "{planarity:?}");
         for w in planarity.windows(2) {
@@ -1376,7 +1384,7 @@ mod tests {
 
     /// At state-plane offsets the coordinates cannot hold the tolerance: the run stops within
     /// [`PRECISION_MARGIN`] of what they hold instead of stirring the rounding for all its
-    /// iterations (the roof at size 0.4 moved by (+3e6, +5e6) m: floor 2.8e-9).
+    /// iterations (the roof's start at size 0.4, in its frame, moved by (+3e6, +5e6)).
     #[test]
     fn far_from_the_origin_the_run_stops_at_the_coordinates_precision() {
         let (p, mut d, options) = roof_start();
@@ -1386,14 +1394,7 @@ mod tests {
         let floor = representable_planarity(&d.mesh);
         assert!(floor > options.tolerance, "{floor:e}");
         let mut opt = PlanarityOptimiser::new(&d.mesh, Some(&d.vertex_uv), options).unwrap();
-        let mut planarity = vec![opt.max_planarity()];
-        while !opt.is_done() {
-            planarity.push(
-                opt.step(&mut d.mesh, p.solver_surface())
-                    .unwrap()
-                    .max_planarity,
-            );
-        }
+        let planarity = planarity_until_done(&mut opt, &mut d, &p);
         assert!(
             opt.max_planarity() <= PRECISION_MARGIN * floor,
             "{planarity:?}"
@@ -1433,14 +1434,7 @@ mod tests {
         let mut opt = PlanarityOptimiser::new(&d.mesh, Some(&d.vertex_uv), options).unwrap();
         assert!(opt.direct, "the roof is open");
         opt.least_move = false;
-        let mut planarity = vec![opt.max_planarity()];
-        while !opt.is_done() {
-            planarity.push(
-                opt.step(&mut d.mesh, p.solver_surface())
-                    .unwrap()
-                    .max_planarity,
-            );
-        }
+        let planarity = planarity_until_done(&mut opt, &mut d, &p);
         assert!(opt.max_planarity() <= options.tolerance, "{planarity:?}");
         assert!(planarity[1] <= planarity[0] / 1000.0, "{planarity:?}");
         for w in planarity[1..].windows(2) {
