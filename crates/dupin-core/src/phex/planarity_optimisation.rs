@@ -556,9 +556,9 @@ impl PlanarityOptimiser {
     }
 
     /// Whether the tolerance is reached, the iteration budget is spent, or the planarity is
-    /// within [`PRECISION_MARGIN`] of what the coordinates can hold (a design far from the
-    /// origin for its size: more steps only stir the rounding; the run's shortfall then names
-    /// the coordinates' precision).
+    /// within twice what the coordinates can hold (a design far from the origin for its size:
+    /// more steps only stir the rounding; the run's shortfall then names the coordinates'
+    /// precision).
     pub fn is_done(&self) -> bool {
         self.max_planarity <= self.options.tolerance
             || self.iteration >= self.options.max_iterations
