@@ -374,10 +374,10 @@ impl PhexPipeline {
         let samples_f = (base_len / size).round();
         if !(6.0..=4000.0).contains(&samples_f) {
             return Err(PhexError::BadSize(format!(
-                "size {} gives {samples_f} samples on a base curve of length {:.3}; \
+                "size {} gives {samples_f} samples on a base curve of length {}; \
                  use a size between {:.3e} and {:.3e}",
                 user_len(size),
-                base_len * frame.scale(),
+                user_len(base_len),
                 base_len / 4000.0 * frame.scale(),
                 base_len / 6.0 * frame.scale()
             )));

@@ -56,17 +56,29 @@ pub struct PhexReport {
 /// `out` (cleared first: callers that visit every face reuse one buffer).
 fn project_face_into(mesh: &PolyMesh, i: usize, out: &mut Vec<Vec2>) {
     let f = mesh.face(i);
-    let at = |k: usize| mesh.positions[f[k] as usize];
     let c = f.iter().map(|&v| mesh.positions[v as usize]).sum::<Vec3>() / f.len() as f64;
+    // Corners relative to the centroid, over a power of two near their size: exact, so the
+    // same bits at ordinary sizes, and no overflow or underflow in the cross products of a face
+    // 1e150 or 1e-150 across (at 1e150 every face of a valid mesh read as self-intersecting).
+    let size = f
+        .iter()
+        .map(|&v| (mesh.positions[v as usize] - c).amax())
+        .fold(0.0, f64::max);
+    let unit = if size.is_normal() {
+        2f64.powi(size.log2().floor() as i32)
+    } else {
+        1.0
+    };
+    let at = |k: usize| (mesh.positions[f[k] as usize] - c) / unit;
     let mut n = Vec3::zeros();
     for k in 0..f.len() {
-        n += (at(k) - c).cross(&(at((k + 1) % f.len()) - c));
+        n += at(k).cross(&at((k + 1) % f.len()));
     }
     let n = n.try_normalize(0.0).unwrap_or(Vec3::z());
     let (e1, e2) = crate::mesh::plane_basis(n);
     out.clear();
     out.extend((0..f.len()).map(|k| {
-        let d = at(k) - c;
+        let d = at(k);
         Vec2::new(d.dot(&e1), d.dot(&e2))
     }));
 }
@@ -286,6 +298,16 @@ mod shape_tests {
         assert_eq!(count_invalid_and_non_convex_faces(&mesh, 0..5), (2, 1));
         assert_eq!(count_invalid_and_non_convex_faces(&mesh, 2..4), (1, 0));
         assert_eq!(count_invalid_faces(&mesh), 2);
+        // The same at any size: the cross products neither overflow nor underflow.
+        for scale in [1e150, 1e-150, 2f64.powi(500), 2f64.powi(-500)] {
+            let mut m = mesh.clone();
+            m.positions.iter_mut().for_each(|p| *p *= scale);
+            assert_eq!(
+                count_invalid_and_non_convex_faces(&m, 0..5),
+                (2, 1),
+                "{scale:e}"
+            );
+        }
     }
 }
 
