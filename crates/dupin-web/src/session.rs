@@ -992,14 +992,20 @@ impl Session {
         let mode = ColorMode::parse(mode.unwrap_or("")).map_err(err)?;
         self.sync_shown();
         let m = self.shown.mesh().clone();
-        let colors: Vec<[f32; 3]> = match mode {
-            ColorMode::Planarity => Vec::new(),
-            ColorMode::Convexity => (0..m.num_faces())
-                .map(|i| {
-                    let f = face_info(&m, i, 0.0);
-                    convexity_color(f.simple, f.convex)
-                })
-                .collect(),
+        let coloured = |colors: Vec<[f32; 3]>| MeshData::panels(m.clone(), &colors);
+        let mut data = match mode {
+            // Planarity colours are kept from state to state (see `ShownMesh`).
+            ColorMode::Planarity => {
+                MeshData::from_panel_buffers(m.clone(), self.shown.planarity_panels().clone())
+            }
+            ColorMode::Convexity => coloured(
+                (0..m.num_faces())
+                    .map(|i| {
+                        let f = face_info(&m, i, 0.0);
+                        convexity_color(f.simple, f.convex)
+                    })
+                    .collect(),
+            ),
             ColorMode::Regularity => {
                 // The regularity measure depends on the sign of K at the face: the P-Hex report
                 // has it per face; other meshes are compared with the affine-regular hexagon.
@@ -1007,23 +1013,18 @@ impl Session {
                     Run::Phex(p, _) => p.report(),
                     Run::Pq { .. } => None,
                 };
-                (0..m.num_faces())
-                    .map(|i| {
-                        let d = match &report {
-                            Some(r) => r.per_face.get(i).and_then(|f| f.shape_deviation),
-                            None => face_info(&m, i, 1.0).shape_deviation,
-                        };
-                        d.map_or(NOT_HEX, regularity_color)
-                    })
-                    .collect()
+                coloured(
+                    (0..m.num_faces())
+                        .map(|i| {
+                            let d = match &report {
+                                Some(r) => r.per_face.get(i).and_then(|f| f.shape_deviation),
+                                None => face_info(&m, i, 1.0).shape_deviation,
+                            };
+                            d.map_or(NOT_HEX, regularity_color)
+                        })
+                        .collect(),
+                )
             }
-        };
-        let mut data = match mode {
-            // Planarity colours are kept from state to state (see `ShownMesh`).
-            ColorMode::Planarity => {
-                MeshData::from_panel_buffers(m.clone(), self.shown.planarity_panels().clone())
-            }
-            _ => MeshData::panels(m.clone(), &colors),
         };
         // The held vertices of a panel mesh: the opened design's anchors and every dragged one.
         if let Run::Pq { stepper, .. } = &self.run
