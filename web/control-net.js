@@ -19,14 +19,21 @@ export class ControlNetOverlay {
     this.overlay.setAttribute('aria-hidden', 'true');
     this.overlay.hidden = true;
     canvas.after(this.overlay);
-    this.net = null; // { nu, nv, points } (design.controlNet)
+    this.net = null; // { nu, nv, points } (design.controlNet, less the view origin)
+    this.origin = [0, 0, 0];
     this.shown = false;
     this.active = -1; // the point being dragged
   }
 
-  /** The run's control net (`design.controlNet`), or null. */
-  set(net) {
-    this.net = net ? { nu: net.nu, nv: net.nv, points: Array.from(net.points) } : null;
+  /**
+   * The run's control net (`design.controlNet`, in the design's coordinates), or null, drawn
+   * and dragged relative to the view's `origin` (the metrics' `viewOrigin`) as the panels are.
+   */
+  set(net, origin) {
+    this.origin = origin ? Array.from(origin) : [0, 0, 0];
+    this.net = net
+      ? { nu: net.nu, nv: net.nv, points: Array.from(net.points, (c, i) => c - this.origin[i % 3]) }
+      : null;
     this.overlay.dataset.points = String(this.net ? this.net.nu * this.net.nv : 0);
   }
 
@@ -40,7 +47,11 @@ export class ControlNetOverlay {
     for (let k = 0; k < 3; k++) this.net.points[3 * index + k] = p[k];
   }
 
+  /** Control point `index` in the view's coordinates. */
   point(index) { return this.net.points.slice(3 * index, 3 * index + 3); }
+
+  /** A point of the view in the design's coordinates (what Session.moveControlPoint takes). */
+  toDesign(p) { return p.map((c, k) => c + this.origin[k]); }
 
   /** The control point nearest canvas point (x, y) within PICK_PX, or -1. */
   pick(x, y, project) {

@@ -305,7 +305,7 @@ function applyState(s) {
   stepLog.push(entry);
   if (stepLog.length > 5000) stepLog.shift();
   schedulePanel(m, entry);
-  net.set(m.design?.controlNet ?? null);
+  net.set(m.design?.controlNet ?? null, m.viewOrigin);
   if (netDrag) net.place(netDrag.index, netDrag.sent ?? netDrag.point);
   net.show(editMode);
   const canEdit = editable(m) || net.available;
@@ -344,7 +344,7 @@ function uploadMesh() {
   const parts = {};
   try {
     const m = MeshData.fromArrays(a.positions, a.normals, a.indices, a.colors, a.edges);
-    m.setPanels(a.panelPositions, a.panelFaces);
+    m.setPanels(a.panelPositions, a.panelFaces, a.viewOrigin);
     parts.copy = performance.now() - meshAt;
     showMesh(m, reframe);
     parts.gpu = performance.now() - meshAt - parts.copy;
@@ -784,7 +784,7 @@ function sendReshape(d = netDrag, force = false) {
   if (!q || (d.sent && q.every((c, k) => c === d.sent[k]))) return;
   d.inFlight = true;
   d.sent = q;
-  postNumbered('reshape', { index: d.index, point: q });
+  postNumbered('reshape', { index: d.index, point: net.toDesign(q) });
   net.place(d.index, q);
   dirty = true;
 }
@@ -805,7 +805,7 @@ function netDragEnd() {
   sendReshape(d, true);
   if (!d.sent) return;
   const moves = config.imported.controlPoints.filter(([i]) => i !== d.index);
-  config.imported.controlPoints = [...moves, [d.index, ...d.sent]];
+  config.imported.controlPoints = [...moves, [d.index, ...net.toDesign(d.sent)]];
   welcome = false;
   syncHash();
 }

@@ -37,7 +37,7 @@ function applyLayers() {
 function meshMessage() {
   const m = session.mesh(mode);
   // The polygons travel too: presentation mode and OBJ need the panels, not their triangles.
-  const mesh = { positions: m.positions, normals: m.normals, indices: m.indices, colors: m.colors, edges: m.edges, panelPositions: m.panelPositions, panelFaces: m.panelFaces };
+  const mesh = { positions: m.positions, normals: m.normals, indices: m.indices, colors: m.colors, edges: m.edges, panelPositions: m.panelPositions, panelFaces: m.panelFaces, viewOrigin: m.viewOrigin };
   m.free();
   return mesh;
 }

@@ -4,7 +4,7 @@
 // file says so. The files are made here, never downloaded.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { byId, domeJson, exportText, metrics, openPage, parseObj, waitDone } from './harness.mjs';
+import { byId, domeJson, exportText, metrics, objVertices, openPage, parseObj, pixelStats, shot, waitDone } from './harness.mjs';
 
 /** A 10 x 10 quad grid over 20 m with seeded +-1 mm noise in z: panels that are nearly planar. */
 function noisyGridObj() {
@@ -13,6 +13,21 @@ function noisyGridObj() {
   const n = 10;
   let obj = '';
   for (let i = 0; i <= n; i++) for (let j = 0; j <= n; j++) obj += `v ${2 * i} ${2 * j} ${(rnd() - 0.5) * 0.002}\n`;
+  const id = (i, j) => i * (n + 1) + j + 1;
+  for (let i = 0; i < n; i++) for (let j = 0; j < n; j++) obj += `f ${id(i, j)} ${id(i + 1, j)} ${id(i + 1, j + 1)} ${id(i, j + 1)}\n`;
+  return obj;
+}
+
+/**
+ * The noisy grid at 1.3 m spacing moved by `shift`: at state-plane coordinates (3e6, 5e6) its
+ * vertices are 0.5 m apart in `f32`, so a view that drew them in absolute `f32` would snap them.
+ */
+function spacedGridObj(shift) {
+  let seed = 7;
+  const rnd = () => { seed = (seed * 1103515245 + 12345) % 2147483648; return seed / 2147483648; };
+  const n = 10;
+  let obj = '';
+  for (let i = 0; i <= n; i++) for (let j = 0; j <= n; j++) obj += `v ${1.3 * i + shift[0]} ${1.3 * j + shift[1]} ${(rnd() - 0.5) * 0.002 + shift[2]}\n`;
   const id = (i, j) => i * (n + 1) + j + 1;
   for (let i = 0; i < n; i++) for (let j = 0; j < n; j++) obj += `f ${id(i, j)} ${id(i + 1, j)} ${id(i + 1, j + 1)} ${id(i, j + 1)}\n`;
   return obj;
@@ -202,6 +217,47 @@ test('panels: a click anchors a vertex, which stays exactly where the file puts 
     await byId(page, 'undo').click();
     await page.waitForFunction(() => document.querySelector('[data-testid=import-anchors]')?.dataset.anchors === '1'
       && /anchors=60(&|$)/.test(location.hash), null, { timeout: 60_000 });
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
+
+test('a design at state-plane coordinates is drawn as at zero, anchored where it is drawn, and exported where the file puts it', async () => {
+  const { browser, page, errors } = await openPage();
+  try {
+    const open = async (name, text) => {
+      await byId(page, 'import-file').setInputFiles({ name, mimeType: 'text/plain', buffer: Buffer.from(text) });
+      await page.waitForFunction((n) => document.querySelector('[data-testid=status]').textContent.includes(`${n} · panels`), name, { timeout: 60_000 });
+    };
+    await open('near.obj', spacedGridObj([0, 0, 0]));
+    const near = await shot(page, 'import-near-zero');
+    // The view's origin for this design (metrics `viewOrigin`): its box centre, rounded to 16 m.
+    const shift = [3e6, 5e6, 96];
+    const text = spacedGridObj(shift);
+    await open('far.obj', text);
+    const far = await shot(page, 'import-state-plane');
+    const s = await pixelStats(page, far, near);
+    console.log(`# state-plane grid: covers ${s.covered.toFixed(3)} of the view, ${s.differing.toFixed(5)} of the pixels differ from it at zero`);
+    assert.ok(s.covered > 0.05, `the design covers ${s.covered} of the view`);
+    assert.ok(s.differing < 0.002, `${s.differing} of the pixels differ from the design drawn at zero`);
+    // Click vertex 60 where the view draws it (relative to the view's origin).
+    const original = objVertices(text);
+    const at = await page.evaluate(([x, y, z]) => {
+      const q = window.dupin.viewer.project(x, y, z);
+      const r = document.querySelector('[data-testid=canvas]').getBoundingClientRect();
+      return { x: r.left + (q[0] + 1) / 2 * r.width, y: r.top + (1 - q[1]) / 2 * r.height };
+    }, original[60].map((c, k) => c - shift[k]));
+    await page.mouse.click(at.x, at.y);
+    await page.waitForFunction(() => /anchors=60(&|$)/.test(location.hash), null, { timeout: 60_000 });
+    await play(page);
+    const m = await metrics(page);
+    assert.equal(m.phase, 'done', await byId(page, 'status').textContent());
+    assert.ok(Number(m.maxDeviationMm) <= 2, m.maxDeviationMm);
+    const out = objVertices(await exportText(page, 'export-obj'));
+    assert.deepEqual(out[60], original[60]);
+    const off = Math.max(...out.map((p, i) => Math.hypot(...p.map((c, k) => c - original[i][k]))));
+    assert.ok(off <= 2e-3, `a vertex moved ${off} m`);
     assert.deepEqual(errors, []);
   } finally {
     await browser.close();

@@ -2,7 +2,7 @@
 
 use dupin_core::mesh::{
     PanelBuffers, PolyMesh, TriangleBuffers, face_planarity, planarity_color, polymesh_buffers,
-    polymesh_edges, write_obj,
+    polymesh_edges, view_origin, write_obj,
 };
 
 use dupin_core::surface::{Torus, sample_surface};
@@ -24,6 +24,9 @@ pub struct MeshData {
     /// The polygon mesh as handed over by a worker (`setPanels`): built into a [`PolyMesh`]
     /// only when asked for (presentation, OBJ), not on every frame's update.
     pub(crate) panel_arrays: Option<(Vec<f64>, Vec<u32>)>,
+    /// The point every position here is relative to (`Session`'s view origin); the OBJ adds
+    /// it back.
+    pub(crate) view_origin: Vec3,
 }
 
 impl MeshData {
@@ -35,6 +38,7 @@ impl MeshData {
             edges: Vec::new(),
             panels: None,
             panel_arrays: None,
+            view_origin: Vec3::zeros(),
         }
     }
 
@@ -47,6 +51,7 @@ impl MeshData {
             edges: polymesh_edges(&mesh),
             panels: Some(mesh),
             panel_arrays: None,
+            view_origin: Vec3::zeros(),
         }
     }
 
@@ -58,6 +63,7 @@ impl MeshData {
             edges: panels.edges,
             panels: Some(mesh),
             panel_arrays: None,
+            view_origin: Vec3::zeros(),
         }
     }
 
@@ -131,6 +137,7 @@ impl MeshData {
             edges,
             panels: None,
             panel_arrays: None,
+            view_origin: Vec3::zeros(),
         })
     }
 
@@ -165,11 +172,32 @@ impl MeshData {
     }
 
     /// Attaches the polygons of `panelPositions`/`panelFaces` (a worker's mesh rebuilt with
-    /// `fromArrays`), so that presentation and OBJ keep the true panels. Checked when used.
+    /// `fromArrays`) and its `viewOrigin` (3 numbers; none: zero), so that presentation and
+    /// OBJ keep the true panels. Checked when used; throws for an origin that is not 3 finite
+    /// numbers.
     #[wasm_bindgen(js_name = setPanels)]
-    pub fn set_panels(&mut self, positions: Vec<f64>, faces: Vec<u32>) {
+    pub fn set_panels(
+        &mut self,
+        positions: Vec<f64>,
+        faces: Vec<u32>,
+        origin: Option<Vec<f64>>,
+    ) -> Result<(), JsError> {
+        let origin = match origin.as_deref() {
+            None => Vec3::zeros(),
+            Some(&[x, y, z]) if [x, y, z].iter().all(|c| c.is_finite()) => Vec3::new(x, y, z),
+            Some(_) => return Err(JsError::new("a view origin needs 3 finite numbers")),
+        };
         self.panels = None;
         self.panel_arrays = (!faces.is_empty()).then_some((positions, faces));
+        self.view_origin = origin;
+        Ok(())
+    }
+
+    /// The point the positions are relative to (3 numbers): zero but for an opened design
+    /// far from zero, whose view is centred near it so that `f32` resolves it.
+    #[wasm_bindgen(getter, js_name = viewOrigin)]
+    pub fn view_origin(&self) -> Vec<f64> {
+        vec![self.view_origin.x, self.view_origin.y, self.view_origin.z]
     }
 
     /// Vertex positions, x y z per vertex.
@@ -214,10 +242,17 @@ impl MeshData {
         self.buffers.triangle_count()
     }
 
-    /// The mesh as OBJ text (the outside contract's format; panels keep their true size).
+    /// The mesh as OBJ text (the outside contract's format; panels keep their true size and
+    /// place: the view origin is added back).
     #[wasm_bindgen(js_name = toObj)]
     pub fn to_obj(&self) -> Result<String, JsError> {
-        Ok(write_obj(&self.to_polymesh()?))
+        let mut mesh = self.to_polymesh()?;
+        if self.view_origin != Vec3::zeros() {
+            mesh.positions
+                .iter_mut()
+                .for_each(|p| *p += self.view_origin);
+        }
+        Ok(write_obj(&mesh))
     }
 }
 
@@ -318,9 +353,23 @@ mod tests {
         let panels = data.panels.as_ref().unwrap();
         let (p, f) = (panel_position_array(panels), panel_face_array(panels));
         let mut rebuilt = MeshData::smooth(data.buffers.clone());
-        rebuilt.set_panels(p.clone(), f.clone());
+        assert!(rebuilt.set_panels(p.clone(), f.clone(), None).is_ok());
         let back = rebuilt.to_polymesh().unwrap();
         assert_eq!(back, m);
+        // Panels relative to a view origin come back there in the OBJ.
+        let origin = vec![1024.0, -2048.0, 0.5];
+        assert!(
+            rebuilt
+                .set_panels(p.clone(), f.clone(), Some(origin.clone()))
+                .is_ok()
+        );
+        assert_eq!(rebuilt.view_origin(), origin);
+        let mut moved = m.clone();
+        moved
+            .positions
+            .iter_mut()
+            .for_each(|q| *q += Vec3::new(1024.0, -2048.0, 0.5));
+        assert_eq!(rebuilt.to_obj().ok(), Some(write_obj(&moved)));
         for bad in [vec![7, 0, 1, 2], vec![2, 0, 1], vec![3, 0, 1]] {
             assert!(panels_from_arrays(&p, &bad).is_err(), "{bad:?}");
         }
@@ -357,10 +406,21 @@ struct PanelsJson {
 #[wasm_bindgen(js_name = designMesh)]
 pub fn design_mesh(json: &str) -> Result<MeshData, JsError> {
     let mesh = design_panels(json).map_err(|e| JsError::new(&e))?;
+    Ok(design_view(mesh))
+}
+
+/// A design's panels coloured by planarity (measured where the design is) and drawn relative
+/// to their view origin, so a design at state-plane coordinates is drawn as finely as one at
+/// zero.
+fn design_view(mut mesh: PolyMesh) -> MeshData {
     let colors: Vec<[f32; 3]> = (0..mesh.num_faces())
         .map(|i| planarity_color(face_planarity(&mesh, i)))
         .collect();
-    Ok(MeshData::panels(mesh, &colors))
+    let origin = view_origin(&mesh.positions);
+    mesh.positions.iter_mut().for_each(|p| *p -= origin);
+    let mut data = MeshData::panels(mesh, &colors);
+    data.view_origin = origin;
+    data
 }
 
 /// The polygon mesh of a design file, or what is wrong with it (see [`design_mesh`]).
@@ -392,6 +452,26 @@ fn design_panels(json: &str) -> Result<PolyMesh, String> {
 #[cfg(test)]
 mod design_tests {
     use super::*;
+
+    /// A design far from zero is shown as the same design at zero, with its colours, and its
+    /// OBJ is where the file put it.
+    #[test]
+    fn a_far_design_is_viewed_as_one_at_zero() {
+        let json = |dx: f64| {
+            format!(
+                r#"{{"vertices": [[{a},-0.5,0],[{b},-0.5,0],[{b},0.5,0.25],[{a},0.5,-0.25]], "faces": [[0,1,2,3]]}}"#,
+                a = dx - 0.5,
+                b = dx + 0.5
+            )
+        };
+        let near = design_view(design_panels(&json(0.0)).unwrap());
+        let far_mesh = design_panels(&json(4_194_304.0)).unwrap();
+        let far = design_view(far_mesh.clone());
+        assert_eq!(far.view_origin, Vec3::new(4_194_304.0, 0.0, 0.0));
+        assert_eq!(far.buffers, near.buffers);
+        assert_eq!(far.colors, near.colors);
+        assert_eq!(far.to_obj().ok(), Some(write_obj(&far_mesh)));
+    }
 
     #[test]
     fn a_design_is_read_bare_or_as_the_json_export_writes_it() {

@@ -4,7 +4,6 @@ use crate::import::Imported;
 use crate::js::{err, refuse_unknown_keys, to_js};
 use crate::mesh_data::MeshData;
 use crate::shown_mesh::ShownMesh;
-use dupin_core::Stepper;
 use dupin_core::conical::{
     PqMode, PqSceneMeasures, PqSceneStepInfo, PqSceneStepper, offset_mesh, pq_scene_shortfall,
     support_structure,
@@ -13,6 +12,7 @@ use dupin_core::fabrication::{
     DxfOptions, GlbLayer, LengthUnit, SheetOptions, panel_csv, panel_dxf, panel_schedule,
     panel_schedule_svg, panels_glb, support_csv,
 };
+use dupin_core::mesh::view_origin;
 use dupin_core::mesh::{
     ColorMode, NOT_HEX, PLANARITY_HIST_HI, PLANARITY_HIST_LO, PLANARITY_LEGEND_LOG10, PolyMesh,
     REGULARITY_LEGEND, convexity_color, max_planarity, mean_planarity, planarity_color,
@@ -23,6 +23,7 @@ use dupin_core::phex::{
 };
 use dupin_core::scenes::{PHEX_SCENES, PQ_SCENES, phex_scene, pq_scene_stepper};
 use dupin_core::surface::surface_catalog;
+use dupin_core::{Stepper, Vec3};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use wasm_bindgen::prelude::*;
@@ -143,6 +144,11 @@ struct Metrics {
     /// at its panel edge (or, for a design, its unit).
     extent: [f64; 3],
     mean_edge: f64,
+    /// The point the view's coordinates are relative to (`MeshData.viewOrigin`): zero for a
+    /// scene and for a design near zero, near the design for an opened one far from zero.
+    /// Picks, drags, box selections and `mesh()` speak the view's coordinates; the metrics,
+    /// the design's control net and every export the file's.
+    view_origin: [f64; 3],
 }
 
 /// The extra layers `Session.mesh` can draw with the panels: `{ offset, support, distance }`
@@ -202,6 +208,11 @@ pub struct Session {
     design: Option<crate::import::DesignInfo>,
     /// An opened NURBS surface, whose control points `moveControlPoint` drags.
     nurbs: Option<crate::import::NurbsSource>,
+    /// The point every position the view sees is relative to ([`view_origin`]): the render
+    /// buffers, picks, drags and selections. Fixed when the session opens, so a reshaped or
+    /// replayed design keeps its camera; exports and the metrics stay in the user's
+    /// coordinates.
+    view_origin: Vec3,
 }
 
 /// The run of an opened design.
@@ -401,6 +412,7 @@ impl Session {
             layers: LayerConfig::default(),
             design: None,
             nurbs: None,
+            view_origin: Vec3::zeros(),
         })
     }
 
@@ -414,16 +426,27 @@ impl Session {
     #[wasm_bindgen(js_name = fromFile)]
     pub fn from_file(name: &str, bytes: &[u8], config: JsValue) -> Result<Session, JsError> {
         let (imported, design, nurbs) = crate::import::import_run(name, bytes, config)?;
+        let run = imported_run(imported);
+        // A P-Hex run's frame holds its surface's box (the first states show one layer); a
+        // panel mesh is all there from the start.
+        let origin = match &run {
+            Run::Phex(p, _) => {
+                let f = p.frame();
+                view_origin(&[f.to_user(Vec3::repeat(-1.0)), f.to_user(Vec3::repeat(1.0))])
+            }
+            Run::Pq { stepper, .. } => view_origin(&stepper.mesh().positions),
+        };
         Ok(Session {
-            run: imported_run(imported),
+            run,
             nurbs,
             config: SessionConfig {
                 imported: Some(name.to_string()),
                 ..SessionConfig::default()
             },
-            shown: ShownMesh::default(),
+            shown: ShownMesh::around(origin),
             layers: LayerConfig::default(),
             design: Some(design),
+            view_origin: origin,
         })
     }
 
@@ -728,7 +751,8 @@ impl Session {
     }
 
     /// The P-Hex triangulation vertex under a click: `origin` and `direction` (3 numbers each)
-    /// are the view ray (`Viewer.pickRay`). Returns `null` when the ray misses the triangles on
+    /// are the view ray (`Viewer.pickRay`; positions in and out are the view's, see the
+    /// metrics' `viewOrigin`). Returns `null` when the ray misses the triangles on
     /// screen, else `{ vertex, uv, point, normal, k1, k2, dir1, dir2, neighbours, ring,
     /// message }`: the surface point, its principal frame and the six ring neighbours (indices
     /// and positions, counter-clockwise), or `message` saying why there is no complete star.
@@ -744,14 +768,20 @@ impl Session {
             return Err(JsError::new("a ray needs 3 origin and 3 direction numbers"));
         }
         let v = |a: &[f64]| dupin_core::Vec3::new(a[0], a[1], a[2]);
-        match crate::pick::pick_star(p, v(&origin), v(&direction)) {
-            Some(pick) => to_js(&pick),
+        let o = self.view_origin;
+        match crate::pick::pick_star(p, v(&origin) + o, v(&direction)) {
+            Some(mut pick) => {
+                let to_view = |q: &mut [f64; 3]| *q = (Vec3::from(*q) - o).into();
+                to_view(&mut pick.point);
+                pick.ring.iter_mut().for_each(to_view);
+                to_js(&pick)
+            }
             None => Ok(JsValue::NULL),
         }
     }
 
     /// The panel-mesh vertex under a click, for anchoring: `origin` and `direction` (3 numbers
-    /// each) are the view ray (`Viewer.pickRay`). Returns `null` on a miss, else `{ vertex,
+    /// each) are the view ray (`Viewer.pickRay`, in the view's coordinates as `point` is). Returns `null` on a miss, else `{ vertex,
     /// point }` (the corner of the panel hit first that is nearest the hit point, 0-based in
     /// the file's order). Throws for a P-Hex run (its vertices are the solver's, not the
     /// design's) or a malformed ray.
@@ -777,8 +807,9 @@ impl Session {
             .flat_map(|f| (1..f.len().saturating_sub(1)).map(move |i| [f[0], f[i], f[i + 1]]))
             .collect();
         let v = |a: &[f64]| dupin_core::Vec3::new(a[0], a[1], a[2]);
+        let o = self.view_origin;
         let Some(pick) =
-            dupin_core::mesh::pick_vertex(&m.positions, &triangles, v(&origin), v(&direction))
+            dupin_core::mesh::pick_vertex(&m.positions, &triangles, v(&origin) + o, v(&direction))
         else {
             return Ok(JsValue::NULL);
         };
@@ -787,19 +818,19 @@ impl Session {
             vertex: usize,
             point: [f64; 3],
         }
-        let p = m.positions[pick.vertex];
+        let p = m.positions[pick.vertex] - o;
         to_js(&PanelPick {
             vertex: pick.vertex,
             point: [p.x, p.y, p.z],
         })
     }
 
-    /// Drags `vertex` of a panel mesh (a PQ scene or an opened panel mesh) to `(x, y, z)`:
-    /// the vertex is held there (an anchor from now on) and the perturbation restarts, one
-    /// iteration a step, from the mesh committed when the drag began (`start`: a new drag,
-    /// which first finishes the running perturbation and commits its result). So every move
-    /// of a drag starts from the same mesh and replaying the committed drags rebuilds a mesh
-    /// bit for bit. Throws for a P-Hex run, a developable strip, a vertex outside the mesh or
+    /// Drags `vertex` of a panel mesh (a PQ scene or an opened panel mesh) to `(x, y, z)` (the
+    /// view's coordinates, see the metrics' `viewOrigin`): the vertex is held there (an anchor
+    /// from now on) and the perturbation restarts, one iteration a step, from the mesh
+    /// committed when the drag began (`start`: a new drag, which first finishes the running
+    /// perturbation and commits its result). So every move of a drag starts from the same mesh
+    /// and replaying the committed drags rebuilds a mesh bit for bit. Throws for a P-Hex run, a developable strip, a vertex outside the mesh or
     /// a position that is not finite, leaving the run as it was.
     #[wasm_bindgen(js_name = dragVertex)]
     pub fn drag_vertex(
@@ -836,9 +867,8 @@ impl Session {
             stepper.commit().map_err(err)?;
         }
         let group: Vec<usize> = group.into_iter().map(|v| v as usize).collect();
-        stepper
-            .hold_group(vertex, dupin_core::Vec3::new(x, y, z), &group)
-            .map_err(err)?;
+        let target = Vec3::new(x, y, z) + self.view_origin;
+        stepper.hold_group(vertex, target, &group).map_err(err)?;
         *started = true;
         Ok(())
     }
@@ -848,8 +878,8 @@ impl Session {
     /// is given by two corners in normalised device coordinates (x, y in [-1, 1], y up).
     /// Every vertex in front of the eye whose projection lies inside counts, hidden or not (a
     /// window selection). Returns `{ vertices, points }`: the vertex numbers in increasing
-    /// order and their positions, 3 numbers each. Throws for a P-Hex run, a matrix that is
-    /// not 16 finite numbers or a corner that is not finite.
+    /// order and their positions in the view's coordinates, 3 numbers each. Throws for a P-Hex
+    /// run, a matrix that is not 16 finite numbers or a corner that is not finite.
     #[wasm_bindgen(js_name = verticesInRect)]
     pub fn vertices_in_rect(
         &self,
@@ -865,7 +895,9 @@ impl Session {
             ));
         };
         let m = self.current_mesh().unwrap_or_default();
-        let vertices = crate::pick::vertices_in_rect(&m.positions, &view_proj, [x0, y0, x1, y1])
+        let o = self.view_origin;
+        let seen: Vec<Vec3> = m.positions.iter().map(|p| p - o).collect();
+        let vertices = crate::pick::vertices_in_rect(&seen, &view_proj, [x0, y0, x1, y1])
             .map_err(|e| JsError::new(&e))?;
         #[derive(Serialize)]
         struct Selection {
@@ -875,7 +907,7 @@ impl Session {
         let points = vertices
             .iter()
             .flat_map(|&v| {
-                let p = m.positions[v];
+                let p = seen[v];
                 [p.x, p.y, p.z]
             })
             .collect();
@@ -991,7 +1023,11 @@ impl Session {
     pub fn mesh_in(&mut self, mode: Option<&str>) -> Result<MeshData, JsError> {
         let mode = ColorMode::parse(mode.unwrap_or("")).map_err(err)?;
         self.sync_shown();
-        let m = self.shown.mesh().clone();
+        // Everything drawn is relative to the view origin (the planarity buffers are built so).
+        let mut m = self.shown.mesh().clone();
+        if self.view_origin != Vec3::zeros() {
+            m.positions.iter_mut().for_each(|p| *p -= self.view_origin);
+        }
         let coloured = |colors: Vec<[f32; 3]>| MeshData::panels(m.clone(), &colors);
         let mut data = match mode {
             // Planarity colours are kept from state to state (see `ShownMesh`).
@@ -1041,6 +1077,7 @@ impl Session {
                 data.add_lines(&segments);
             }
         }
+        data.view_origin = self.view_origin;
         Ok(data)
     }
 
@@ -1157,6 +1194,7 @@ impl Session {
                     steps_left_at_most: p.steps_left_at_most(),
                     extent,
                     mean_edge,
+                    view_origin: self.view_origin.into(),
                 }
             }
             Run::Pq { stepper, started } => {
@@ -1217,6 +1255,7 @@ impl Session {
                         .map(|n| n + usize::from(!*started)),
                     extent,
                     mean_edge,
+                    view_origin: self.view_origin.into(),
                 }
             }
         }
@@ -1310,6 +1349,7 @@ mod tests {
             layers: LayerConfig::default(),
             design: None,
             nurbs: None,
+            view_origin: Vec3::zeros(),
         }
     }
 
@@ -1387,6 +1427,7 @@ mod tests {
             layers: LayerConfig::default(),
             design: None,
             nurbs: None,
+            view_origin: Vec3::zeros(),
         }
     }
 

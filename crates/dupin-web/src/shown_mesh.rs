@@ -23,6 +23,15 @@ pub(crate) struct ShownMesh {
 }
 
 impl ShownMesh {
+    /// Nothing shown yet; the render buffers will be relative to `origin`
+    /// ([`dupin_core::mesh::view_origin`]).
+    pub(crate) fn around(origin: dupin_core::Vec3) -> Self {
+        ShownMesh {
+            panels: PanelBuffers::around(origin),
+            ..ShownMesh::default()
+        }
+    }
+
     /// Makes `mesh` the shown mesh. Its faces that the last shown mesh had first, with the same
     /// corners at the same positions, keep their figures; if any of the last mesh's faces is
     /// gone or moved, every figure is computed afresh.
@@ -32,7 +41,7 @@ impl ShownMesh {
         } else {
             self.planarity.clear();
             (self.invalid, self.non_convex) = (0, 0);
-            self.panels = PanelBuffers::default();
+            self.panels = PanelBuffers::around(self.panels.origin());
             0
         };
         self.planarity

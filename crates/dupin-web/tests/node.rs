@@ -205,3 +205,164 @@ fn pq_session_steps_levels_and_draws_conical_layers() {
     t.set_layers(wasm_bindgen::JsValue::NULL).unwrap();
     assert!(t.layer_info().unwrap().is_null());
 }
+
+/// A panel design at state-plane coordinates (3.1e6, 5.2e6) is shown relative to its view
+/// origin, so `f32` draws it as finely as the same design at zero: its render buffers are that
+/// design's bit for bit; a pick, a drag and a box selection speak the view's coordinates; the
+/// OBJ (the page's and the session's) and the metrics stay where the file put the design.
+#[wasm_bindgen_test]
+fn a_far_design_is_shown_relative_to_its_view_origin() {
+    use dupin_web::Session;
+    let get = |m: &JsValue, k: &str| js_sys::Reflect::get(m, &k.into()).unwrap();
+    let numbers = |v: JsValue| -> Vec<f64> {
+        js_sys::Array::from(&v)
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect()
+    };
+    // A 4 x 4 quad grid centred on zero, slightly warped, in numbers a shift keeps exact.
+    let grid = |shift: [f64; 3]| -> String {
+        let mut obj = String::new();
+        for j in 0..5 {
+            for i in 0..5 {
+                let z = [0.0, 1.0, -1.0][(i * 7 + j * 3) % 3] / 16.0;
+                let p = [i as f64 - 2.0, j as f64 - 2.0, z];
+                obj += &format!(
+                    "v {} {} {}\n",
+                    p[0] + shift[0],
+                    p[1] + shift[1],
+                    p[2] + shift[2]
+                );
+            }
+        }
+        for j in 0..4 {
+            for i in 0..4 {
+                let v = |a: usize, b: usize| b * 5 + a + 1;
+                obj += &format!(
+                    "f {} {} {} {}\n",
+                    v(i, j),
+                    v(i + 1, j),
+                    v(i + 1, j + 1),
+                    v(i, j + 1)
+                );
+            }
+        }
+        obj
+    };
+    let shift = [3.0 * 2f64.powi(20), 5.0 * 2f64.powi(20), 64.0];
+    let far_obj = grid(shift);
+    let open = |obj: &str| Session::from_file("grid.obj", obj.as_bytes(), JsValue::UNDEFINED);
+    let mut far = open(&far_obj).unwrap();
+    let mut near = open(&grid([0.0; 3])).unwrap();
+    assert_eq!(numbers(get(&far.metrics().unwrap(), "viewOrigin")), shift);
+    assert_eq!(
+        numbers(get(&near.metrics().unwrap(), "viewOrigin")),
+        [0.0; 3]
+    );
+    let (m, n) = (
+        far.mesh(JsValue::UNDEFINED).unwrap(),
+        near.mesh(JsValue::UNDEFINED).unwrap(),
+    );
+    assert_eq!(m.positions().to_vec(), n.positions().to_vec());
+    assert_eq!(m.normals().to_vec(), n.normals().to_vec());
+    assert_eq!(m.edges().to_vec(), n.edges().to_vec());
+    assert_eq!(m.view_origin(), shift);
+    // The page's OBJ of the drawn mesh is the file's design, where the file put it.
+    let vertices = |obj: &str| -> Vec<String> {
+        obj.lines()
+            .filter(|l| l.starts_with("v "))
+            .map(str::to_string)
+            .collect()
+    };
+    let numbers_of = |line: &str| -> Vec<f64> {
+        line.split_whitespace()
+            .skip(1)
+            .map(|x| x.parse().unwrap())
+            .collect()
+    };
+    let page_obj = m.to_obj().unwrap();
+    for (a, b) in vertices(&page_obj).iter().zip(vertices(&far_obj).iter()) {
+        assert_eq!(numbers_of(a), numbers_of(b));
+    }
+    // A click above grid vertex (3, 3) of the view picks it and answers in the view.
+    let pick = far
+        .pick_panel_vertex(vec![1.0, 1.0, 10.0], vec![0.0, 0.0, -1.0])
+        .unwrap();
+    let vertex = get(&pick, "vertex").as_f64().unwrap() as usize;
+    assert_eq!(vertex, 3 * 5 + 3);
+    let point = numbers(get(&pick, "point"));
+    assert_eq!(&point[..2], &[1.0, 1.0]);
+    // A box selection through the identity view, in the view's coordinates.
+    let identity: Vec<f64> = (0..16)
+        .map(|k| if k % 5 == 0 { 1.0 } else { 0.0 })
+        .collect();
+    let sel = far
+        .vertices_in_rect(identity, -0.5, -0.5, 1.5, 1.5)
+        .unwrap();
+    let chosen = numbers(get(&sel, "vertices"));
+    assert_eq!(chosen, [12.0, 13.0, 17.0, 18.0]);
+    let points = numbers(get(&sel, "points"));
+    assert!(
+        points.chunks(3).all(|p| p[0] >= -0.5 && p[1] <= 1.5),
+        "{points:?}"
+    );
+    // A drag to a point of the view holds the vertex at that point plus the origin, exactly.
+    far.drag_vertex(vertex, 1.0, 1.0, 0.5, true).unwrap();
+    far.step().unwrap();
+    let moved = vertices(&far.export_obj())[vertex].clone();
+    assert_eq!(
+        numbers_of(&moved),
+        [1.0 + shift[0], 1.0 + shift[1], 0.5 + shift[2]]
+    );
+}
+
+/// An opened NURBS surface far from zero is drawn relative to a view origin near its control
+/// net, fixed while its control points move.
+#[wasm_bindgen_test]
+fn a_far_surface_is_shown_relative_to_its_view_origin() {
+    use dupin_web::Session;
+    let get = |m: &JsValue, k: &str| js_sys::Reflect::get(m, &k.into()).unwrap();
+    let net = |dx: f64, dy: f64| {
+        format!(
+            r#"{{"degree_u":2,"degree_v":2,"knots_u":[0,0,0,1,1,1],"knots_v":[0,0,0,1,1,1],
+            "control_points":[[[{a},{b},0],[{a},{c},1],[{a},{d},0]],
+                              [[{e},{b},1],[{e},{c},3],[{e},{d},1]],
+                              [[{f},{b},0],[{f},{c},1],[{f},{d},0]]]}}"#,
+            a = dx,
+            e = dx + 5.0,
+            f = dx + 10.0,
+            b = dy,
+            c = dy + 5.0,
+            d = dy + 10.0
+        )
+    };
+    let config = js_sys::JSON::parse(r#"{"size":1.5}"#).unwrap();
+    let mut s = Session::from_file(
+        "dome.json",
+        net(3_000_000.0, 5_000_000.0).as_bytes(),
+        config,
+    )
+    .unwrap();
+    let origin: Vec<f64> = js_sys::Array::from(&get(&s.metrics().unwrap(), "viewOrigin"))
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert!((origin[0] - 3_000_005.0).abs() <= 16.0, "{origin:?}");
+    assert!((origin[1] - 5_000_005.0).abs() <= 16.0, "{origin:?}");
+    for _ in 0..5 {
+        s.step().unwrap();
+    }
+    let p = s.mesh(JsValue::UNDEFINED).unwrap().positions().to_vec();
+    assert!(
+        !p.is_empty() && p.iter().all(|c| c.abs() <= 32.0),
+        "{:?}",
+        &p[..3]
+    );
+    s.move_control_point(4.0, 3_000_005.0, 5_000_005.0, 4.0)
+        .unwrap();
+    let after: Vec<f64> = js_sys::Array::from(&get(&s.metrics().unwrap(), "viewOrigin"))
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert_eq!(after, origin);
+}

@@ -37,16 +37,50 @@ pub fn polymesh_buffers(
 ) -> (TriangleBuffers, Vec<f32>) {
     let mut out = TriangleBuffers::default();
     let mut colors = Vec::new();
-    push_faces(mesh, 0, face_colors, &mut out, &mut colors);
+    push_faces(mesh, 0, face_colors, Vec3::zeros(), &mut out, &mut colors);
     (out, colors)
 }
 
-/// Appends faces `from..` of `mesh` to `out` and (with `face_colors`) their colours to
-/// `colors`, as [`polymesh_buffers`] lays them out.
+/// The point a design's `f32` render buffers are best taken relative to: zero for a design
+/// near the origin (within 256 times its size, where `f32`'s 24 bits still resolve 1/65 536 of
+/// the design), else the centre of its bounding box rounded to a multiple of a power of two
+/// near its size. A design at state-plane coordinates (1e6..1e7 m) drawn in absolute `f32`
+/// would snap to a half-metre grid; relative to this origin it is drawn as finely as one near
+/// zero. Non-finite points are skipped; no finite point gives zero.
+pub fn view_origin(points: &[Vec3]) -> Vec3 {
+    let mut lo = Vec3::repeat(f64::INFINITY);
+    let mut hi = Vec3::repeat(f64::NEG_INFINITY);
+    for p in points.iter().filter(|p| p.iter().all(|c| c.is_finite())) {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    if lo.x > hi.x {
+        return Vec3::zeros();
+    }
+    // Halves first: the sum of two coordinates near f64::MAX would overflow.
+    let center = lo * 0.5 + hi * 0.5;
+    let size = (hi * 0.5 - lo * 0.5).max() * 2.0;
+    if center.amax() <= 256.0 * size {
+        return Vec3::zeros();
+    }
+    // A round origin (the same for a design moved by less than its rounding step) and an
+    // exact one: the quotient's rounding and the product by a power of two lose nothing that
+    // matters at this size.
+    let step = if size.is_normal() {
+        2f64.powi(size.log2().ceil().clamp(-1000.0, 1000.0) as i32)
+    } else {
+        1.0
+    };
+    center.map(|c| (c / step).round() * step)
+}
+
+/// Appends faces `from..` of `mesh`, taken relative to `origin`, to `out` and (with
+/// `face_colors`) their colours to `colors`, as [`polymesh_buffers`] lays them out.
 fn push_faces(
     mesh: &PolyMesh,
     from: usize,
     face_colors: Option<&[[f32; 3]]>,
+    origin: Vec3,
     out: &mut TriangleBuffers,
     colors: &mut Vec<f32>,
 ) {
@@ -65,7 +99,9 @@ fn push_faces(
     }
     for fi in faces {
         let f = mesh.face(fi);
-        let at = |k: usize| mesh.positions[f[k] as usize];
+        // Relative to the origin before anything else: the cross products below would lose
+        // every digit of a small face far from zero.
+        let at = |k: usize| mesh.positions[f[k] as usize] - origin;
         // Newell's normal: robust for non-planar and non-convex polygons.
         let mut n = Vec3::zeros();
         for k in 0..f.len() {
@@ -93,7 +129,7 @@ fn push_faces(
 /// the lower vertex.
 pub fn polymesh_edges(mesh: &PolyMesh) -> Vec<f32> {
     let mut out = Vec::new();
-    push_edge_segments(mesh, &edge_keys(mesh, 0), &mut out);
+    push_edge_segments(mesh, &edge_keys(mesh, 0), Vec3::zeros(), &mut out);
     out
 }
 
@@ -114,12 +150,13 @@ fn edge_keys(mesh: &PolyMesh, from: usize) -> Vec<u64> {
     keys
 }
 
-/// Appends the segments of the edges `keys` ([`edge_keys`]) to `out`, from the lower vertex.
-fn push_edge_segments(mesh: &PolyMesh, keys: &[u64], out: &mut Vec<f32>) {
+/// Appends the segments of the edges `keys` ([`edge_keys`]) to `out`, from the lower vertex,
+/// relative to `origin`.
+fn push_edge_segments(mesh: &PolyMesh, keys: &[u64], origin: Vec3, out: &mut Vec<f32>) {
     out.reserve(6 * keys.len());
     for &key in keys {
         for v in [key >> 32, key & u64::from(u32::MAX)] {
-            let q = mesh.positions[v as usize];
+            let q = mesh.positions[v as usize] - origin;
             out.extend([q.x as f32, q.y as f32, q.z as f32]);
         }
     }
@@ -129,7 +166,7 @@ fn push_edge_segments(mesh: &PolyMesh, keys: &[u64], out: &mut Vec<f32>) {
 /// state to the next: a P-Hex run reveals its triangulation a layer at a time and the page draws
 /// every layer, so rebuilding at every state visited each face once per later layer (1.1 M face
 /// visits for the 10 203-panel roof's 111 states). [`PanelBuffers::extend`] adds only the new
-/// faces.
+/// faces. The buffers are relative to an origin ([`PanelBuffers::around`], [`view_origin`]).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PanelBuffers {
     /// The faces' triangles, as [`polymesh_buffers`] lays them out.
@@ -142,9 +179,25 @@ pub struct PanelBuffers {
     edge_keys: Vec<u64>,
     /// How many faces are in.
     faces: usize,
+    /// The point every position is taken relative to.
+    origin: Vec3,
 }
 
 impl PanelBuffers {
+    /// Empty buffers whose positions will be taken relative to `origin` (see [`view_origin`]);
+    /// `default()` is relative to zero.
+    pub fn around(origin: Vec3) -> Self {
+        PanelBuffers {
+            origin,
+            ..PanelBuffers::default()
+        }
+    }
+
+    /// The point the positions are relative to.
+    pub fn origin(&self) -> Vec3 {
+        self.origin
+    }
+
     /// How many faces are in: the first `faces()` of the meshes given to `extend`.
     pub fn faces(&self) -> usize {
         self.faces
@@ -159,12 +212,13 @@ impl PanelBuffers {
             mesh,
             from,
             Some(face_colors),
+            self.origin,
             &mut self.buffers,
             &mut self.colors,
         );
         let mut fresh = edge_keys(mesh, from);
         fresh.retain(|k| self.edge_keys.binary_search(k).is_err());
-        push_edge_segments(mesh, &fresh, &mut self.edges);
+        push_edge_segments(mesh, &fresh, self.origin, &mut self.edges);
         if !fresh.is_empty() {
             self.edge_keys.extend(fresh);
             // Two sorted runs: the sort merges them in linear time.
@@ -273,5 +327,64 @@ mod tests {
         once.extend(&mesh, &colors);
         assert_eq!(once.edges, one_shot);
         assert_eq!(once.buffers, buffers);
+    }
+
+    /// A design at state-plane coordinates is drawn relative to its view origin exactly as
+    /// the same design near zero: positions, normals (whose cross products would cancel in
+    /// absolute coordinates) and edges, bit for bit.
+    #[test]
+    fn a_far_design_is_drawn_as_finely_as_one_near_zero() {
+        let near = triangles();
+        let shift = Vec3::new(3.0 * 2f64.powi(22), 5.0 * 2f64.powi(22), 0.0);
+        let mut far = near.clone();
+        far.positions.iter_mut().for_each(|p| *p += shift);
+        assert_eq!(view_origin(&near.positions), Vec3::zeros());
+        assert_eq!(view_origin(&far.positions), shift);
+        let colors = vec![[0.5f32; 3]; near.num_faces()];
+        let mut relative = PanelBuffers::around(view_origin(&far.positions));
+        relative.extend(&far, &colors);
+        let mut at_zero = PanelBuffers::default();
+        at_zero.extend(&near, &colors);
+        assert_eq!(relative.buffers, at_zero.buffers);
+        assert_eq!(relative.edges, at_zero.edges);
+        assert_eq!(relative.origin(), shift);
+    }
+
+    /// The view origin is zero near zero, round and within one and a half sizes of every point
+    /// far from it, unmoved by a move smaller than its rounding step, and ignores non-finite
+    /// points.
+    #[test]
+    fn the_view_origin_is_near_the_design_and_round() {
+        let v = Vec3::new;
+        assert_eq!(view_origin(&[]), Vec3::zeros());
+        assert_eq!(view_origin(&[v(f64::NAN, 0.0, 0.0)]), Vec3::zeros());
+        // 256 sizes away is still near.
+        assert_eq!(
+            view_origin(&[v(255.0, 0.0, 0.0), v(257.0, 0.0, 0.0)]),
+            Vec3::zeros()
+        );
+        let roof = [
+            v(3_000_123.4, 5_000_456.7, 96.0),
+            v(3_000_143.9, 5_000_470.2, 104.5),
+        ];
+        let o = view_origin(&roof);
+        assert_ne!(o, Vec3::zeros());
+        assert!(o.iter().all(|c| (c / 32.0).fract() == 0.0), "{o}");
+        assert!(roof.iter().all(|p| (p - o).amax() <= 1.5 * 20.5), "{o}");
+        let nudged = roof.map(|p| p + v(0.01, -0.01, 0.0));
+        assert_eq!(view_origin(&nudged), o);
+        let with_nan = [
+            roof[0],
+            v(f64::NAN, 1.0, 1.0),
+            roof[1],
+            v(f64::INFINITY, 0.0, 0.0),
+        ];
+        assert_eq!(view_origin(&with_nan), o);
+        // One point far away: itself, to within half a unit.
+        let one = view_origin(&[v(4e6 + 0.3, -2e6, 7.0)]);
+        assert_eq!(one, v(4e6, -2e6, 7.0));
+        // Extreme coordinates stay finite.
+        let huge = view_origin(&[Vec3::repeat(f64::MAX), Vec3::repeat(f64::MAX * 0.5)]);
+        assert!(huge.iter().all(|c| c.is_finite()));
     }
 }
