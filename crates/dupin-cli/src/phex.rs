@@ -88,9 +88,15 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
             }
             let path = args.input.as_deref().unwrap_or(Path::new(""));
             let (surface, mesh) = read_design_surface(path)?;
-            fitted = mesh;
             let label = path.display().to_string();
-            PhexConfig::for_nurbs(&label, surface, None)
+            // A fitted surface's u and v are ours: lay the layers across its parabolic curves.
+            let config = if mesh.is_some() {
+                PhexConfig::for_fitted_mesh(&label, surface, None)
+            } else {
+                PhexConfig::for_nurbs(&label, surface, None)
+            };
+            fitted = mesh;
+            config
         }
         (Some(name), None) => {
             if !args.set.is_empty() {

@@ -284,19 +284,15 @@ fn input_fits_and_panels_a_cylinder_mesh() {
     std::fs::write(&design, obj).unwrap();
     let run = run_reported(
         "vault-mesh",
-        &["phex", "--input", design.to_str().unwrap(), "--size", "0.6"],
+        &["phex", "--input", design.to_str().unwrap(), "--size", "0.5"],
     );
-    // Measured: 523 faces planar to 1e-11, 3 of them self-intersecting beside the parabolic
-    // circle (K changes sign at z = 1.96 m), so the run says it missed (exit 3) and still writes
-    // the panels and the report.
-    let r = run.unmet();
-    assert!(
-        r["reason"].as_str().unwrap().contains("self-intersecting"),
-        "{r}"
-    );
-    let faces = r["faces"].as_u64().unwrap();
-    assert!(faces > 400, "{r}");
-    assert!(r["invalid_faces"].as_u64().unwrap() * 50 <= faces, "{r}");
+    // Measured: 431 faces, none invalid, planar to 7e-15, 0.36% of the diagonal from the mesh
+    // (the layers laid across the parabolic circle at z = 1.96 m, along the axis; along the
+    // circle 10 of 773 came out invalid). Sizes where a few hexagons beside the circle fold
+    // exit 3 with the panels and the report written (`missed_results_exit_3_...`).
+    let r = run.ok();
+    assert_eq!(r["invalid_faces"], 0, "{r}");
+    assert!(r["faces"].as_u64().unwrap() > 400, "{r}");
     assert!(r["max_planarity"].as_f64().unwrap() <= 1e-10, "{r}");
     assert!(r["fit_max_distance"].as_f64().unwrap() < 5e-3, "{r}");
     let diagonal = r["bbox_diagonal"].as_f64().unwrap();

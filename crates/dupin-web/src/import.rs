@@ -360,7 +360,12 @@ fn import_design(
     };
     let run = match (surface, mesh) {
         (Some(surface), _) => {
-            let mut config = PhexConfig::for_nurbs(name, surface, cfg.size);
+            // A fitted surface's u and v are ours: lay the layers across its parabolic curves.
+            let mut config = if is_json {
+                PhexConfig::for_nurbs(name, surface, cfg.size)
+            } else {
+                PhexConfig::for_fitted_mesh(name, surface, cfg.size)
+            };
             if let Some(m) = &cfg.method {
                 config.method = m
                     .parse::<TriangulationMethod>()

@@ -37,7 +37,7 @@ pub use report::{
 };
 pub use triangulation::{
     ConjugateFields, DEFAULT_BOUND, LayerRule, MAX_PHEX_FACES, MAX_RATIO, MAX_RATIO_ELLIPTIC,
-    Triangulation, TriangulationMethod, TriangulationSpec, bounded_ratio,
+    ParabolicCrossings, Triangulation, TriangulationMethod, TriangulationSpec, bounded_ratio,
     convex_loop_triangulation, loop_subdivide, triangulate, triangulate_along_fields,
 };
 

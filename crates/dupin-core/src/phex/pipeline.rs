@@ -102,6 +102,21 @@ impl PhexConfig {
         }
     }
 
+    /// [`PhexConfig::for_nurbs`] for a surface fitted to a triangle mesh
+    /// ([`crate::surface::fit_mesh_surface`]), whose u and v come from an arbitrary corner of
+    /// the mesh: the layers are laid across the parabolic curves, which then run along the
+    /// base curves (sections 5.3 and 7, Fig. 22; [`super::ParabolicCrossings`]), whichever
+    /// parameter that makes the layer direction. Measured on a translational roof mesh with a
+    /// parabolic line (`translational_roof_triangle_mesh`): the fit's two orientations gave 0
+    /// and 10 invalid faces along the parameter it happened to pick, 0 and 0 so.
+    pub fn for_fitted_mesh(label: &str, surface: NurbsSurface, size: Option<f64>) -> PhexConfig {
+        let swap = super::ParabolicCrossings::of(&surface, 32).layers_along_v();
+        PhexConfig {
+            swap,
+            ..PhexConfig::for_nurbs(label, surface, size)
+        }
+    }
+
     /// A configuration for a library surface with the whole domain (the sphere and ellipsoid
     /// stop at latitude +-1.2 to avoid the singular poles), lower bound b = 0.3.
     pub fn for_surface(

@@ -187,6 +187,14 @@ pub fn bump_triangle_mesh(n: usize, seed: u64) -> PolyMesh {
     jittered_height_mesh(n, seed, |x, y| 3.0 * (-(x * x + y * y) / 18.0).exp())
 }
 
+/// A triangle mesh with no UVs of mixed curvature with a conjugate network: a translational
+/// roof 12 m x 12 m, z = 3 - x² / 24 + 0.8 sin(y / 2), elliptic (K > 0) for y > 0 and
+/// hyperbolic (K < 0) for y < 0, the parabolic line y = 0 between; its x and y lines are
+/// conjugate (z_xy = 0). Triangulated as [`dome_triangle_mesh`] is.
+pub fn translational_roof_triangle_mesh(n: usize, seed: u64) -> PolyMesh {
+    jittered_height_mesh(n, seed, |x, y| 3.0 - x * x / 24.0 + 0.8 * (y / 2.0).sin())
+}
+
 /// The height field `z(x, y)` over [-6, 6]² as an irregular triangulation of `2 n²` triangles:
 /// a grid with jittered interior vertices and randomly chosen diagonals, the vertex order
 /// shuffled (an exporter's order is not a grid's).

@@ -6,11 +6,13 @@
 //! |---|---|---|
 //! | 5.2, 5.3 | methods 1 and 2, layer heights from the ideal triangle, the bound b | `layers.rs` |
 //! | 5.2 | method 2 along a chosen direction field and its conjugate | `conjugate_fields.rs` |
+//! | 5.3, 7 (Fig. 22) | which parameter direction runs along the parabolic curves | `parabolic_curves.rs` |
 //! | 7, Fig. 21 | Loop subdivision of an icosahedron projected onto a convex surface | `loop_subdivision.rs` |
 
 mod conjugate_fields;
 mod layers;
 mod loop_subdivision;
+mod parabolic_curves;
 
 pub use conjugate_fields::{ConjugateFields, triangulate_along_fields};
 pub use layers::{
@@ -18,3 +20,4 @@ pub use layers::{
     TriangulationMethod, TriangulationSpec, bounded_ratio, triangulate,
 };
 pub use loop_subdivision::{convex_loop_triangulation, loop_subdivide};
+pub use parabolic_curves::ParabolicCrossings;
