@@ -1,7 +1,9 @@
 //! A triangle mesh of a smooth surface (a freeform roof exported from a CAD tool with no UVs)
 //! made into a [`Surface`] that the P-Hex pipeline panels like a library surface: a mean-value
 //! parametrisation onto the unit square, then a faired least-squares bicubic B-spline fit. A
-//! mesh of cylinder topology is cut open along a seam first (`cylinder_cut.rs`).
+//! mesh of cylinder topology is cut open along a seam first (`cylinder_cut.rs`), the seam put
+//! on the sides u = 0 and u = 1, and fitted closed in u, so it has no seam
+//! ([`NurbsSurface::closed_in_u`]).
 //!
 //! Why this route and not a triangulation walking the mesh itself: P-Hex needs second
 //! derivatives everywhere (the Dupin indicatrix, P-Hex paper section 3) and closest points
@@ -216,13 +218,28 @@ pub fn fit_mesh_surface(
         });
     }
     let boundary = &loops[0];
-    let corners = match seam_ends {
-        Some(ends) => {
+    let corners = match (seam_ends, &origin) {
+        (Some(ends), Some(origin)) => {
             let mut at = ends.map(|e| boundary.iter().position(|&v| v == e).unwrap_or(0));
             at.sort_unstable();
+            // The seam must become the sides u = 0 and u = 1 (sides 1 and 3 of
+            // `square_boundary`) for the surface to close in u, so side 0, from corner 0 to
+            // corner 1, must be a loop's: a seam side has no vertex between its corners, or
+            // vertices whose input vertex the boundary holds twice (once on each side).
+            let mut times = vec![0u8; mesh.num_vertices()];
+            for &v in boundary {
+                let o = origin[v as usize] as usize;
+                times[o] = times[o].saturating_add(1);
+            }
+            let next = (at[0] + 1) % boundary.len();
+            let side_0_is_seam =
+                next == at[1] || times[origin[boundary[next] as usize] as usize] > 1;
+            if side_0_is_seam {
+                at.rotate_left(1);
+            }
             at
         }
-        None => square_corners(disk, boundary),
+        _ => square_corners(disk, boundary),
     };
     let boundary_uv = square_boundary(disk, boundary, &corners);
     let disk_uv = mean_value_map(disk, boundary, &boundary_uv)?;
@@ -237,7 +254,11 @@ pub fn fit_mesh_surface(
         }
         None => net_size(disk, boundary, &corners),
     };
-    let surface = least_squares_bspline(disk, &disk_uv, nu, nv, options.fairness)?;
+    // A cylinder's seam is the square's sides u = 0 and u = 1: fitted closed in u, the surface
+    // goes all around with no seam, and P-Hex panels it as it panels a library tube.
+    let closed_u = seam_ends.is_some();
+    let nu = if closed_u { nu.max(8) } else { nu };
+    let surface = least_squares_bspline(disk, &disk_uv, nu, nv, options.fairness, closed_u)?;
     // Distances of the input's vertices (a seam vertex at its first copy's parameters).
     let uv = disk_uv[..mesh.num_vertices()].to_vec();
     let (mut max_distance, mut sum) = (0.0f64, 0.0);
@@ -492,36 +513,67 @@ fn uniform_knots(n: usize) -> Vec<f64> {
     k
 }
 
-/// The least-squares bicubic net with thin-plate fairness. The normal matrix couples control
-/// points at most 3 apart in each direction, so it is kept as a 7 x 7 stencil per control
-/// point while the data is summed, then handed to faer as its lower triangle.
+/// The u knots of a cubic B-spline closed in u with `n` distinct control rows written out as
+/// `n + 3` rows: uniformly spaced with no end multiplicity, the domain [0, 1] between knots 3
+/// and `n + 3`.
+fn closed_knots(n: usize) -> Vec<f64> {
+    (0..n + 7).map(|k| (k as f64 - 3.0) / n as f64).collect()
+}
+
+/// The least-squares bicubic net with thin-plate fairness (`nu` x `nv` unknown control points;
+/// `closed_u`: rows wrap around, `nu` >= 8, and the net is written out closed in u). The normal
+/// matrix couples control points at most 3 apart in each direction, so it is kept as a 7 x 7
+/// stencil per control point while the data is summed, then handed to faer as its lower
+/// triangle.
 fn least_squares_bspline(
     mesh: &PolyMesh,
     uv: &[Vec2],
     nu: usize,
     nv: usize,
     fairness: f64,
+    closed_u: bool,
 ) -> Result<NurbsSurface, MeshFitError> {
-    let (ku, kv) = (uniform_knots(nu), uniform_knots(nv));
+    let (rows_u, ku) = if closed_u {
+        (nu + 3, closed_knots(nu))
+    } else {
+        (nu, uniform_knots(nu))
+    };
+    let kv = uniform_knots(nv);
     let n = nu * nv;
     let mut stencil = vec![[0.0f64; 49]; n];
     let mut rhs = faer::Mat::<f64>::zeros(n, 3);
     let at = |di: isize, dj: isize| ((di + 3) * 7 + dj + 3) as usize;
+    // The unknown row of written-out row `i`, and the offset from row `i` to row `i2` (both
+    // unknown rows; around a closed net the short way, which is unique for nu >= 7).
+    let row_of = |i: usize| if closed_u { i % nu } else { i };
+    let offset = |i: usize, i2: usize| -> isize {
+        let d = i2 as isize - i as isize;
+        if closed_u {
+            let d = d.rem_euclid(nu as isize);
+            if d > nu as isize / 2 {
+                d - nu as isize
+            } else {
+                d
+            }
+        } else {
+            d
+        }
+    };
     for (p, t) in mesh.positions.iter().zip(uv) {
-        let (su, bu) = basis_values(&ku, nu, 3, t.x);
+        let (su, bu) = basis_values(&ku, rows_u, 3, t.x);
         let (sv, bv) = basis_values(&kv, nv, 3, t.y);
         for r in 0..4 {
             for s in 0..4 {
-                let (i, j) = (su - 3 + r, sv - 3 + s);
+                let (i, j) = (row_of(su - 3 + r), sv - 3 + s);
                 let w = bu[r] * bv[s];
                 let row = i * nv + j;
                 for c in 0..3 {
                     rhs[(row, c)] += w * p[c];
                 }
-                for r2 in 0..4 {
-                    for s2 in 0..4 {
-                        stencil[row][at(r2 as isize - r as isize, s2 as isize - s as isize)] +=
-                            w * bu[r2] * bv[s2];
+                for (r2, b) in bu.iter().enumerate() {
+                    let di = offset(i, row_of(su - 3 + r2));
+                    for (s2, c) in bv.iter().enumerate() {
+                        stencil[row][at(di, s2 as isize - s as isize)] += w * b * c;
                     }
                 }
             }
@@ -533,14 +585,17 @@ fn least_squares_bspline(
     let mut add = |cells: &[((usize, usize), f64)], weight: f64| {
         for &((i, j), a) in cells {
             for &((i2, j2), b) in cells {
-                let (di, dj) = (i2 as isize - i as isize, j2 as isize - j as isize);
+                let (i, i2) = (row_of(i), row_of(i2));
+                let (di, dj) = (offset(i, i2), j2 as isize - j as isize);
                 stencil[i * nv + j][at(di, dj)] += weight * a * b;
             }
         }
     };
+    // Around a closed net the differences wrap (rows nu and nu + 1 are rows 0 and 1).
+    let last = if closed_u { nu + 1 } else { 0 };
     for i in 0..nu {
         for j in 0..nv {
-            if i + 2 < nu {
+            if i + 2 < nu + last {
                 add(
                     &[((i, j), 1.0), ((i + 1, j), -2.0), ((i + 2, j), 1.0)],
                     lambda,
@@ -552,7 +607,7 @@ fn least_squares_bspline(
                     lambda,
                 );
             }
-            if i + 1 < nu && j + 1 < nv {
+            if i + 1 < nu + last.min(1) && j + 1 < nv {
                 let cells = [
                     ((i, j), 1.0),
                     ((i + 1, j), -1.0),
@@ -569,7 +624,10 @@ fn least_squares_bspline(
             let col = i * nv + j;
             for di in -3isize..=3 {
                 for dj in -3isize..=3 {
-                    let (i2, j2) = (i as isize + di, j as isize + dj);
+                    let (mut i2, j2) = (i as isize + di, j as isize + dj);
+                    if closed_u {
+                        i2 = i2.rem_euclid(nu as isize);
+                    }
                     if i2 < 0 || j2 < 0 || i2 >= nu as isize || j2 >= nv as isize {
                         continue;
                     }
@@ -592,17 +650,17 @@ fn least_squares_bspline(
         ))
     })?;
     let x = llt.solve(&rhs);
-    let control_points = (0..nu)
+    let control_points = (0..rows_u)
         .map(|i| {
             (0..nv)
                 .map(|j| {
-                    let r = i * nv + j;
+                    let r = row_of(i) * nv + j;
                     [x[(r, 0)], x[(r, 1)], x[(r, 2)]]
                 })
                 .collect()
         })
         .collect();
-    Ok(NurbsSurface::try_from(NurbsDefinition {
+    let surface = NurbsSurface::try_from(NurbsDefinition {
         degree_u: 3,
         degree_v: 3,
         knots_u: ku,
@@ -610,5 +668,10 @@ fn least_squares_bspline(
         control_points,
         weights: None,
         unit: None,
-    })?)
+    })?;
+    Ok(if closed_u {
+        surface.closed_in_u()?
+    } else {
+        surface
+    })
 }

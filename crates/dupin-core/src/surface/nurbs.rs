@@ -211,6 +211,9 @@ pub enum NurbsError {
     /// The `unit` is not one Dupin knows.
     #[error("{0}")]
     Unit(#[from] UnknownUnit),
+    /// [`NurbsSurface::closed_in_u`] on a net that does not wrap around.
+    #[error("the surface is not closed in u: {0}")]
+    NotClosed(String),
 }
 
 /// The JSON form of a NURBS surface, as documented in `docs/nurbs-json.md`: degrees, knot
@@ -261,6 +264,8 @@ pub struct NurbsSurface {
     /// Homogeneous control points `(w x, w y, w z, w)`, point (i, j) at `i * nv + j`.
     homogeneous: Vec<[f64; 4]>,
     unit: Option<LengthUnit>,
+    /// Closed in u ([`NurbsSurface::closed_in_u`]): the domain is periodic in u.
+    periodic_u: bool,
 }
 
 fn direction(d: usize) -> char {
@@ -417,11 +422,55 @@ impl TryFrom<NurbsDefinition> for NurbsSurface {
             points,
             homogeneous,
             unit,
+            periodic_u: false,
         })
     }
 }
 
 impl NurbsSurface {
+    /// This surface as closed in u, its domain periodic in u (a tube or a vault all around):
+    /// a periodic B-spline in u written out, i.e. u knots uniformly spaced over the whole
+    /// vector (no end multiplicity) and the last `degree_u` rows of control points and weights
+    /// repeating the first ones, so the surface joins itself across u = lo ~ hi with
+    /// continuous derivatives up to order `degree_u - 1` (second order for the bicubic fits).
+    /// Errors ([`NurbsError::NotClosed`]) name what does not wrap.
+    pub fn closed_in_u(mut self) -> Result<Self, NurbsError> {
+        let p = self.degree[0];
+        let [nu, nv] = self.count;
+        let k = &self.knots[0];
+        let step = (k[k.len() - 1] - k[0]) / (k.len() - 1) as f64;
+        if let Some(i) = (1..k.len()).find(|&i| ((k[i] - k[i - 1]) - step).abs() > 1e-9 * step) {
+            return Err(NurbsError::NotClosed(format!(
+                "u knots {} and {} are not one uniform step apart",
+                i - 1,
+                i
+            )));
+        }
+        if nu < 2 * p {
+            return Err(NurbsError::NotClosed(format!(
+                "{nu} rows of control points are too few to repeat {p}"
+            )));
+        }
+        for r in 0..p {
+            for j in 0..nv {
+                let (a, b) = (r * nv + j, (nu - p + r) * nv + j);
+                if self.homogeneous[a] != self.homogeneous[b] {
+                    return Err(NurbsError::NotClosed(format!(
+                        "control point ({}, {j}) does not repeat ({r}, {j})",
+                        nu - p + r
+                    )));
+                }
+            }
+        }
+        self.periodic_u = true;
+        Ok(self)
+    }
+
+    /// Whether the domain is periodic in u ([`NurbsSurface::closed_in_u`]).
+    pub fn is_closed_in_u(&self) -> bool {
+        self.periodic_u
+    }
+
     /// Reads the JSON form (`docs/nurbs-json.md`). Errors name the line and column of malformed
     /// JSON, or the array entry that breaks a rule.
     pub fn from_json(text: &str) -> Result<Self, NurbsError> {
@@ -647,7 +696,7 @@ impl Surface for NurbsSurface {
         Domain {
             u: (self.knots[0][p], self.knots[0][nu]),
             v: (self.knots[1][q], self.knots[1][nv]),
-            periodic_u: false,
+            periodic_u: self.periodic_u,
             periodic_v: false,
         }
     }
@@ -720,6 +769,67 @@ impl NurbsSurface {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A cubic tube written out closed in u (8 rows around, 3 repeated) is a smooth closed
+    /// surface: value, first and second derivatives agree across u = 0 ~ 1 and its domain is
+    /// periodic; a clamped net, uneven knots or a row that does not repeat are refused.
+    #[test]
+    fn a_net_written_out_closed_in_u_closes_smoothly() {
+        let m = 8;
+        let ring = |i: usize| {
+            let a = std::f64::consts::TAU * (i % m) as f64 / m as f64;
+            (0..4)
+                .map(|j| {
+                    [
+                        2.0 * a.cos(),
+                        2.0 * a.sin(),
+                        j as f64 + 0.3 * (2.0 * a).sin(),
+                    ]
+                })
+                .collect::<Vec<_>>()
+        };
+        let def = NurbsDefinition {
+            degree_u: 3,
+            degree_v: 3,
+            knots_u: (0..m + 7).map(|k| (k as f64 - 3.0) / m as f64).collect(),
+            knots_v: vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0],
+            control_points: (0..m + 3).map(ring).collect(),
+            weights: None,
+            unit: None,
+        };
+        let tube = NurbsSurface::try_from(def.clone())
+            .unwrap()
+            .closed_in_u()
+            .unwrap();
+        assert!(tube.is_closed_in_u() && tube.domain().periodic_u);
+        assert_eq!(tube.domain().u, (0.0, 1.0));
+        for v in [0.0, 0.4, 1.0] {
+            let (a, b) = (tube.derivatives(0.0, v), tube.derivatives(1.0, v));
+            for (x, y) in [(a.p, b.p), (a.pu, b.pu), (a.puu, b.puu), (a.puv, b.puv)] {
+                assert!((x - y).norm() < 1e-12 * (1.0 + x.norm()), "{x:?} {y:?}");
+            }
+        }
+        let refused = |d: NurbsDefinition| {
+            let e = NurbsSurface::try_from(d)
+                .unwrap()
+                .closed_in_u()
+                .unwrap_err();
+            assert!(matches!(e, NurbsError::NotClosed(_)), "{e}");
+            e.to_string()
+        };
+        let mut uneven = def.clone();
+        uneven.knots_u[5] += 0.01;
+        assert!(refused(uneven).contains("uniform step"));
+        let mut torn = def.clone();
+        torn.control_points[m + 1][2][2] += 1e-3;
+        assert!(refused(torn).contains("does not repeat"));
+        let clamped = NurbsDefinition {
+            knots_u: vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0],
+            control_points: (0..4).map(ring).collect(),
+            ..def
+        };
+        assert!(refused(clamped).contains("uniform step"));
+    }
 
     /// A bilinear-by-biquadratic net (degree 1 along u, 2 along v) as JSON, with `edit` applied
     /// to the definition first.
