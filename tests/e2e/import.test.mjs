@@ -263,3 +263,43 @@ test('a design at state-plane coordinates is drawn as at zero, anchored where it
     await browser.close();
   }
 });
+
+test('a tube-like mesh (a vault closed around) is fitted closed and panelled all around', async () => {
+  const { browser, page, errors } = await openPage();
+  try {
+    // 64 x 24 quads of a vault of revolution split into triangles: cylinder topology, no UVs.
+    const [nu, nv] = [64, 24];
+    let obj = '';
+    for (let j = 0; j <= nv; j++) for (let i = 0; i < nu; i++) {
+      const a = 2 * Math.PI * i / nu, z = 6 * j / nv, r = 3 + 0.4 * Math.cos(0.8 * z);
+      obj += `v ${r * Math.cos(a)} ${r * Math.sin(a)} ${z}\n`;
+    }
+    const id = (i, j) => j * nu + (i % nu) + 1;
+    for (let j = 0; j < nv; j++) for (let i = 0; i < nu; i++) obj += `f ${id(i, j)} ${id(i + 1, j)} ${id(i + 1, j + 1)}\nf ${id(i, j)} ${id(i + 1, j + 1)} ${id(i, j + 1)}\n`;
+    await byId(page, 'import-file').setInputFiles({ name: 'vault.obj', mimeType: 'text/plain', buffer: Buffer.from(obj) });
+    await page.waitForFunction(() => document.querySelector('[data-testid=status]').textContent.includes('vault.obj · surface'), null, { timeout: 60_000 });
+    await byId(page, 'free-size').fill('0.45');
+    await byId(page, 'free-size').press('Enter');
+    await page.waitForFunction(() => /size=0\.45/.test(location.hash), null, { timeout: 60_000 });
+    await play(page);
+    const m = await metrics(page);
+    assert.equal(m.phase, 'done', await byId(page, 'status').textContent());
+    assert.equal(m.invalidFaces, '0');
+    assert.ok(Number(m.maxPlanarity) <= 1e-10, m.maxPlanarity);
+    // All around with no seam: every panel edge away from the two loops is shared by two panels.
+    const text = await exportText(page, 'export-obj');
+    const { faces } = parseObj(text);
+    assert.ok(faces > 300, `${faces} panels`);
+    const v = objVertices(text);
+    const f = text.split('\n').filter((l) => l.startsWith('f ')).map((l) => l.split(/\s+/).slice(1).map((x) => Number(x.split('/')[0]) - 1));
+    const uses = new Map();
+    for (const face of f) face.forEach((a, k) => { const b = face[(k + 1) % face.length]; const key = Math.min(a, b) + ',' + Math.max(a, b); uses.set(key, (uses.get(key) ?? 0) + 1); });
+    const zs = v.map((p) => p[2]);
+    const [lo, hi] = [Math.min(...zs), Math.max(...zs)];
+    const open = [...uses].filter(([key, n]) => n === 1 && key.split(',').every((i) => v[i][2] > lo + 0.8 && v[i][2] < hi - 0.8));
+    assert.deepEqual(open, [], 'boundary edges away from the loops (a seam)');
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
