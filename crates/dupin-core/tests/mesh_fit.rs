@@ -65,6 +65,37 @@ fn phex_panels_the_fitted_dome_close_to_the_mesh() {
     assert!(far <= 0.005 * diagonal, "{far}");
 }
 
+/// Fits `mesh` (within a thousandth of its diagonal) and panels the fit as `--input` and the
+/// page do (`PhexConfig::for_fitted_mesh`) at `size`: the configuration, the result and its
+/// faces with K > 0 and with K < 0.
+fn fit_and_panel(
+    mesh: &PolyMesh,
+    size: f64,
+) -> (
+    dupin_core::phex::PhexConfig,
+    dupin_core::phex::PhexResult,
+    [usize; 2],
+) {
+    use dupin_core::Stepper;
+    use dupin_core::phex::{PhexConfig, PhexPipeline};
+    assert!(mesh.num_faces() >= 20_000);
+    let fit = fit_mesh_surface(mesh, &MeshFitOptions::default()).unwrap();
+    let diagonal = mesh.bbox_diagonal();
+    assert!(fit.max_distance < 1e-3 * diagonal, "{}", fit.max_distance);
+    let config = PhexConfig::for_fitted_mesh("design", fit.surface, Some(size));
+    let r = PhexPipeline::new(config.clone())
+        .and_then(Stepper::finish)
+        .unwrap();
+    let rep = &r.report;
+    let gaussian = |s: f64| rep.per_face.iter().filter(|f| f.gaussian * s > 0.0).count();
+    let signs = [gaussian(1.0), gaussian(-1.0)];
+    eprintln!(
+        "{} faces ({} with K > 0, {} with K < 0), {} invalid, planarity {:e}",
+        rep.faces, signs[0], signs[1], rep.invalid_faces, rep.max_planarity
+    );
+    (config, r, signs)
+}
+
 /// A mixed-curvature freeform mesh with a conjugate network (a translational roof, whose x and
 /// y lines are conjugate, K > 0 on one side of a parabolic line and K < 0 on the other), over
 /// 20 000 triangles and no UVs: the paper's setting (sections 5.2 and 7: a singularity-free
@@ -74,32 +105,13 @@ fn phex_panels_the_fitted_dome_close_to_the_mesh() {
 /// gave 10 invalid faces of 1 532).
 #[test]
 fn phex_panels_a_fitted_mixed_curvature_mesh_with_a_conjugate_network() {
-    use dupin_core::Stepper;
-    use dupin_core::phex::{PhexConfig, PhexPipeline};
     let mut swaps = vec![];
     for seed in [2, 3] {
         let mesh = translational_roof_triangle_mesh(104, seed);
-        assert!(mesh.num_faces() >= 20_000);
-        let fit = fit_mesh_surface(&mesh, &MeshFitOptions::default()).unwrap();
-        let diagonal = mesh.bbox_diagonal();
-        assert!(fit.max_distance < 1e-3 * diagonal, "{}", fit.max_distance);
-        let config = PhexConfig::for_fitted_mesh("roof", fit.surface, Some(0.3));
+        let (config, r, [elliptic, hyperbolic]) = fit_and_panel(&mesh, 0.3);
         swaps.push(config.swap);
-        let r = PhexPipeline::new(config).and_then(Stepper::finish).unwrap();
-        let rep = &r.report;
-        let gaussian = |s: f64| rep.per_face.iter().filter(|f| f.gaussian * s > 0.0).count();
-        eprintln!(
-            "seed {seed}: {} faces ({} with K > 0, {} with K < 0), {} invalid, planarity {:e}",
-            rep.faces,
-            gaussian(1.0),
-            gaussian(-1.0),
-            rep.invalid_faces,
-            rep.max_planarity
-        );
-        assert!(
-            gaussian(1.0) > 500 && gaussian(-1.0) > 500,
-            "both signs of K"
-        );
+        let (rep, diagonal) = (&r.report, mesh.bbox_diagonal());
+        assert!(elliptic > 500 && hyperbolic > 500, "both signs of K");
         assert_eq!(rep.invalid_faces, 0);
         assert!(rep.max_planarity <= 1e-10, "{}", rep.max_planarity);
         let input = MeshSurface::from_mesh(mesh.clone());
@@ -202,27 +214,11 @@ fn on_a_fitted_roof_mesh_only_faces_beside_the_parabolic_line_are_invalid() {
 /// both misses.
 #[test]
 fn phex_on_a_fitted_mixed_curvature_mesh_reports_what_it_misses() {
-    use dupin_core::Stepper;
-    use dupin_core::phex::{PhexConfig, PhexGoals, PhexPipeline};
-    let mesh = bump_triangle_mesh(104, 3);
-    assert!(mesh.num_faces() >= 20_000);
-    let fit = fit_mesh_surface(&mesh, &MeshFitOptions::default()).unwrap();
-    let diagonal = mesh.bbox_diagonal();
-    assert!(fit.max_distance < 1e-3 * diagonal, "{}", fit.max_distance);
-    let config = PhexConfig::for_fitted_mesh("bump", fit.surface, Some(0.3));
+    use dupin_core::phex::PhexGoals;
+    let (config, r, [elliptic, hyperbolic]) = fit_and_panel(&bump_triangle_mesh(104, 3), 0.3);
     let goals = PhexGoals::of(&config, true);
-    let r = PhexPipeline::new(config).and_then(Stepper::finish).unwrap();
     let rep = &r.report;
-    let gaussian = |s: f64| rep.per_face.iter().filter(|f| f.gaussian * s > 0.0).count();
-    eprintln!(
-        "{} faces ({} with K > 0, {} with K < 0), {} invalid, planarity {:e}",
-        rep.faces,
-        gaussian(1.0),
-        gaussian(-1.0),
-        rep.invalid_faces,
-        rep.max_planarity
-    );
-    assert!(gaussian(1.0) > 10 && gaussian(-1.0) > 10, "both signs of K");
+    assert!(elliptic > 10 && hyperbolic > 10, "both signs of K");
     let missed = goals.shortfall(
         &r.mesh,
         rep.max_planarity,
