@@ -317,3 +317,68 @@ fn an_imported_design_is_panelled_alike_in_any_unit_and_at_any_offset() {
     assert!(moved < 1e-2 * rep.bbox_diagonal, "{moved}");
     assert!((far.report.max_planarity / rep.max_planarity - 1.0).abs() < 0.1);
 }
+
+/// A closed surface as Rhino writes a periodic one (uniform u knots without the two that never
+/// reach the domain, the first three rows of control points repeated at the end) is read as
+/// closed in u, and P-Hex panels it all around: its only boundary is at the two open ends.
+#[test]
+fn a_periodic_tube_is_read_closed_and_panelled_all_around() {
+    use dupin_core::Stepper;
+    use dupin_core::mesh::MeshTopology;
+    use dupin_core::phex::{PhexConfig, PhexPipeline};
+    use dupin_core::surface::Surface;
+    let m = 12;
+    let ring = |i: usize| -> Vec<[f64; 3]> {
+        let a = std::f64::consts::TAU * (i % m) as f64 / m as f64;
+        (0..5)
+            .map(|j| {
+                let r = 3.0 + 0.3 * (j as f64 - 2.0).powi(2) / 4.0;
+                [r * a.cos(), r * a.sin(), 1.5 * j as f64]
+            })
+            .collect()
+    };
+    let def = NurbsDefinition {
+        degree_u: 3,
+        degree_v: 3,
+        knots_u: (1..m + 6).map(|k| (k as f64 - 3.0) / m as f64).collect(),
+        knots_v: vec![0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0],
+        control_points: (0..m + 3).map(ring).collect(),
+        weights: None,
+        unit: Some("m".into()),
+    };
+    let tube = NurbsSurface::try_from(def).unwrap();
+    assert!(tube.is_closed_in_u() && tube.domain().periodic_u);
+    // A dragged point of the wrapped rows moves with its copy: still closed, still smooth.
+    let mut dragged = tube.clone();
+    // Point (1, 2) of the 5-point rows; its copy is row m + 1.
+    dragged
+        .set_control_point(5 + 2, dupin_core::Vec3::new(3.5, 1.0, 3.2))
+        .unwrap();
+    assert_eq!(dragged.control_points()[(m + 1) * 5 + 2], [3.5, 1.0, 3.2]);
+    assert!(dragged.clone().closed_in_u().is_ok());
+    let (a, b) = (dragged.derivatives(0.0, 0.5), dragged.derivatives(1.0, 0.5));
+    assert!((a.p - b.p).norm() < 1e-12 && (a.puu - b.puu).norm() < 1e-9);
+    let r = PhexPipeline::new(PhexConfig::for_nurbs("tube", tube, Some(0.5)))
+        .and_then(Stepper::finish)
+        .unwrap();
+    let rep = &r.report;
+    eprintln!(
+        "tube: {} faces, {} invalid, planarity {:e}",
+        rep.faces, rep.invalid_faces, rep.max_planarity
+    );
+    assert!(rep.faces > 150, "{} faces", rep.faces);
+    assert_eq!(rep.invalid_faces, 0);
+    assert!(rep.max_planarity <= 1e-10);
+    let topo = MeshTopology::new(&r.mesh).unwrap();
+    let (lo, hi) = r
+        .mesh
+        .positions
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(lo, hi), p| {
+            (lo.min(p.z), hi.max(p.z))
+        });
+    let seam = (0..r.mesh.num_vertices())
+        .filter(|&v| topo.is_boundary(v) && (lo + 1.0..hi - 1.0).contains(&r.mesh.positions[v].z))
+        .count();
+    assert_eq!(seam, 0, "boundary vertices away from the two ends");
+}

@@ -415,7 +415,7 @@ impl TryFrom<NurbsDefinition> for NurbsSurface {
             }
         }
         let unit = def.unit.as_deref().map(str::parse).transpose()?;
-        Ok(NurbsSurface {
+        let surface = NurbsSurface {
             degree,
             knots,
             count,
@@ -423,27 +423,31 @@ impl TryFrom<NurbsDefinition> for NurbsSurface {
             homogeneous,
             unit,
             periodic_u: false,
-        })
+        };
+        // A net that wraps around in u is a closed surface (a Rhino periodic surface, a tube):
+        // panelled all around, with no seam.
+        Ok(surface.clone().closed_in_u().unwrap_or(surface))
     }
 }
 
 impl NurbsSurface {
     /// This surface as closed in u, its domain periodic in u (a tube or a vault all around):
-    /// a periodic B-spline in u written out, i.e. u knots uniformly spaced over the whole
-    /// vector (no end multiplicity) and the last `degree_u` rows of control points and weights
-    /// repeating the first ones, so the surface joins itself across u = lo ~ hi with
-    /// continuous derivatives up to order `degree_u - 1` (second order for the bicubic fits).
-    /// Errors ([`NurbsError::NotClosed`]) name what does not wrap.
+    /// a periodic B-spline in u written out, i.e. u knots uniformly spaced (no end
+    /// multiplicity; the first and the last knot, which never reach the domain, may be
+    /// anything, as Rhino leaves them out) and the last `degree_u` rows of control points and
+    /// weights repeating the first ones, so the surface joins itself across u = lo ~ hi with
+    /// continuous derivatives up to order `degree_u - 1` (second order for bicubics). Reading
+    /// a definition (`NurbsSurface::try_from`) does this whenever the net so wraps. Errors
+    /// ([`NurbsError::NotClosed`]) name what does not wrap.
     pub fn closed_in_u(mut self) -> Result<Self, NurbsError> {
         let p = self.degree[0];
         let [nu, nv] = self.count;
-        let k = &self.knots[0];
+        let k = &self.knots[0][1..self.knots[0].len() - 1];
         let step = (k[k.len() - 1] - k[0]) / (k.len() - 1) as f64;
         if let Some(i) = (1..k.len()).find(|&i| ((k[i] - k[i - 1]) - step).abs() > 1e-9 * step) {
             return Err(NurbsError::NotClosed(format!(
-                "u knots {} and {} are not one uniform step apart",
-                i - 1,
-                i
+                "u knots {i} and {} are not one uniform step apart",
+                i + 1
             )));
         }
         if nu < 2 * p {
@@ -538,8 +542,10 @@ impl NurbsSurface {
     /// Moves control point `index` (row-major, `i * nv + j`) to `p`, keeping its weight (at
     /// most [`MAX_MOVE_IN_NET_SIZES`] net sizes from the net, where evaluation stays exact): the
     /// surface changes over the `(p + 1) x (q + 1)` spans the point supports and nowhere else
-    /// (The NURBS Book, P3.6). Fails, leaving the surface as it was, for an index past the net
-    /// or a point that is not finite (also once weighted).
+    /// (The NURBS Book, P3.6). On a surface closed in u a point of the first or the last
+    /// `degree_u` rows moves with its copy, so the surface stays closed. Fails, leaving the
+    /// surface as it was, for an index past the net or a point that is not finite (also once
+    /// weighted).
     pub fn set_control_point(&mut self, index: usize, p: Vec3) -> Result<(), NurbsError> {
         let [nu, nv] = self.count;
         if index >= nu * nv {
@@ -563,8 +569,19 @@ impl NurbsSurface {
                 j: index % nv,
             });
         }
-        self.points[index] = [p.x, p.y, p.z];
-        self.homogeneous[index] = h;
+        // On a surface closed in u the first `degree_u` rows are the last ones: a point there
+        // moves with its copy, and the surface stays closed.
+        let (i, j, p_u) = (index / nv, index % nv, self.degree[0]);
+        let copy = match i {
+            _ if !self.periodic_u => None,
+            i if i < p_u => Some(i + nu - p_u),
+            i if i >= nu - p_u => Some(i + p_u - nu),
+            _ => None,
+        };
+        for k in std::iter::once(index).chain(copy.map(|c| c * nv + j)) {
+            self.points[k] = [p.x, p.y, p.z];
+            self.homogeneous[k] = h;
+        }
         Ok(())
     }
 
