@@ -2,6 +2,8 @@
 //! (`surface/mesh_fit.rs`) and panelled by P-Hex: the fit is close to the mesh, the map is one to
 //! one, and the panels are planar, valid and close to the input mesh.
 
+mod common;
+
 use dupin_core::Vec3;
 use dupin_core::mesh::PolyMesh;
 use dupin_core::scenes::benchmark_meshes::{
@@ -53,16 +55,20 @@ fn phex_panels_the_fitted_dome_close_to_the_mesh() {
     assert!(rep.faces > 300);
     assert_eq!(rep.invalid_faces, 0);
     assert!(rep.max_planarity <= 1e-10);
-    let input = MeshSurface::from_mesh(mesh.clone());
     let diagonal = mesh.bbox_diagonal();
-    let far = r
-        .mesh
+    let far = farthest_from(&mesh, &r.mesh);
+    eprintln!("max distance to the input mesh {far:.3e} of a {diagonal:.2} m diagonal");
+    assert!(far <= 0.005 * diagonal, "{far}");
+}
+
+/// The largest distance from a vertex of `panels` to the triangle mesh `input`.
+fn farthest_from(input: &PolyMesh, panels: &PolyMesh) -> f64 {
+    let input = MeshSurface::from_mesh(input.clone());
+    panels
         .positions
         .iter()
         .map(|p| input.closest_point(p).unwrap().distance)
-        .fold(0.0, f64::max);
-    eprintln!("max distance to the input mesh {far:.3e} of a {diagonal:.2} m diagonal");
-    assert!(far <= 0.005 * diagonal, "{far}");
+        .fold(0.0, f64::max)
 }
 
 /// Fits `mesh` (within a thousandth of its diagonal) and panels the fit as `--input` and the
@@ -114,13 +120,7 @@ fn phex_panels_a_fitted_mixed_curvature_mesh_with_a_conjugate_network() {
         assert!(elliptic > 500 && hyperbolic > 500, "both signs of K");
         assert_eq!(rep.invalid_faces, 0);
         assert!(rep.max_planarity <= 1e-10, "{}", rep.max_planarity);
-        let input = MeshSurface::from_mesh(mesh.clone());
-        let far = r
-            .mesh
-            .positions
-            .iter()
-            .map(|p| input.closest_point(p).unwrap().distance)
-            .fold(0.0, f64::max);
+        let far = farthest_from(&mesh, &r.mesh);
         assert!(far <= 0.005 * diagonal, "{far} of {diagonal}");
     }
     assert_eq!(
@@ -377,17 +377,7 @@ fn a_cylinder_mesh_is_cut_open_fitted_closed_and_panelled_all_around() {
     );
     assert!(rep.faces > 100);
     assert_eq!(quadrants, 4, "the panels go all around");
-    let topo = dupin_core::mesh::MeshTopology::new(&r.mesh).unwrap();
-    let (lo, hi) = r
-        .mesh
-        .positions
-        .iter()
-        .fold((f64::MAX, f64::MIN), |(lo, hi), p| {
-            (lo.min(p.z), hi.max(p.z))
-        });
-    let seam: Vec<usize> = (0..r.mesh.num_vertices())
-        .filter(|&v| topo.is_boundary(v) && (lo + 0.8..hi - 0.8).contains(&r.mesh.positions[v].z))
-        .collect();
+    let seam = common::boundary_vertices_between_ends(&r.mesh, 0.8);
     assert!(
         seam.is_empty(),
         "boundary vertices away from the loops: {seam:?}"

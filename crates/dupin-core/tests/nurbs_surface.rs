@@ -4,6 +4,8 @@
 //! derivatives; the JSON form reads back bit for bit, in both knot conventions.
 #![cfg(not(target_arch = "wasm32"))]
 
+mod common;
+
 use curvo::prelude::{KnotVector, NurbsSurface3D};
 use dupin_core::Vec3;
 use dupin_core::scenes::benchmark_meshes::nurbs_roof;
@@ -324,7 +326,6 @@ fn an_imported_design_is_panelled_alike_in_any_unit_and_at_any_offset() {
 #[test]
 fn a_periodic_tube_is_read_closed_and_panelled_all_around() {
     use dupin_core::Stepper;
-    use dupin_core::mesh::MeshTopology;
     use dupin_core::phex::{PhexConfig, PhexPipeline};
     use dupin_core::surface::Surface;
     let m = 12;
@@ -369,16 +370,6 @@ fn a_periodic_tube_is_read_closed_and_panelled_all_around() {
     assert!(rep.faces > 150, "{} faces", rep.faces);
     assert_eq!(rep.invalid_faces, 0);
     assert!(rep.max_planarity <= 1e-10);
-    let topo = MeshTopology::new(&r.mesh).unwrap();
-    let (lo, hi) = r
-        .mesh
-        .positions
-        .iter()
-        .fold((f64::MAX, f64::MIN), |(lo, hi), p| {
-            (lo.min(p.z), hi.max(p.z))
-        });
-    let seam = (0..r.mesh.num_vertices())
-        .filter(|&v| topo.is_boundary(v) && (lo + 1.0..hi - 1.0).contains(&r.mesh.positions[v].z))
-        .count();
+    let seam = common::boundary_vertices_between_ends(&r.mesh, 1.0).len();
     assert_eq!(seam, 0, "boundary vertices away from the two ends");
 }
