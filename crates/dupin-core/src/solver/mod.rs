@@ -25,6 +25,7 @@ mod gauss_newton;
 mod nested_dissection;
 mod pattern;
 mod sqp;
+mod supernodal_llt;
 
 pub(crate) use block_normal::fill_reducing_ordering;
 pub(crate) use block_system::{BlockLayout, BlockSystem};
