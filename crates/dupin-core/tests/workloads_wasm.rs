@@ -139,3 +139,94 @@ fn read_1m_triangles_obj_and_glb() {
         println!("{line}");
     }
 }
+
+/// Prints a line natively and on wasm32 (Node's console through wasm-bindgen-test).
+macro_rules! say {
+    ($($t:tt)*) => {{
+        #[cfg(target_arch = "wasm32")]
+        wasm_bindgen_test::console_log!($($t)*);
+        #[cfg(not(target_arch = "wasm32"))]
+        println!($($t)*);
+    }};
+}
+
+/// Every workload of BENCHMARKS.md's wasm-against-native table in one run, timed inside the
+/// test: the first run (what a page's first click costs; on wasm32 it includes growing the
+/// memory and the JIT's first tiers) and the median and range of the next five. Each run
+/// checks its result. Printed, not asserted, and ignored by default: run with
+/// `-- --ignored --nocapture` natively and on wasm32 (the commands of the module comment).
+#[test]
+#[ignore = "timings for BENCHMARKS.md"]
+fn side_by_side_timings() {
+    use dupin_core::conical::PqMode;
+    use dupin_core::mesh::catmull_clark;
+    use dupin_core::phex::{PhexConfig, TriangulationMethod, phex_run};
+    use dupin_core::scenes::benchmark_meshes::{nurbs_roof, torus_centroid_dual};
+    use dupin_core::scenes::phex_scene;
+    use dupin_core::surface::{NurbsSurface, SurfaceOfRevolution};
+
+    fn time(name: &str, mut run: impl FnMut()) {
+        let t = now_ms();
+        run();
+        let first = now_ms() - t;
+        let mut ms: Vec<f64> = (0..5)
+            .map(|_| {
+                let t = now_ms();
+                run();
+                now_ms() - t
+            })
+            .collect();
+        ms.sort_by(f64::total_cmp);
+        say!(
+            "{name}: first {first:.0} ms, then median {:.0} ms ({:.0}-{:.0})",
+            ms[2],
+            ms[0],
+            ms[4]
+        );
+    }
+
+    time("P-Hex torus-bound 10k faces", || {
+        let mut c = phex_scene("torus-bound").unwrap().config;
+        c.size = Some(0.155);
+        assert!(phex_run(c).unwrap().report.max_planarity <= 1e-10);
+    });
+    time("P-Hex NURBS roof 10k faces", || {
+        let surface = NurbsSurface::try_from(nurbs_roof()).unwrap();
+        let mut c = PhexConfig::for_nurbs("roof", surface, Some(0.22));
+        c.method = TriangulationMethod::Prescribed;
+        assert_eq!(phex_run(c).unwrap().report.faces, 10_203);
+    });
+    let conical = PqOptions {
+        mode: PqMode::Conical,
+        ..PqOptions::default()
+    };
+    // The conical paper's Fig. 15 run (as benches/pq.rs): a principal 10 x 9 mesh of the
+    // vase, three levels of Catmull-Clark with conical perturbation: 5 913 vertices.
+    let mut vase = dupin_core::conical::principal_quad_mesh(
+        &SurfaceOfRevolution::vase(),
+        (0.0, 6.0),
+        (-0.9, 0.9),
+        10,
+        9,
+    );
+    for _ in 0..3 {
+        vase = catmull_clark(&pq_perturb(&vase, conical.clone()).unwrap().mesh).unwrap();
+    }
+    assert_eq!(vase.num_vertices(), 5913);
+    time("PQ conical 5 913 vertices", || {
+        assert!(pq_perturb(&vase, conical.clone()).unwrap().converged);
+    });
+    let dual = torus_centroid_dual(48, 24, 3.0, 1.0);
+    time("PQ torus dual 1 152 hexagons", || {
+        assert!(pq_perturb(&dual, PqOptions::default()).unwrap().converged);
+    });
+    time(
+        "hexagonal Delaunay 16k points",
+        hex_delaunay_16k_points_extended,
+    );
+    time("planarise 10k quads, the paper's way", planarize_10k_quads);
+    time(
+        "planarise 10k quads, keeping the design",
+        planarize_10k_quads_keeping_the_design,
+    );
+}

@@ -196,19 +196,44 @@ pub(crate) fn fill_reducing_ordering(
     if nk < DISSECTION_FROM {
         return Ok(perm);
     }
+    let nd = nested_dissection(&node_graph(nk, pattern));
+    let amd_len = CholeskyAnalysis::new(pattern.as_ref(), &perm)?.factor_len();
+    let nd_len = CholeskyAnalysis::new(pattern.as_ref(), &nd)?.factor_len();
+    Ok(if nd_len < amd_len { nd } else { perm })
+}
+
+/// [`fill_reducing_ordering`] of a scalar pattern, as the analysis of the ordering it keeps:
+/// the winner's analysis is the one its factorisation needs, so it is not made twice.
+pub(crate) fn fill_reducing_analysis(
+    n: usize,
+    pattern: &SymbolicSparseColMat<u32>,
+) -> Result<CholeskyAnalysis, SolverError> {
+    let amd = CholeskyAnalysis::new(pattern.as_ref(), &amd_ordering(pattern)?)?;
+    if n < DISSECTION_FROM {
+        return Ok(amd);
+    }
+    let nd = CholeskyAnalysis::new(
+        pattern.as_ref(),
+        &nested_dissection(&node_graph(n, pattern)),
+    )?;
+    Ok(if nd.factor_len() < amd.factor_len() {
+        nd
+    } else {
+        amd
+    })
+}
+
+/// The graph of the `nk` nodes of an upper-triangle pattern.
+fn node_graph(nk: usize, pattern: &SymbolicSparseColMat<u32>) -> Graph {
     let (col_ptr, row_blk) = (pattern.col_ptr(), pattern.row_idx());
-    let graph = Graph::from_upper_pairs(
+    Graph::from_upper_pairs(
         nk,
         (0..nk).flat_map(|j| {
             row_blk[col_ptr[j] as usize..col_ptr[j + 1] as usize]
                 .iter()
                 .map(move |&i| (i, j as u32))
         }),
-    );
-    let nd = nested_dissection(&graph);
-    let amd_len = CholeskyAnalysis::new(pattern.as_ref(), &perm)?.factor_len();
-    let nd_len = CholeskyAnalysis::new(pattern.as_ref(), &nd)?.factor_len();
-    Ok(if nd_len < amd_len { nd } else { perm })
+    )
 }
 
 /// How the rows of one Jacobian pattern land in a [`Structure`].

@@ -427,7 +427,8 @@ mod tests {
     /// nested dissection and the identity ordering; and refuses an indefinite matrix.
     #[test]
     fn the_hand_written_factorisation_writes_faer_s_factor() {
-        use crate::solver::{amd_ordering, csc_pattern, fill_reducing_ordering};
+        use crate::solver::block_normal::fill_reducing_ordering;
+        use crate::solver::{amd_ordering, csc_pattern};
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         // (unknowns, random couplings per unknown, grid side: a 5-point grid stencil when > 0)
         for (n, per, side) in [

@@ -27,9 +27,9 @@ mod pattern;
 mod sqp;
 mod supernodal_llt;
 
-pub(crate) use block_normal::fill_reducing_ordering;
+pub(crate) use block_normal::fill_reducing_analysis;
 pub(crate) use block_system::{BlockLayout, BlockSystem};
-pub(crate) use cholesky::SparseCholesky;
+pub(crate) use cholesky::{CholeskyAnalysis, SparseCholesky};
 pub(crate) use gauss_newton::{BlockLeastSquares, LmAnalysis};
 pub use gauss_newton::{LevenbergMarquardt, LmOptions, LmStep, NonlinearLeastSquares};
 pub(crate) use nested_dissection::amd_ordering;

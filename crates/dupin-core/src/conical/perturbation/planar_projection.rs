@@ -35,7 +35,8 @@ use crate::Vec3;
 use crate::conical::discrete_terms::quad_det_grad;
 use crate::mesh::PolyMesh;
 use crate::solver::{
-    SolverError, SparseCholesky, amd_ordering, csc_pattern, fill_reducing_ordering,
+    CholeskyAnalysis, SolverError, SparseCholesky, amd_ordering, csc_pattern,
+    fill_reducing_analysis,
 };
 
 /// Relative Levenberg damping of the face-space matrix: it keeps a determinant whose four
@@ -87,7 +88,7 @@ impl PlanarProjection {
     /// The pattern and its analysis for `mesh` whose vertex `v` has its unknowns at
     /// `var_of[v] .. + 3` (`u32::MAX` for none), ordered by AMD, and with `dissection` by
     /// whichever of AMD and nested dissection gives the smaller factor
-    /// ([`fill_reducing_ordering`]: on quad grids the dissection's, on hexagons AMD's). Refused
+    /// ([`fill_reducing_analysis`]: on quad grids the dissection's, on hexagons AMD's). Refused
     /// like the other solvers when the factor would take more than `max_factor_bytes`.
     pub(crate) fn new(
         mesh: &PolyMesh,
@@ -131,12 +132,12 @@ impl PlanarProjection {
             }
         }
         let (pattern, csc_slot) = csc_pattern(nr, &pairs)?;
-        let order = if dissection {
-            fill_reducing_ordering(nr, &pattern)?
+        let analysis = if dissection {
+            fill_reducing_analysis(nr, &pattern)?
         } else {
-            amd_ordering(&pattern)?
+            CholeskyAnalysis::new(pattern.as_ref(), &amd_ordering(&pattern)?)?
         };
-        let cholesky = SparseCholesky::analyse_within(pattern.as_ref(), &order, max_factor_bytes)?;
+        let cholesky = SparseCholesky::from_analysis(analysis, max_factor_bytes)?;
         let slot = |k: usize| cholesky.positions()[csc_slot[k] as usize];
         let diagonal = (0..nr).map(slot).collect();
         let slots = (nr..pairs.len()).map(slot).collect();
