@@ -45,6 +45,8 @@ pub(crate) struct SparseCholesky {
     factored: bool,
     /// The hand-written numeric factorisation's plan and scratch (made on its first use).
     by_hand: Option<(SupernodalPlan, Vec<u32>)>,
+    /// The last factorisation was the hand-written one, so its solves are too.
+    solve_by_hand: bool,
 }
 
 /// Whether the numeric factorisation is [`super::supernodal_llt`]'s rather than faer's: on
@@ -116,6 +118,7 @@ impl SparseCholesky {
             work: vec![0.0; n],
             factored: false,
             by_hand: None,
+            solve_by_hand: false,
         })
     }
 
@@ -145,6 +148,7 @@ impl SparseCholesky {
     /// [`super::supernodal_llt`] (where faer's analysis is supernodal).
     fn factorize_by(&mut self, values: &[f64], by_hand: bool) -> Result<(), SolverError> {
         self.factored = false;
+        self.solve_by_hand = false;
         if values.len() != self.positions.len() {
             return Err(SolverError::Factorization(
                 "values do not match the analysed pattern".into(),
@@ -158,6 +162,7 @@ impl SparseCholesky {
                 )
             });
             let lower = (self.lower.col_ptr(), self.lower.row_idx(), values);
+            self.solve_by_hand = true;
             supernodal_llt::factorize(symbolic, plan, lower, &mut self.factor, local).map_err(
                 |index| {
                     fe(&faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index })
@@ -194,13 +199,20 @@ impl SparseCholesky {
         for (w, &old) in self.work.iter_mut().zip(&self.fwd) {
             *w = rhs[old as usize];
         }
-        let llt = faer::sparse::linalg::cholesky::LltRef::new(&self.symbolic, &self.factor);
-        llt.solve_in_place_with_conj(
-            Conj::No,
-            faer::MatMut::from_column_major_slice_mut(&mut self.work, n, 1),
-            Par::Seq,
-            MemStack::new(&mut self.scratch),
-        );
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Supernodal(symbolic) if self.solve_by_hand => {
+                supernodal_llt::solve_in_place(symbolic, &self.factor, &mut self.work);
+            }
+            _ => {
+                let llt = faer::sparse::linalg::cholesky::LltRef::new(&self.symbolic, &self.factor);
+                llt.solve_in_place_with_conj(
+                    Conj::No,
+                    faer::MatMut::from_column_major_slice_mut(&mut self.work, n, 1),
+                    Par::Seq,
+                    MemStack::new(&mut self.scratch),
+                );
+            }
+        }
         for (r, &new) in rhs.iter_mut().zip(&self.inv) {
             *r = self.work[new as usize];
         }
@@ -422,7 +434,7 @@ mod tests {
     }
 
     /// The hand-written numeric factorisation (wasm32's) writes faer's factor, entry for
-    /// entry to rounding, on random sparse SPD matrices of 1 to 900 unknowns (supernodes from
+    /// entry to rounding, and its solve finds faer's solution, on random sparse SPD matrices of 1 to 900 unknowns (supernodes from
     /// one column to dense blocks of hundreds, short and full groups of its kernel) under AMD,
     /// nested dissection and the identity ordering; and refuses an indefinite matrix.
     #[test]
@@ -487,9 +499,19 @@ mod tests {
                 for (k, &v) in upper.iter().enumerate() {
                     values[chol.positions()[slot[k] as usize] as usize] = v;
                 }
+                let b: Vec<f64> = (0..n).map(|_| rng.random::<f64>() - 0.5).collect();
                 chol.factorize_by(&values, false).unwrap();
                 let faer = chol.factor.clone();
+                let mut faer_x = b.clone();
+                chol.solve_in_place(&mut faer_x).unwrap();
                 chol.factorize_by(&values, true).unwrap();
+                assert!(chol.solve_by_hand || n < 2);
+                let mut x = b.clone();
+                chol.solve_in_place(&mut x).unwrap();
+                let x_scale = faer_x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                for (a, b) in x.iter().zip(&faer_x) {
+                    assert!((a - b).abs() <= 1e-12 * x_scale, "{n}: {a} vs {b}");
+                }
                 assert!(chol.by_hand.is_some() || n < 2, "{n}: not supernodal");
                 let scale = faer.iter().fold(0.0f64, |m, v| m.max(v.abs()));
                 // Every entry of L: the diagonal blocks' upper triangles are not L (faer's

@@ -144,7 +144,6 @@ pub(super) fn factorize(
     local: &mut [u32],
 ) -> Result<(), usize> {
     let val_ptr = symbolic.col_ptr_for_val();
-    l.fill(0.0);
     let mut row_map = Vec::new();
     for s in 0..symbolic.n_supernodes() {
         let (s_start, s_end) = (
@@ -159,6 +158,8 @@ pub(super) fn factorize(
         }
         let (head, tail) = l.split_at_mut(val_ptr[s] as usize);
         let ls = &mut tail[..val_ptr[s + 1] as usize - val_ptr[s] as usize];
+        // Zeroed here rather than all at once: the block is then in cache for its updates.
+        ls.fill(0.0);
 
         for j in s_start..s_end {
             let at = col_ptr[j] as usize..col_ptr[j + 1] as usize;
@@ -246,4 +247,46 @@ pub(super) fn factorize(
         }
     }
     Ok(())
+}
+
+/// Solves `L Lᵀ x = b` in place (`x` holds `b` on entry) with a factor written by
+/// [`factorize`]: forward through the supernodes, then back. The same reason as for the
+/// factorisation: faer's solve makes one generic matrix product per supernode on wasm32.
+pub(super) fn solve_in_place(symbolic: &SymbolicSupernodalCholesky<u32>, l: &[f64], x: &mut [f64]) {
+    let val_ptr = symbolic.col_ptr_for_val();
+    let block = |s: usize| {
+        let s_start = symbolic.supernode_begin()[s] as usize;
+        let nc = symbolic.supernode_end()[s] as usize - s_start;
+        let pattern = symbolic.supernode(s).pattern();
+        let ls = &l[val_ptr[s] as usize..val_ptr[s + 1] as usize];
+        (s_start, nc, nc + pattern.len(), pattern, ls)
+    };
+    for s in 0..symbolic.n_supernodes() {
+        let (s_start, nc, nr, pattern, ls) = block(s);
+        for j in 0..nc {
+            let col = &ls[j * nr..(j + 1) * nr];
+            let xj = x[s_start + j] / col[j];
+            x[s_start + j] = xj;
+            for (i, &v) in col[j + 1..nc].iter().enumerate() {
+                x[s_start + j + 1 + i] -= v * xj;
+            }
+            for (&r, &v) in pattern.iter().zip(&col[nc..]) {
+                x[r as usize] -= v * xj;
+            }
+        }
+    }
+    for s in (0..symbolic.n_supernodes()).rev() {
+        let (s_start, nc, nr, pattern, ls) = block(s);
+        for j in (0..nc).rev() {
+            let col = &ls[j * nr..(j + 1) * nr];
+            let mut xj = x[s_start + j];
+            for (&r, &v) in pattern.iter().zip(&col[nc..]) {
+                xj -= v * x[r as usize];
+            }
+            for (i, &v) in col[j + 1..nc].iter().enumerate() {
+                xj -= v * x[s_start + j + 1 + i];
+            }
+            x[s_start + j] = xj / col[j];
+        }
+    }
 }
