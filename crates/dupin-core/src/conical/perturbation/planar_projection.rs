@@ -17,9 +17,8 @@
 //! least-move problem on the vertex positions and one plane per face, its normal matrix one
 //! 3 x 3 block per vertex after the planes are eliminated: on quads three times the unknowns
 //! on the same graph, so its supernodal factor takes about 27 times the floating-point work of
-//! this one (a 10 000-quad grid: 60 ms natively per factorisation, and in wasm, whose dense
-//! kernels run two lanes without fused multiply-add against AVX-512's eight, 0.25 s; a whole
-//! step here, evaluation and assembly included, takes about 15 ms natively). A live edit
+//! this one (a 10 000-quad grid: 60 ms natively per factorisation on an AVX-512 machine; a
+//! whole step here, evaluation and assembly included, takes about 15 ms). A live edit
 //! moves a vertex of a planar mesh and a kept design is near planar, so every Newton step is
 //! near the constraints, where the determinants are as good a measure of planarity as the
 //! planes.
