@@ -434,9 +434,10 @@ mod tests {
     }
 
     /// The hand-written numeric factorisation (wasm32's) writes faer's factor, entry for
-    /// entry to rounding, and its solve finds faer's solution, on random sparse SPD matrices of 1 to 900 unknowns (supernodes from
-    /// one column to dense blocks of hundreds, short and full groups of its kernel) under AMD,
-    /// nested dissection and the identity ordering; and refuses an indefinite matrix.
+    /// entry to rounding, and its solve finds faer's solution, on random sparse SPD matrices
+    /// of 1 to 4 900 unknowns (supernodes from one column to dense blocks of hundreds, short
+    /// and full groups of its kernel) under AMD, nested dissection and the identity ordering;
+    /// and it refuses an indefinite matrix.
     #[test]
     fn the_hand_written_factorisation_writes_faer_s_factor() {
         use crate::solver::block_normal::fill_reducing_ordering;
