@@ -13,9 +13,11 @@
 //! the small products, then the scatter. That made the numeric factorisation of a 10k-quad
 //! face-space matrix about ten times slower in Node than natively, against under twice for
 //! the rest of the solver. Here each update (by a descendant supernode, and by the
-//! supernode's own earlier columns) is one register-blocked kernel, [`products`]: four rows
-//! by four columns of accumulators, which LLVM compiles to two-lane f64 vectors with simd128.
-//! The algorithm is faer's left-looking one.
+//! supernode's own earlier columns) is one register-blocked kernel: four rows by four columns
+//! of accumulators, which LLVM compiles to two-lane f64 vectors with simd128. A large update
+//! first copies its rows into blocks of four rows ([`pack`]) that [`block_products`] reads
+//! front to back, where reading the factor in place strides a column (often a page) per
+//! product term. The algorithm is faer's left-looking one.
 
 use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
 use std::ops::Range;
@@ -24,6 +26,8 @@ use std::ops::Range;
 const ROWS: usize = 4;
 /// Columns (target columns) of one block of accumulators in [`products`].
 const COLS: usize = 4;
+// [`packed_products`] reads a block of columns as a block of packed rows.
+const _: () = assert!(ROWS == COLS);
 /// No local row (a row outside the supernode being factored).
 const NONE: u32 = u32::MAX;
 
@@ -132,6 +136,81 @@ fn products(
     }
 }
 
+/// Copies rows `rows` of the first `depth` columns of `panel` (column-major, `ld` rows per
+/// column) into `packed` as blocks of [`ROWS`] rows, each block `capacity` groups of ROWS
+/// values (one group per column, zero-padded past the last row): the layout [`block_products`]
+/// reads front to back. Only columns `first..depth` of the blocks from `first_block` on are
+/// written; the rest is kept.
+fn pack(
+    panel: &[f64],
+    ld: usize,
+    (first, depth): (usize, usize),
+    capacity: usize,
+    (rows, first_block): (Range<usize>, usize),
+    packed: &mut Vec<f64>,
+) {
+    let blocks = rows.len().div_ceil(ROWS);
+    packed.resize(blocks * capacity * ROWS, 0.0);
+    for k in first..depth {
+        let col = &panel[k * ld..][..ld];
+        let blocks = packed.chunks_exact_mut(capacity * ROWS).enumerate();
+        for (b, block) in blocks.skip(first_block) {
+            let group = &mut block[k * ROWS..][..ROWS];
+            let from = rows.start + b * ROWS;
+            for (r, v) in group.iter_mut().enumerate() {
+                *v = if from + r < rows.end {
+                    col[from + r]
+                } else {
+                    0.0
+                };
+            }
+        }
+    }
+}
+
+/// `acc[g][r] = Σ_k a[k ROWS + r] · b[k ROWS + g]`: the products of two packed blocks of
+/// [`pack`] over their first `depth` columns. Both are read front to back, so a large
+/// supernode streams through the cache instead of striding a page per column.
+#[cfg_attr(target_arch = "wasm32", target_feature(enable = "simd128"))]
+fn block_products(a: &[f64], b: &[f64], depth: usize) -> [[f64; ROWS]; COLS] {
+    let mut acc = [[0.0f64; ROWS]; COLS];
+    for (a, b) in a[..depth * ROWS]
+        .chunks_exact(ROWS)
+        .zip(b[..depth * ROWS].chunks_exact(COLS))
+    {
+        for g in 0..COLS {
+            for r in 0..ROWS {
+                acc[g][r] += a[r] * b[g];
+            }
+        }
+    }
+    acc
+}
+
+/// [`products`] over a panel packed by [`pack`] (`capacity` groups per block): the columns
+/// are the `n <= COLS` rows from packed row `cols_from` (a multiple of ROWS), the rows those
+/// from `cols_from` to `len`; `out(g, i, v)` with `i` a packed row.
+fn packed_products(
+    packed: &[f64],
+    capacity: usize,
+    depth: usize,
+    (cols_from, n): (usize, usize),
+    len: usize,
+    mut out: impl FnMut(usize, usize, f64),
+) {
+    let block = |b: usize| &packed[b * capacity * ROWS..][..capacity * ROWS];
+    let cols = block(cols_from / ROWS);
+    for b in cols_from / ROWS..len.div_ceil(ROWS) {
+        let acc = block_products(block(b), cols, depth);
+        let rows = ROWS.min(len - b * ROWS);
+        for (g, acc) in acc.iter().enumerate().take(n) {
+            for (r, &v) in acc.iter().enumerate().take(rows) {
+                out(g, b * ROWS + r, v);
+            }
+        }
+    }
+}
+
 /// Factors the matrix whose lower triangle is `(col_ptr, row_idx, values)` (CSC, in the
 /// analysed order) into `l` (faer's supernodal layout of `symbolic`, `len_val` entries).
 /// `local` is scratch of `nrows` entries, all [`NONE`] on entry and on return. Returns the
@@ -145,6 +224,7 @@ pub(super) fn factorize(
 ) -> Result<(), usize> {
     let val_ptr = symbolic.col_ptr_for_val();
     let mut row_map = Vec::new();
+    let (mut packed, mut own) = (Vec::new(), Vec::new());
     for s in 0..symbolic.n_supernodes() {
         let (s_start, s_end) = (
             symbolic.supernode_begin()[s] as usize,
@@ -195,6 +275,19 @@ pub(super) fn factorize(
                 }
             }));
             let base = d_nc + first;
+            if mid > COLS {
+                pack(ld, d_nr, (0, d_nc), d_nc, (base..d_nr, 0), &mut packed);
+                for g0 in (0..mid).step_by(COLS) {
+                    let n = COLS.min(mid - g0);
+                    packed_products(&packed, d_nc, d_nc, (g0, n), d_nr - base, |g, i, v| {
+                        let (col, row) = (row_map[g0 + g], row_map[i]);
+                        if row >= col {
+                            ls[col * nr + row] -= v;
+                        }
+                    });
+                }
+                continue;
+            }
             for g0 in (0..mid).step_by(COLS) {
                 let n = COLS.min(mid - g0);
                 let cols: [usize; COLS] = std::array::from_fn(|g| base + g0 + g);
@@ -213,7 +306,11 @@ pub(super) fn factorize(
             let cols = &cols[..n];
             let (done, rest) = ls.split_at_mut(j0 * nr);
             if j0 > 0 {
-                products(done, nr, j0, cols, j0..nr, |g, i, v| {
+                // The columns finished last, packed from their diagonal down: the rows
+                // above are not read again.
+                let last = (j0 - COLS, j0);
+                pack(done, nr, last, nc, (0..nr, (j0 - COLS) / ROWS), &mut own);
+                packed_products(&own, nc, j0, (j0, n), nr, |g, i, v| {
                     if i >= j0 + g {
                         rest[g * nr + i] -= v;
                     }
