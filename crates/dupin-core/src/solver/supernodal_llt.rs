@@ -187,27 +187,23 @@ fn block_products(a: &[f64], b: &[f64], depth: usize) -> [[f64; ROWS]; COLS] {
     acc
 }
 
-/// [`products`] over a panel packed by [`pack`] (`capacity` groups per block): the columns
-/// are the `n <= COLS` rows from packed row `cols_from` (a multiple of ROWS), the rows those
-/// from `cols_from` to `len`; `out(g, i, v)` with `i` a packed row.
+/// The products of [`products`] over a panel packed by [`pack`] (`capacity` groups per
+/// block), by blocks: the columns are the packed rows from `cols_from` (a multiple of
+/// ROWS), the rows those from `cols_from` to `len`; `out(i, acc)` takes the block of rows
+/// from packed row `i` (`acc[g][r]` for row `i + r`, column `cols_from + g`; rows from `len`
+/// on are padding).
 fn packed_products(
     packed: &[f64],
     capacity: usize,
     depth: usize,
-    (cols_from, n): (usize, usize),
+    cols_from: usize,
     len: usize,
-    mut out: impl FnMut(usize, usize, f64),
+    mut out: impl FnMut(usize, &[[f64; ROWS]; COLS]),
 ) {
     let block = |b: usize| &packed[b * capacity * ROWS..][..capacity * ROWS];
     let cols = block(cols_from / ROWS);
     for b in cols_from / ROWS..len.div_ceil(ROWS) {
-        let acc = block_products(block(b), cols, depth);
-        let rows = ROWS.min(len - b * ROWS);
-        for (g, acc) in acc.iter().enumerate().take(n) {
-            for (r, &v) in acc.iter().enumerate().take(rows) {
-                out(g, b * ROWS + r, v);
-            }
-        }
+        out(b * ROWS, &block_products(block(b), cols, depth));
     }
 }
 
@@ -279,10 +275,14 @@ pub(super) fn factorize(
                 pack(ld, d_nr, (0, d_nc), d_nc, (base..d_nr, 0), &mut packed);
                 for g0 in (0..mid).step_by(COLS) {
                     let n = COLS.min(mid - g0);
-                    packed_products(&packed, d_nc, d_nc, (g0, n), d_nr - base, |g, i, v| {
-                        let (col, row) = (row_map[g0 + g], row_map[i]);
-                        if row >= col {
-                            ls[col * nr + row] -= v;
+                    let cols = &row_map[g0..g0 + n];
+                    packed_products(&packed, d_nc, d_nc, g0, d_nr - base, |i, acc| {
+                        for (r, &row) in row_map[i..].iter().take(ROWS).enumerate() {
+                            for (&col, acc) in cols.iter().zip(acc) {
+                                if row >= col {
+                                    ls[col * nr + row] -= acc[r];
+                                }
+                            }
                         }
                     });
                 }
@@ -310,9 +310,14 @@ pub(super) fn factorize(
                 // above are not read again.
                 let last = (j0 - COLS, j0);
                 pack(done, nr, last, nc, (0..nr, (j0 - COLS) / ROWS), &mut own);
-                packed_products(&own, nc, j0, (j0, n), nr, |g, i, v| {
-                    if i >= j0 + g {
-                        rest[g * nr + i] -= v;
+                packed_products(&own, nc, j0, j0, nr, |i, acc| {
+                    for (g, acc) in acc.iter().enumerate().take(n) {
+                        let col = &mut rest[g * nr..][..nr];
+                        for (r, &v) in acc.iter().enumerate().take(nr - i) {
+                            if i + r >= j0 + g {
+                                col[i + r] -= v;
+                            }
+                        }
                     }
                 });
             }
