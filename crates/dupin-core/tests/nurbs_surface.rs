@@ -320,15 +320,9 @@ fn an_imported_design_is_panelled_alike_in_any_unit_and_at_any_offset() {
     assert!((far.report.max_planarity / rep.max_planarity - 1.0).abs() < 0.1);
 }
 
-/// A closed surface as Rhino writes a periodic one (uniform u knots without the two that never
-/// reach the domain, the first three rows of control points repeated at the end) is read as
-/// closed in u, and P-Hex panels it all around: its only boundary is at the two open ends.
-#[test]
-fn a_periodic_tube_is_read_closed_and_panelled_all_around() {
-    use dupin_core::Stepper;
-    use dupin_core::phex::{PhexConfig, PhexPipeline};
-    use dupin_core::surface::Surface;
-    let m = 12;
+/// Rhino's way of writing a periodic cubic tube of `m` control rows around (the first three
+/// repeated at the end), 5 points along its axis per row.
+fn periodic_tube(m: usize) -> NurbsDefinition {
     let ring = |i: usize| -> Vec<[f64; 3]> {
         let a = std::f64::consts::TAU * (i % m) as f64 / m as f64;
         (0..5)
@@ -338,7 +332,7 @@ fn a_periodic_tube_is_read_closed_and_panelled_all_around() {
             })
             .collect()
     };
-    let def = NurbsDefinition {
+    NurbsDefinition {
         degree_u: 3,
         degree_v: 3,
         knots_u: (1..m + 6).map(|k| (k as f64 - 3.0) / m as f64).collect(),
@@ -346,7 +340,46 @@ fn a_periodic_tube_is_read_closed_and_panelled_all_around() {
         control_points: (0..m + 3).map(ring).collect(),
         weights: None,
         unit: Some("m".into()),
+    }
+}
+
+/// The same tube written closed in v (its net transposed, its degrees and knots exchanged) is
+/// read as the tube itself, closed in u: the same control points and knots, so P-Hex panels it
+/// all around as well. A net that wraps in neither direction stays open.
+#[test]
+fn a_tube_closed_in_v_is_read_with_u_and_v_exchanged() {
+    let def = periodic_tube(12);
+    let transposed = NurbsDefinition {
+        degree_u: def.degree_v,
+        degree_v: def.degree_u,
+        knots_u: def.knots_v.clone(),
+        knots_v: def.knots_u.clone(),
+        control_points: (0..5)
+            .map(|j| def.control_points.iter().map(|row| row[j]).collect())
+            .collect(),
+        weights: None,
+        unit: def.unit.clone(),
     };
+    let tube = NurbsSurface::try_from(def).unwrap();
+    let read = NurbsSurface::try_from(transposed).unwrap();
+    assert!(read.is_closed_in_u());
+    assert_eq!(read.to_json(), tube.to_json());
+    let mut open = periodic_tube(12);
+    open.control_points[13][2][2] += 0.1;
+    let open = NurbsSurface::try_from(open).unwrap();
+    assert!(!open.is_closed_in_u());
+}
+
+/// A closed surface as Rhino writes a periodic one (uniform u knots without the two that never
+/// reach the domain, the first three rows of control points repeated at the end) is read as
+/// closed in u, and P-Hex panels it all around: its only boundary is at the two open ends.
+#[test]
+fn a_periodic_tube_is_read_closed_and_panelled_all_around() {
+    use dupin_core::Stepper;
+    use dupin_core::phex::{PhexConfig, PhexPipeline};
+    use dupin_core::surface::Surface;
+    let m = 12;
+    let def = periodic_tube(m);
     let tube = NurbsSurface::try_from(def).unwrap();
     assert!(tube.is_closed_in_u() && tube.domain().periodic_u);
     // A dragged point of the wrapped rows moves with its copy: still closed, still smooth.

@@ -425,8 +425,13 @@ impl TryFrom<NurbsDefinition> for NurbsSurface {
             periodic_u: false,
         };
         // A net that wraps around in u is a closed surface (a Rhino periodic surface, a tube):
-        // panelled all around, with no seam.
-        Ok(surface.clone().closed_in_u().unwrap_or(surface))
+        // panelled all around, with no seam. One that wraps in v only is the same surface with
+        // u and v exchanged, and is read so, to be panelled all around too.
+        Ok(surface
+            .clone()
+            .closed_in_u()
+            .or_else(|_| surface.transposed().closed_in_u())
+            .unwrap_or(surface))
     }
 }
 
@@ -468,6 +473,23 @@ impl NurbsSurface {
         }
         self.periodic_u = true;
         Ok(self)
+    }
+
+    /// The same surface with u and v exchanged: control point (i, j) becomes (j, i), the
+    /// degrees and knot vectors trade places, and the domain is not periodic.
+    fn transposed(&self) -> Self {
+        let [nu, nv] = self.count;
+        // New point (a, b) is stored at a nu + b and was old point (b, a).
+        let old = |k: usize| (k % nu) * nv + k / nu;
+        NurbsSurface {
+            degree: [self.degree[1], self.degree[0]],
+            knots: [self.knots[1].clone(), self.knots[0].clone()],
+            count: [nv, nu],
+            points: (0..nu * nv).map(|k| self.points[old(k)]).collect(),
+            homogeneous: (0..nu * nv).map(|k| self.homogeneous[old(k)]).collect(),
+            unit: self.unit,
+            periodic_u: false,
+        }
     }
 
     /// Whether the domain is periodic in u ([`NurbsSurface::closed_in_u`]).
