@@ -13,6 +13,7 @@ import { BoxSelection } from './box-select.js';
 import { ControlNetOverlay } from './control-net.js';
 import { presentationFile } from './share.js';
 import { Solver } from './solver.js';
+import { ShownArrays } from './shown-arrays.js';
 import { initTeach, showPick } from './teach.js';
 import { initHexd2d } from './hexd2d.js';
 import { initPresent } from './present.js';
@@ -32,6 +33,7 @@ let TORUS = null;         // the torus preview's parameters { key: { label, valu
 let viewer = null;
 let solver = null;
 let mesh = null;          // MeshData on screen
+const shownArrays = new ShownArrays(); // the worker's mesh arrays, its states' additions appended
 let config = null;        // what is on screen (last configuration that loaded; defaults once loaded)
 let running = false;      // a stepped scene or free configuration is loaded in the worker
 let playing = false;
@@ -288,7 +290,9 @@ function applyState(s) {
   // Frame the growing mesh at its first step and once more when its last layer is in, unless
   // the user has taken the camera.
   const grown = lastPhase === 'triangulation' && m.phase !== 'triangulation';
-  scheduleMesh(s.mesh, lastFaces === 0 ? !userMoved : grown && !userMoved, m.faces);
+  const arrays = shownArrays.apply(s.mesh);
+  if (arrays) scheduleMesh(arrays, lastFaces === 0 ? !userMoved : grown && !userMoved, m.faces);
+  else solver.post('resync'); // a missed state: the worker sends the whole mesh next
   if (s.layers) showLayers(s.layers);
   lastFaces = m.faces;
   lastPhase = m.phase;
@@ -558,6 +562,10 @@ window.dupin = {
   /** The number of the last drag or reshape sent, and whether its run is still to finish. */
   get dragSeq() { return dragSeq; },
   get dragPending() { return dragPending; },
+  /** The worker's mesh arrays as the page holds them (shown-arrays.js), and a request for the
+   * whole mesh in the next state. */
+  get shownArrays() { return shownArrays; },
+  resync: () => solver.post('resync'),
   /** Makes the solver worker trap (`'trap'`) or run out of memory (`'oom'`), to test recovery. */
   fault: (kind) => solver.post('fault', { kind }),
 };

@@ -2,14 +2,15 @@
 // the page's thread only draws. Protocol (all messages carry the load generation `gen`; stale
 // ones are dropped on both sides):
 //   in:  load {config, steps, mode, layers, file?, edits?} (file {name, bytes}: Session.fromFile; edits: drags to replay)
-//        | step | play | pause | ack | mode {mode}
+//        | step | play | pause | ack | mode {mode} | resync (the next state's mesh is whole)
 //        | drag {vertex, point, group?, start} (Session.dragVertices; start: a new drag)
 //        | select {viewProj, rect} (Session.verticesInRect: a box selection)
 //        | reshape {index, point} (Session.moveControlPoint: a dragged NURBS control point)
 //        | layers {layers} (offset/support, Session.setLayers) | export {kind, panelEdge} (obj, json, svg, dxf, csv, glb, 3dm)
 //        | pick {origin, direction, panels} (a view ray; panels: Session.pickPanelVertex)
 //        | fault {kind} (debugFault: a deliberate trap or out-of-memory, for recovery tests)
-//   out: ready | state {metrics, steps, done, mesh: typed arrays (transferred), layers:
+//   out: ready | state {metrics, steps, done, mesh: typed arrays (transferred), whole or, with
+//        `appendTo`, what the mesh added since the last state's (Session.meshSince), layers:
 //        {unavailable, info}} | error {message, field}
 //        | export {kind, text} | pick {panels, pick | error} (Session.pickVertex's or pickPanelVertex's answer)
 //        error {fatal: true} after a wasm trap: the module is unusable and the page restarts us
@@ -34,10 +35,16 @@ function applyLayers() {
   if (session && !session.offsetUnavailable()) session.setLayers(layers);
 }
 
+// The key of the last mesh posted: a state whose mesh only grew since posts only what it added
+// (Session.meshSince; the page appends it, shown-arrays.js).
+let shownKey = null;
+
 function meshMessage() {
-  const m = session.mesh(mode);
+  const m = session.meshSince(mode, shownKey);
+  const appendTo = m.appendTo ?? null;
+  shownKey = m.key ?? null;
   // The polygons travel too: presentation mode and OBJ need the panels, not their triangles.
-  const mesh = { positions: m.positions, normals: m.normals, indices: m.indices, colors: m.colors, edges: m.edges, panelPositions: m.panelPositions, panelFaces: m.panelFaces, viewOrigin: m.viewOrigin };
+  const mesh = { positions: m.positions, normals: m.normals, indices: m.indices, colors: m.colors, edges: m.edges, panelPositions: m.panelPositions, panelFaces: m.panelFaces, viewOrigin: m.viewOrigin, key: shownKey, appendTo };
   m.free();
   return mesh;
 }
@@ -121,6 +128,7 @@ const handlers = {
     session?.free();
     session = next;
     gen = msg.gen;
+    shownKey = null;
     dragSeq = null;
     mode = msg.mode ?? mode;
     layers = msg.layers ?? null;
@@ -154,6 +162,12 @@ const handlers = {
     try { stepOnce(true); send(); } catch (e) { fail(e); }
   },
   pause() { playing = false; },
+  // The page missed a state and cannot add to what it holds: the next state is whole (now, or
+  // the next step's while playing).
+  resync() {
+    shownKey = null;
+    if (session && !(playing && !session.done())) { try { send(); } catch (e) { fail(e); } }
+  },
   // A vertex drag: the run restarts from the mesh committed when the drag began, the vertex
   // held at `point`; steps for up to DRAG_FRAME_MS, then the state, then (playing) the ack loop
   // finishes the run.

@@ -2,7 +2,7 @@
 // from the URL, export OBJ and reject bad input inline.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { SHOTS, byId, drag, openPage, pixelStats, shot } from './harness.mjs';
+import { SHOTS, byId, drag, metrics, openPage, pixelStats, shot, waitSteps } from './harness.mjs';
 
 for (const [backend, webgpu] of [['WebGPU', true], ['WebGL2', false]]) {
   test(`${backend}: loads cleanly, draws the torus and orbits on drag`, async () => {
@@ -196,6 +196,40 @@ test('a run shows a progress bar: steps done under the core\'s bound on the step
     await page.waitForFunction(() => ['done', 'warning'].includes(document.querySelector('[data-testid=metrics]').dataset.phase), null, { timeout: 60_000 });
     assert.ok(Number(await m.getAttribute('data-steps')) <= 4 + lastLeft);
     await bar.waitFor({ state: 'hidden' });
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
+  }
+});
+
+test('a triangulation revealed a layer at a time is drawn from appended layers, the same as its whole mesh', async () => {
+  const { browser, page, errors } = await openPage({ hash: '#scene=cyclide-prescribed' });
+  // FNV-1a over the bytes of every held array, and how many states were appended to them.
+  const held = () => page.evaluate(() => {
+    const s = window.dupin.shownArrays;
+    const digest = {};
+    for (const [name, a] of Object.entries(s.arrays())) {
+      let h = 0x811c9dc5;
+      for (const b of new Uint8Array(a.buffer, a.byteOffset, a.byteLength)) h = Math.imul(h ^ b, 0x01000193) >>> 0;
+      digest[name] = `${a.length}:${h}`;
+    }
+    return { digest, appended: s.appended };
+  });
+  try {
+    for (let k = 2; k <= 6; k++) {
+      await byId(page, 'step').click();
+      await waitSteps(page, k);
+    }
+    assert.equal((await metrics(page)).phase, 'triangulation');
+    const appended = await held();
+    assert.ok(appended.appended >= 4, `${appended.appended} states appended`);
+    const states = await page.evaluate(() => window.dupin.stepLog.length);
+    await page.evaluate(() => window.dupin.resync());
+    await page.waitForFunction((n) => window.dupin.stepLog.length > n, states);
+    const whole = await held();
+    assert.equal(whole.appended, 0);
+    assert.deepEqual(appended.digest, whole.digest);
+    assert.ok(Number(whole.digest.indices.split(':')[0]) > 0);
     assert.deepEqual(errors, []);
   } finally {
     await browser.close();

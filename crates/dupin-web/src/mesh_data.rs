@@ -1,14 +1,26 @@
 //! Triangle buffers handed to JavaScript as typed arrays.
 
+use crate::js::to_js;
 use dupin_core::mesh::{
-    PanelBuffers, PolyMesh, TriangleBuffers, face_planarity, planarity_color, polymesh_buffers,
-    polymesh_edges, view_origin, write_obj,
+    PanelBuffers, PanelTail, PolyMesh, TriangleBuffers, face_planarity, planarity_color,
+    polymesh_buffers, polymesh_edges, view_origin, write_obj,
 };
 
 use dupin_core::surface::{Torus, sample_surface};
 
 use dupin_core::Vec3;
+use serde::{Deserialize, Serialize};
 use wasm_bindgen::prelude::*;
+
+/// Where a shown mesh stands in its run (`Session.meshSince`): under one revision the mesh
+/// only grows, so its first `faces` faces and `vertices` positions are those it had then.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct MeshKey {
+    pub(crate) revision: u64,
+    pub(crate) faces: usize,
+    pub(crate) vertices: usize,
+}
 
 /// A triangle mesh as typed arrays: `positions` and `normals` (3 floats a vertex), `indices`
 /// (3 a triangle).
@@ -27,6 +39,11 @@ pub struct MeshData {
     /// The point every position here is relative to (`Session`'s view origin); the OBJ adds
     /// it back.
     pub(crate) view_origin: Vec3,
+    /// Where a session's mesh stands in its run (`Session.meshSince`); `None` for a mesh that
+    /// cannot be added to.
+    pub(crate) key: Option<MeshKey>,
+    /// For only what was added to a session's mesh: the key of the mesh it adds to.
+    pub(crate) append_to: Option<MeshKey>,
 }
 
 impl MeshData {
@@ -39,6 +56,8 @@ impl MeshData {
             panels: None,
             panel_arrays: None,
             view_origin: Vec3::zeros(),
+            key: None,
+            append_to: None,
         }
     }
 
@@ -52,6 +71,8 @@ impl MeshData {
             panels: Some(mesh),
             panel_arrays: None,
             view_origin: Vec3::zeros(),
+            key: None,
+            append_to: None,
         }
     }
 
@@ -64,6 +85,34 @@ impl MeshData {
             panels: Some(mesh),
             panel_arrays: None,
             view_origin: Vec3::zeros(),
+            key: None,
+            append_to: None,
+        }
+    }
+
+    /// What a session's mesh added since it stood at `since` (`Session.meshSince`): the render
+    /// buffers' `tail`, the added panel positions (x y z each, relative to `view_origin`) and
+    /// faces (`panelFaces`' layout); `key` is where the mesh stands now.
+    pub(crate) fn tail(
+        tail: PanelTail<'_>,
+        panel_arrays: (Vec<f64>, Vec<u32>),
+        view_origin: Vec3,
+        since: MeshKey,
+        key: MeshKey,
+    ) -> Self {
+        MeshData {
+            buffers: TriangleBuffers {
+                positions: tail.positions.to_vec(),
+                normals: tail.normals.to_vec(),
+                indices: tail.indices.to_vec(),
+            },
+            colors: tail.colors.to_vec(),
+            edges: tail.edges.to_vec(),
+            panels: None,
+            panel_arrays: Some(panel_arrays),
+            view_origin,
+            key: Some(key),
+            append_to: Some(since),
         }
     }
 
@@ -138,6 +187,8 @@ impl MeshData {
             panels: None,
             panel_arrays: None,
             view_origin: Vec3::zeros(),
+            key: None,
+            append_to: None,
         })
     }
 
@@ -145,12 +196,11 @@ impl MeshData {
     /// `panelFaces` (per face its corner count, then its corners); empty for a smooth surface.
     #[wasm_bindgen(getter, js_name = panelPositions)]
     pub fn panel_positions(&self) -> js_sys::Float64Array {
-        let flat = self
-            .panels
-            .as_ref()
-            .map(panel_position_array)
-            .unwrap_or_default();
-        js_sys::Float64Array::from(flat.as_slice())
+        match (&self.panels, &self.panel_arrays) {
+            (Some(mesh), _) => js_sys::Float64Array::from(panel_position_array(mesh).as_slice()),
+            (None, Some((positions, _))) => js_sys::Float64Array::from(positions.as_slice()),
+            (None, None) => js_sys::Float64Array::new_with_length(0),
+        }
     }
 
     /// The number of polygons behind the triangles (0 for a smooth surface or a worker's mesh
@@ -163,12 +213,27 @@ impl MeshData {
     /// See [`MeshData::panel_positions`].
     #[wasm_bindgen(getter, js_name = panelFaces)]
     pub fn panel_faces(&self) -> js_sys::Uint32Array {
-        let flat = self
-            .panels
-            .as_ref()
-            .map(panel_face_array)
-            .unwrap_or_default();
-        js_sys::Uint32Array::from(flat.as_slice())
+        match (&self.panels, &self.panel_arrays) {
+            (Some(mesh), _) => js_sys::Uint32Array::from(panel_face_array(mesh).as_slice()),
+            (None, Some((_, faces))) => js_sys::Uint32Array::from(faces.as_slice()),
+            (None, None) => js_sys::Uint32Array::new_with_length(0),
+        }
+    }
+
+    /// Where a session's mesh stands in its run, `{ revision, faces, vertices }`: give it to
+    /// `Session.meshSince` for only what the run adds next. `undefined` for a mesh that cannot
+    /// be added to (colours other than planarity, extra layers or anchors drawn, or not a
+    /// session's).
+    #[wasm_bindgen(getter)]
+    pub fn key(&self) -> Result<JsValue, JsError> {
+        self.key.map_or(Ok(JsValue::UNDEFINED), |k| to_js(&k))
+    }
+
+    /// For only what was added to a session's mesh (`Session.meshSince`): the `key` of the
+    /// mesh it adds to; `undefined` for a whole mesh.
+    #[wasm_bindgen(getter, js_name = appendTo)]
+    pub fn append_to(&self) -> Result<JsValue, JsError> {
+        self.append_to.map_or(Ok(JsValue::UNDEFINED), |k| to_js(&k))
     }
 
     /// Attaches the polygons of `panelPositions`/`panelFaces` (a worker's mesh rebuilt with

@@ -2,7 +2,7 @@
 
 use crate::import::Imported;
 use crate::js::{err, refuse_unknown_keys, to_js};
-use crate::mesh_data::MeshData;
+use crate::mesh_data::{MeshData, MeshKey};
 use crate::shown_mesh::ShownMesh;
 use dupin_core::conical::{
     PqMode, PqSceneMeasures, PqSceneStepInfo, PqSceneStepper, offset_mesh, pq_scene_shortfall,
@@ -15,8 +15,8 @@ use dupin_core::fabrication::{
 use dupin_core::mesh::view_origin;
 use dupin_core::mesh::{
     ColorMode, NOT_HEX, PLANARITY_HIST_HI, PLANARITY_HIST_LO, PLANARITY_LEGEND_LOG10, PolyMesh,
-    REGULARITY_LEGEND, convexity_color, max_planarity, mean_planarity, planarity_color,
-    planarity_histogram, regularity_color, write_obj,
+    REGULARITY_LEGEND, convexity_color, max_planarity, planarity_color, regularity_color,
+    write_obj,
 };
 use dupin_core::phex::{
     Initialisation, LayerRule, PhexConfig, PhexGoals, PhexPipeline, TriangulationMethod, face_info,
@@ -928,6 +928,38 @@ impl Session {
         self.mesh_in(mode.as_deref())
     }
 
+    /// [`Session::mesh`], or only what the run added since an earlier mesh: `since` is the
+    /// `key` of a mesh this session gave (`undefined` or `null`: none). When the shown mesh is
+    /// that one with faces and vertices added (a P-Hex run revealing its triangulation), in
+    /// planarity colours with no layers or anchors drawn, the result carries only what was
+    /// added: its `appendTo` is `since`, its arrays are to be appended to that mesh's
+    /// (`indices` count that mesh's vertices too), `panelPositions` holds the added vertices
+    /// and `panelFaces` the added faces. Otherwise it is the whole mesh, as `mesh` gives it.
+    /// Either way its `key` is where the mesh stands now. Throws for a `since` that is not a
+    /// mesh's `key`.
+    #[wasm_bindgen(js_name = meshSince)]
+    pub fn mesh_since(&mut self, mode: JsValue, since: JsValue) -> Result<MeshData, JsError> {
+        let since = if since.is_undefined() || since.is_null() {
+            None
+        } else {
+            refuse_unknown_keys(&since, "mesh key", &["revision", "faces", "vertices"])?;
+            Some(
+                serde_wasm_bindgen::from_value(since)
+                    .map_err(|e| JsError::new(&format!("bad mesh key: {e}")))?,
+            )
+        };
+        let planarity = mode.is_undefined()
+            || mode.is_null()
+            || mode.as_string().map(|m| ColorMode::parse(&m)) == Some(Ok(ColorMode::Planarity));
+        if let Some(since) = since
+            && planarity
+            && let Some(tail) = self.tail_since(since)
+        {
+            return Ok(tail);
+        }
+        self.mesh(mode)
+    }
+
     /// Sets the extra layers `mesh()` draws: `{ offset, support, distance }` (see
     /// `offsetUnavailable`); `null` or `{}` for none. Throws for a distance that is not a
     /// finite non-zero number, or layers this run has no offset for.
@@ -1078,7 +1110,45 @@ impl Session {
             }
         }
         data.view_origin = self.view_origin;
+        if mode == ColorMode::Planarity && !self.draws_extras() {
+            data.key = Some(self.shown.key());
+        }
         Ok(data)
+    }
+
+    /// What [`Session::mesh_since`] hands out when only faces and vertices were added since
+    /// `since` and nothing but the planarity-coloured panels is drawn; `None` otherwise.
+    fn tail_since(&mut self, since: MeshKey) -> Option<MeshData> {
+        if self.draws_extras() {
+            return None;
+        }
+        self.sync_shown();
+        let key = self.shown.key();
+        let origin = self.view_origin;
+        let (tail, mesh) = self.shown.planarity_tail(since)?;
+        // As `mesh_in` takes them: relative to the view origin.
+        let positions = mesh.positions[since.vertices..]
+            .iter()
+            .flat_map(|p| {
+                let q = p - origin;
+                [q.x, q.y, q.z]
+            })
+            .collect();
+        let faces = (since.faces..mesh.num_faces())
+            .flat_map(|i| {
+                let f = mesh.face(i);
+                std::iter::once(f.len() as u32).chain(f.iter().copied())
+            })
+            .collect();
+        Some(MeshData::tail(tail, (positions, faces), origin, since, key))
+    }
+
+    /// Whether `mesh_in` draws more than the panels: a panel mesh's anchors, or offset and
+    /// support layers.
+    fn draws_extras(&self) -> bool {
+        let anchors = matches!(&self.run, Run::Pq { stepper, .. } if !stepper.anchors().is_empty());
+        let layers = (self.layers.offset || self.layers.support) && self.offset_reason().is_none();
+        anchors || layers
     }
 
     /// Brings [`Session::shown`] up to the current mesh.
@@ -1136,17 +1206,16 @@ impl Session {
     fn metrics_struct(&mut self) -> Metrics {
         self.sync_shown();
         let mesh = self.shown.mesh();
-        let per_face = self.shown.planarity();
-        let mean_planarity = mean_planarity(per_face);
-        let histogram = planarity_histogram(per_face);
+        let mean_planarity = self.shown.mean_planarity();
+        let histogram = self.shown.histogram();
         let hist_log10 = [PLANARITY_HIST_LO, PLANARITY_HIST_HI];
         let (self_intersecting, non_convex_faces) = self.shown.shape_counts();
-        let mean_edge = mesh.mean_edge();
+        let mean_edge = self.shown.mean_edge();
         let mean_edge_m = self
             .design
             .as_ref()
             .map(|d| mean_edge * d.unit.parse::<LengthUnit>().unwrap_or_default().to_m());
-        let extent = extent(mesh);
+        let extent = self.shown.extent();
         match &self.run {
             Run::Phex(p, goals) => {
                 let m = p.metrics();
@@ -1154,13 +1223,7 @@ impl Session {
                 // is solved in its own frame (`PhexPipeline::frame`), and far from the origin
                 // the user's coordinates hold less than the solver's.
                 // A NaN face makes the whole NaN (a miss), as the optimiser's figure did.
-                let max_planarity = per_face.iter().fold(0.0, |a: f64, &b| {
-                    if a.is_nan() || b.is_nan() {
-                        f64::NAN
-                    } else {
-                        a.max(b)
-                    }
-                });
+                let max_planarity = self.shown.max_planarity();
                 let reason = p
                     .is_done()
                     .then(|| goals.shortfall(mesh, max_planarity, m.iteration, m.invalid_faces))
@@ -1262,23 +1325,10 @@ impl Session {
     }
 }
 
-/// The bounding box extent of `mesh` along x, y and z (zeros for an empty mesh).
-fn extent(mesh: &PolyMesh) -> [f64; 3] {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in &mesh.positions {
-        for (k, c) in [p.x, p.y, p.z].into_iter().enumerate() {
-            lo[k] = lo[k].min(c);
-            hi[k] = hi[k].max(c);
-        }
-    }
-    [0, 1, 2].map(|k| if hi[k] >= lo[k] { hi[k] - lo[k] } else { 0.0 })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use dupin_core::mesh::face_planarity;
+    use dupin_core::mesh::{face_planarity, planarity_histogram};
 
     /// Not a test: where a worker step of the page's 10k-face benchmark configuration goes,
     /// natively (thread CPU time per Gauss-Newton iteration, CG iterations and Cholesky
@@ -1368,7 +1418,7 @@ mod tests {
         assert!((m.extent[0] - 5.4).abs() < 0.1 && (m.extent[1] - 5.4).abs() < 0.1);
         assert!((m.extent[2] - 1.4).abs() < 0.05, "height {}", m.extent[2]);
         assert_eq!(m.mean_edge, mesh.mean_edge());
-        assert!(extent(&PolyMesh::default()) == [0.0; 3]);
+        assert_eq!(ShownMesh::default().extent(), [0.0; 3]);
     }
 
     #[test]
@@ -1384,6 +1434,83 @@ mod tests {
         assert!(m.invalid_faces > 0, "the case no longer has invalid faces");
         assert_eq!(m.phase, "warning");
         assert!(m.reason.unwrap().contains("faces are self-intersecting"));
+    }
+
+    /// Each state's tail (`meshSince` with the last state's key), appended to the arrays held
+    /// so far, gives that state's whole mesh bit for bit: triangles, colours, edges and
+    /// panels. The triangulation's layers come as tails, and a state whose mesh moved (the
+    /// optimisation) or another colour mode comes whole.
+    #[test]
+    fn tails_appended_state_by_state_give_the_whole_meshes() {
+        let cfg = PhexConfig::for_surface("torus", &[], TriangulationMethod::Prescribed, Some(0.6));
+        let mut s = torus_session(cfg);
+        type Arrays = (
+            Vec<f32>,
+            Vec<f32>,
+            Vec<u32>,
+            Vec<f32>,
+            Vec<f32>,
+            Vec<f64>,
+            Vec<u32>,
+        );
+        let arrays = |m: &MeshData| -> Arrays {
+            let (positions, faces) = match (&m.panels, &m.panel_arrays) {
+                (Some(p), _) => (
+                    p.positions.iter().flat_map(|q| [q.x, q.y, q.z]).collect(),
+                    p.faces()
+                        .flat_map(|f| std::iter::once(f.len() as u32).chain(f.iter().copied()))
+                        .collect(),
+                ),
+                (None, Some(a)) => a.clone(),
+                (None, None) => unreachable!(),
+            };
+            let b = &m.buffers;
+            let (p, n, i) = (b.positions.clone(), b.normals.clone(), b.indices.clone());
+            (p, n, i, m.colors.clone(), m.edges.clone(), positions, faces)
+        };
+        let (mut held, mut key): (Option<Arrays>, Option<MeshKey>) = (None, None);
+        let (mut tails, mut wholes) = (0, 0);
+        while !s.done() {
+            s.advance().unwrap();
+            let whole = s.mesh_in(None).unwrap();
+            let part = match key.and_then(|k| s.tail_since(k)) {
+                Some(part) => part,
+                None => s.mesh_in(None).unwrap(),
+            };
+            assert_eq!(part.key, whole.key);
+            let now = match (part.append_to, held.take()) {
+                (Some(since), Some(mut h)) => {
+                    assert_eq!(Some(since), key);
+                    let t = arrays(&part);
+                    h.0.extend(t.0);
+                    h.1.extend(t.1);
+                    h.2.extend(t.2);
+                    h.3.extend(t.3);
+                    h.4.extend(t.4);
+                    h.5.extend(t.5);
+                    h.6.extend(t.6);
+                    tails += 1;
+                    h
+                }
+                (None, _) => {
+                    wholes += 1;
+                    arrays(&part)
+                }
+                (Some(_), None) => unreachable!(),
+            };
+            assert_eq!(now, arrays(&whole));
+            held = Some(now);
+            key = part.key;
+        }
+        assert!(tails >= 10 && wholes >= 2, "{tails} tails, {wholes} whole");
+        // Other colours cannot be added to, nor added to what they drew.
+        assert_eq!(s.mesh_in(Some("convexity")).unwrap().key, None);
+        assert!(s.tail_since(key.unwrap()).is_some());
+        let stale = MeshKey {
+            revision: key.unwrap().revision + 1,
+            ..key.unwrap()
+        };
+        assert!(s.tail_since(stale).is_none());
     }
 
     /// The per-face figures kept from state to state follow every step: the metrics' mean and

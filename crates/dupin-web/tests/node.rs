@@ -82,6 +82,60 @@ fn session_steps_a_phex_scene_to_planar_hexagons() {
     assert_eq!(total as usize, faces);
 }
 
+/// `meshSince` across the JS boundary: while the triangulation is revealed each state's mesh
+/// comes as only its new triangles and panels, appended to the last key's (the whole mesh's
+/// triangle and panel counts add up); a bad key is an Error naming it; another colour mode is
+/// whole and cannot be added to.
+#[wasm_bindgen_test]
+fn mesh_since_hands_out_what_each_reveal_state_added() {
+    use dupin_web::Session;
+    let mut s = Session::new(js_sys::JSON::parse(r#"{"scene":"sphere-spiral"}"#).unwrap()).unwrap();
+    let get = |v: &JsValue, k: &str| js_sys::Reflect::get(v, &k.into()).unwrap();
+    let (mut key, mut triangles, mut panels, mut appended) = (JsValue::UNDEFINED, 0, 0, 0);
+    while !s.done() {
+        s.step().unwrap();
+        let part = s.mesh_since(JsValue::UNDEFINED, key.clone()).unwrap();
+        let whole = s.mesh(JsValue::UNDEFINED).unwrap();
+        let append_to = part.append_to().unwrap();
+        if append_to.is_undefined() {
+            (triangles, panels) = (0, 0);
+        } else {
+            assert_eq!(get(&append_to, "faces"), get(&key, "faces"));
+            appended += 1;
+        }
+        triangles += part.triangle_count();
+        let faces = part.panel_faces().to_vec();
+        let mut rest = faces.as_slice();
+        while let Some((&n, tail)) = rest.split_first() {
+            panels += 1;
+            rest = &tail[n as usize..];
+        }
+        assert_eq!(triangles, whole.triangle_count());
+        assert_eq!(panels, whole.panel_count());
+        key = part.key().unwrap();
+        assert_eq!(
+            get(&key, "faces").as_f64(),
+            Some(whole.panel_count() as f64)
+        );
+    }
+    assert!(appended > 3, "{appended} states were appended");
+    for bad in [
+        r#"{"revision":1}"#,
+        r#"{"revision":1,"faces":2,"vertices":3,"x":4}"#,
+        "42",
+        r#""key""#,
+    ] {
+        assert!(
+            s.mesh_since(JsValue::UNDEFINED, js_sys::JSON::parse(bad).unwrap())
+                .is_err(),
+            "{bad}"
+        );
+    }
+    let convexity = s.mesh_since(JsValue::from("convexity"), key).unwrap();
+    assert!(convexity.append_to().unwrap().is_undefined());
+    assert!(convexity.key().unwrap().is_undefined());
+}
+
 #[wasm_bindgen_test]
 fn bad_session_configs_throw_readable_errors() {
     use dupin_web::Session;

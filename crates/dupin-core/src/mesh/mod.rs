@@ -42,7 +42,7 @@ pub use planarity::{
 pub use polygon::{PolygonError, is_simple_polygon, segments_intersect, strictly_inside_triangle};
 pub use polymesh::{MeshError, PolyMesh};
 pub use render_buffers::{
-    PanelBuffers, TriangleBuffers, polymesh_buffers, polymesh_edges, view_origin,
+    PanelBuffers, PanelTail, TriangleBuffers, polymesh_buffers, polymesh_edges, view_origin,
 };
 pub use subdivision::{catmull_clark, chaikin, doo_sabin, lane_riesenfeld_cubic};
 pub use topology::{MeshTopology, TopologyError};

@@ -75,7 +75,8 @@ pub fn view_origin(points: &[Vec3]) -> Vec3 {
 }
 
 /// Appends faces `from..` of `mesh`, taken relative to `origin`, to `out` and (with
-/// `face_colors`) their colours to `colors`, as [`polymesh_buffers`] lays them out.
+/// `face_colors`, one triple per face from `from` on) their colours to `colors`, as
+/// [`polymesh_buffers`] lays them out.
 fn push_faces(
     mesh: &PolyMesh,
     from: usize,
@@ -109,7 +110,7 @@ fn push_faces(
         }
         let n = n.try_normalize(0.0).unwrap_or_else(Vec3::z);
         let base = out.vertex_count() as u32;
-        let color = face_colors.and_then(|c| c.get(fi));
+        let color = face_colors.and_then(|c| c.get(fi - from));
         for k in 0..f.len() {
             let q = at(k);
             out.positions.extend([q.x as f32, q.y as f32, q.z as f32]);
@@ -166,7 +167,8 @@ fn push_edge_segments(mesh: &PolyMesh, keys: &[u64], origin: Vec3, out: &mut Vec
 /// state to the next: a P-Hex run reveals its triangulation a layer at a time and the page draws
 /// every layer, so rebuilding at every state visited each face once per later layer (1.1 M face
 /// visits for the 10 203-panel roof's 111 states). [`PanelBuffers::extend`] adds only the new
-/// faces. The buffers are relative to an origin ([`PanelBuffers::around`], [`view_origin`]).
+/// faces, and [`PanelBuffers::since`] hands out only what they added, for a viewer that keeps
+/// the rest. The buffers are relative to an origin ([`PanelBuffers::around`], [`view_origin`]).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PanelBuffers {
     /// The faces' triangles, as [`polymesh_buffers`] lays them out.
@@ -181,6 +183,34 @@ pub struct PanelBuffers {
     faces: usize,
     /// The point every position is taken relative to.
     origin: Vec3,
+    /// Where the buffers ended after each `extend`, in the order of the calls.
+    marks: Vec<PanelMark>,
+}
+
+/// The lengths of [`PanelBuffers`]' vectors after an `extend` that left `faces` faces in.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct PanelMark {
+    faces: usize,
+    positions: usize,
+    indices: usize,
+    edges: usize,
+}
+
+/// What the faces from a face count on added to [`PanelBuffers`] ([`PanelBuffers::since`]):
+/// appended to each vector as it stood then, it gives the vector as it stands. `indices` are
+/// into the whole buffers (the vertices before the tail count too).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PanelTail<'a> {
+    /// See [`TriangleBuffers::positions`].
+    pub positions: &'a [f32],
+    /// See [`TriangleBuffers::normals`].
+    pub normals: &'a [f32],
+    /// See [`TriangleBuffers::indices`].
+    pub indices: &'a [u32],
+    /// See [`PanelBuffers::colors`].
+    pub colors: &'a [f32],
+    /// See [`PanelBuffers::edges`].
+    pub edges: &'a [f32],
 }
 
 impl PanelBuffers {
@@ -203,15 +233,15 @@ impl PanelBuffers {
         self.faces
     }
 
-    /// Adds faces `self.faces()..` of `mesh`, face `i` coloured `face_colors[i]` (one triple
-    /// per face of `mesh`). `mesh`'s first `self.faces()` faces must be the ones already in,
-    /// at the same positions (the caller checks: the buffers cannot).
-    pub fn extend(&mut self, mesh: &PolyMesh, face_colors: &[[f32; 3]]) {
+    /// Adds faces `self.faces()..` of `mesh`, face `self.faces() + k` coloured
+    /// `new_face_colors[k]` (one triple per new face). `mesh`'s first `self.faces()` faces must
+    /// be the ones already in, at the same positions (the caller checks: the buffers cannot).
+    pub fn extend(&mut self, mesh: &PolyMesh, new_face_colors: &[[f32; 3]]) {
         let from = self.faces.min(mesh.num_faces());
         push_faces(
             mesh,
             from,
-            Some(face_colors),
+            Some(new_face_colors),
             self.origin,
             &mut self.buffers,
             &mut self.colors,
@@ -225,6 +255,31 @@ impl PanelBuffers {
             self.edge_keys.sort();
         }
         self.faces = mesh.num_faces();
+        self.marks.push(PanelMark {
+            faces: self.faces,
+            positions: self.buffers.positions.len(),
+            indices: self.buffers.indices.len(),
+            edges: self.edges.len(),
+        });
+    }
+
+    /// What the faces from `faces` on added, when the buffers held exactly `faces` faces after
+    /// some `extend` (or `faces` is 0); `None` otherwise.
+    pub fn since(&self, faces: usize) -> Option<PanelTail<'_>> {
+        let mark = if faces == 0 {
+            PanelMark::default()
+        } else {
+            // Face counts only grow from one extend to the next.
+            let k = self.marks.partition_point(|m| m.faces < faces);
+            *self.marks.get(k).filter(|m| m.faces == faces)?
+        };
+        Some(PanelTail {
+            positions: &self.buffers.positions[mark.positions..],
+            normals: &self.buffers.normals[mark.positions..],
+            indices: &self.buffers.indices[mark.indices..],
+            colors: &self.colors[mark.positions..],
+            edges: &self.edges[mark.edges..],
+        })
     }
 }
 
@@ -307,7 +362,7 @@ mod tests {
         let (buffers, vertex_colors) = polymesh_buffers(&mesh, Some(&colors));
         let mut grown = PanelBuffers::default();
         for n in [0, 7, 12, 12, 31, 60] {
-            grown.extend(&first(&mesh, n), &colors[..n]);
+            grown.extend(&first(&mesh, n), &colors[grown.faces()..n]);
             assert_eq!(grown.faces(), n);
         }
         assert_eq!(grown.buffers, buffers);
@@ -327,6 +382,44 @@ mod tests {
         once.extend(&mesh, &colors);
         assert_eq!(once.edges, one_shot);
         assert_eq!(once.buffers, buffers);
+    }
+
+    /// The tail since any face count an `extend` left, appended to the buffers as they were
+    /// then, gives the buffers as they are; a count no `extend` left has no tail.
+    #[test]
+    fn a_tail_appended_to_earlier_buffers_gives_the_current_ones() {
+        let mesh = triangles();
+        let colors: Vec<[f32; 3]> = (0..mesh.num_faces())
+            .map(|i| [i as f32 / 60.0, 0.25, 0.5])
+            .collect();
+        let mut grown = PanelBuffers::default();
+        let mut earlier = vec![grown.clone()];
+        for n in [7, 12, 12, 31, 60] {
+            grown.extend(&first(&mesh, n), &colors[grown.faces()..n]);
+            earlier.push(grown.clone());
+        }
+        for then in &earlier {
+            let tail = grown.since(then.faces()).unwrap();
+            let cat = |a: &[f32], b: &[f32]| [a, b].concat();
+            assert_eq!(
+                cat(&then.buffers.positions, tail.positions),
+                grown.buffers.positions
+            );
+            assert_eq!(
+                cat(&then.buffers.normals, tail.normals),
+                grown.buffers.normals
+            );
+            assert_eq!(
+                [then.buffers.indices.as_slice(), tail.indices].concat(),
+                grown.buffers.indices
+            );
+            assert_eq!(cat(&then.colors, tail.colors), grown.colors);
+            assert_eq!(cat(&then.edges, tail.edges), grown.edges);
+        }
+        assert!(grown.since(60).unwrap().indices.is_empty());
+        for n in [1, 6, 8, 30, 59, 61] {
+            assert_eq!(grown.since(n), None, "{n}");
+        }
     }
 
     /// A design at state-plane coordinates is drawn relative to its view origin exactly as
