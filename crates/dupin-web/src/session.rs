@@ -202,6 +202,9 @@ pub struct Session {
     /// The current mesh's per-face figures and render buffers, for the metrics and `mesh()`
     /// (a worker step asks for both), carried over the faces a state shares with the last.
     shown: ShownMesh,
+    /// `shown` is the run's current mesh: nothing changed the run since it was synced (every
+    /// change of `run` clears this, so a state's metrics and mesh sync once between them).
+    shown_is_current: bool,
     /// Extra layers drawn with the panels (`setLayers`).
     layers: LayerConfig,
     /// The opened design (`Session.fromFile`), shown with the metrics.
@@ -409,6 +412,7 @@ impl Session {
             run,
             config: cfg,
             shown: ShownMesh::default(),
+            shown_is_current: false,
             layers: LayerConfig::default(),
             design: None,
             nurbs: None,
@@ -444,6 +448,7 @@ impl Session {
                 ..SessionConfig::default()
             },
             shown: ShownMesh::around(origin),
+            shown_is_current: false,
             layers: LayerConfig::default(),
             design: Some(design),
             view_origin: origin,
@@ -480,6 +485,7 @@ impl Session {
             .move_control_point(index, [x, y, z])
             .map_err(|e| JsError::new(&e))?;
         self.run = imported_run(imported);
+        self.shown_is_current = false;
         self.design = Some(design);
         Ok(())
     }
@@ -495,6 +501,7 @@ impl Session {
     /// [`Session::step`] without building the metrics (the worker times the solver and the
     /// metrics separately, then calls `metrics()`).
     pub fn advance(&mut self) -> Result<(), JsError> {
+        self.shown_is_current = false;
         match &mut self.run {
             Run::Phex(p, _) => {
                 if !p.is_done() {
@@ -858,6 +865,7 @@ impl Session {
         group: Vec<u32>,
         start: bool,
     ) -> Result<(), JsError> {
+        self.shown_is_current = false;
         let Run::Pq { stepper, started } = &mut self.run else {
             return Err(JsError::new(
                 "dragging is for a panel mesh: a P-Hex run follows its surface, not its vertices",
@@ -1153,8 +1161,12 @@ impl Session {
 
     /// Brings [`Session::shown`] up to the current mesh.
     fn sync_shown(&mut self) {
+        if self.shown_is_current {
+            return;
+        }
         let mesh = self.current_mesh().unwrap_or_default();
         self.shown.sync(mesh);
+        self.shown_is_current = true;
     }
 
     /// Why this run has no offset layer (see `offsetUnavailable`).
@@ -1396,6 +1408,7 @@ mod tests {
             run: Run::Phex(Box::new(PhexPipeline::new(cfg).unwrap()), goals),
             config: serde_json::from_str(r#"{"surface": "torus"}"#).unwrap(),
             shown: ShownMesh::default(),
+            shown_is_current: false,
             layers: LayerConfig::default(),
             design: None,
             nurbs: None,
@@ -1551,6 +1564,7 @@ mod tests {
             },
             config: serde_json::from_str(&format!(r#"{{"scene": "{scene}"}}"#)).unwrap(),
             shown: ShownMesh::default(),
+            shown_is_current: false,
             layers: LayerConfig::default(),
             design: None,
             nurbs: None,

@@ -63,7 +63,6 @@ impl ShownMesh {
     /// corners at the same positions, keep their figures; if any of the last mesh's faces is
     /// gone or moved, every figure is computed afresh.
     pub(crate) fn sync(&mut self, mesh: PolyMesh) {
-        let faces_kept = starts_with(&mesh, &self.mesh);
         let positions_kept = self.mesh.positions.len() <= mesh.positions.len()
             && self
                 .mesh
@@ -71,6 +70,13 @@ impl ShownMesh {
                 .iter()
                 .zip(&mesh.positions)
                 .all(|(a, b)| same_bits(a, b));
+        // With every position as it was (none NaN), the faces' lists alone tell: the corner by
+        // corner test costs a position lookup per corner.
+        let faces_kept = if positions_kept {
+            mesh.starts_with_faces_of(&self.mesh)
+        } else {
+            starts_with(&mesh, &self.mesh)
+        };
         if !(faces_kept && positions_kept) || self.revision == 0 {
             self.revision = NEXT_REVISION.fetch_add(1, Ordering::Relaxed);
         }

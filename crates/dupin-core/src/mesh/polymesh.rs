@@ -146,6 +146,14 @@ impl PolyMesh {
         (0..self.num_faces()).map(move |i| self.face(i))
     }
 
+    /// Whether this mesh's first faces are `earlier`'s faces, corner for corner (positions are
+    /// not compared): a mesh that grew by faces starts with the faces it had.
+    pub fn starts_with_faces_of(&self, earlier: &PolyMesh) -> bool {
+        let (starts, corners) = (earlier.face_start.len(), earlier.face_verts.len());
+        self.face_start.get(..starts) == Some(&earlier.face_start[..])
+            && self.face_verts.get(..corners) == Some(&earlier.face_verts[..])
+    }
+
     /// Histogram of face sizes: polygon size -> number of faces.
     pub fn face_sizes(&self) -> BTreeMap<usize, usize> {
         let mut h = BTreeMap::new();
@@ -247,6 +255,30 @@ mod tests {
         );
         assert_eq!((empty.num_faces(), empty.num_vertices()), (0, 0));
         assert_eq!(empty.faces().count(), 0);
+    }
+
+    /// A mesh starts with its own faces, the faces of a first part of them and the empty
+    /// mesh's; not with faces that differ in a corner, in size or in number.
+    #[test]
+    fn starts_with_the_faces_it_grew_from() {
+        let p = || {
+            let mut p = square();
+            p.push(Vec3::new(2.0, 0.5, 0.0));
+            p
+        };
+        let grown = PolyMesh::new(p(), [vec![0u32, 1, 2, 3], vec![1, 4, 2]]).unwrap();
+        let first = PolyMesh::new(p(), [[0u32, 1, 2, 3]]).unwrap();
+        assert!(grown.starts_with_faces_of(&grown));
+        assert!(grown.starts_with_faces_of(&first));
+        assert!(grown.starts_with_faces_of(&PolyMesh::default()));
+        assert!(!first.starts_with_faces_of(&grown));
+        for other in [
+            PolyMesh::new(p(), [[0u32, 1, 2, 4]]).unwrap(),
+            PolyMesh::new(p(), [[0u32, 1, 2]]).unwrap(),
+            PolyMesh::new(p(), [[1u32, 2, 3, 0]]).unwrap(),
+        ] {
+            assert!(!grown.starts_with_faces_of(&other), "{other:?}");
+        }
     }
 
     #[test]
