@@ -63,23 +63,27 @@ function send() {
     [mesh.positions.buffer, mesh.normals.buffer, mesh.indices.buffer, mesh.colors.buffer, mesh.edges.buffer, mesh.panelPositions.buffer, mesh.panelFaces.buffer]);
   // Posting (structured clone of the metrics; the typed arrays are transferred) is timed for
   // the step log of the next state.
-  postMs = performance.now() - t1;
+  postedAt = performance.now();
+  postMs = postedAt - t1;
 }
 
 let postMs = 0;
-// What the last state cost besides solving: its metrics and render buffers (O(faces) each).
+let postedAt = 0;
+// What the last state cost besides solving: its metrics and render buffers, and (playing) the
+// wait for the page to draw it and acknowledge.
 let overhead = 0;
 
 // `ms` is a step as the contract's `session.step()` (solver + metrics), per step of the state;
 // `timing` splits the worker's time per state: solver, metrics, render buffers (mesh) and the
 // previous post; `stepsInState` counts the steps the state took.
 //
-// While playing (`batch`) a large mesh (BATCH_FACES or more) whose last state's metrics and
-// mesh cost 30 ms or more, a state takes one step for every 10 ms of that overhead, while their
-// solve time stays under it (and 250 ms): revealing a large triangulation takes steps of a
-// hundredth of a millisecond whose states cost 100 ms or more (190k triangles), so measuring and
-// shipping every layer would be nearly the whole run (49 of 55 s at 96k faces). Layers still
-// appear a few at a time. The face threshold, not the time alone, decides whether a run batches
+// While playing (`batch`) a large mesh (BATCH_FACES or more) whose last state's overhead
+// (metrics, mesh and the page's acknowledgement) was 30 ms or more, a state takes one step for
+// every 10 ms of it, while their solve time stays under it (and 250 ms): revealing a large
+// triangulation takes steps of a hundredth of a millisecond, and at 190k triangles the page
+// takes 30 ms or more to draw and acknowledge each state, so a state per layer would make the
+// round trips nearly the whole run (50 s for the reveal at 96k faces). Layers still appear a
+// few at a time. The face threshold, not the time alone, decides whether a run batches
 // at all, so every scene of the papers (at most about 10k faces) shows every step however
 // loaded the machine is.
 const BATCH_FACES = 50_000;
@@ -192,6 +196,7 @@ const handlers = {
   // the page from queueing meshes it cannot draw).
   ack(msg) {
     if (msg.gen !== gen || !playing || !session || session.done()) return;
+    overhead += performance.now() - postedAt;
     setTimeout(() => {
       if (!playing || !session || session.done()) return;
       try { stepOnce(true, dragRun ? DRAG_FRAME_MS : 0); send(); } catch (e) { fail(e); }
