@@ -3,11 +3,19 @@
 // `scenes::benchmark_meshes`, written out here: bicubic, 12 x 9 control points at the Greville
 // points of z = 2 sin(x / 5) + 0.06 y², 20 m x 15 m), opened with the file input and panelled
 // at size 0.22 m (10 203 faces), `runs` times (Reset, then Play).
-//   DUPIN_URL=http://127.0.0.1:8094/ node tests/e2e/bench-import.mjs [runs]
+//   DUPIN_URL=http://127.0.0.1:8094/ node tests/e2e/bench-import.mjs [runs] [reshapes]
 // Prints per run: the worker's time summed over the run's states, split as `timing` splits it
 // (solver, metrics, render buffers), its steps' time as `session.step()` measures it (solver and
 // metrics, `ms`), and the wall time from Play to `done` (every state also drawn and posted).
-import { byId, openPage, waitDone } from './harness.mjs';
+// Then `reshapes` control-point drags (default 0): control point (6, 4) 8 px up, then back, in
+// 5 pointer moves 40 ms apart; per drag the worker's time over the run the release leaves (the
+// states of the last position sent) and the wall time from the release to its `done`.
+import { byId, onScreen, openPage, waitDone } from './harness.mjs';
+
+/** Control point (i, j) of the roof's net. */
+function roofPoint(i, j) {
+  return JSON.parse(roofJson()).control_points[i][j];
+}
 
 function roofJson() {
   const p = 3;
@@ -61,6 +69,42 @@ try {
     }, t0);
     const m = await page.evaluate(() => ({ ...document.querySelector('[data-testid=metrics]').dataset }));
     console.log(JSON.stringify({ run: r + 1, ...r0, invalidFaces: m.invalidFaces, phase: m.phase }));
+  }
+  const reshapes = Number(process.argv[3] ?? 0);
+  if (reshapes > 0) {
+    await byId(page, 'edit-vertices').click();
+    await byId(page, 'control-net').waitFor({ state: 'visible', timeout: 5000 });
+  }
+  const [[x0, y0]] = await onScreen(page, [roofPoint(6, 4)]);
+  for (let r = 0; r < reshapes; r++) {
+    const [from, to] = r % 2 === 0 ? [y0, y0 - 8] : [y0 - 8, y0];
+    await page.evaluate(() => {
+      window.__up = null;
+      document.querySelector('[data-testid=canvas]').addEventListener('pointerup', () => { window.__up = performance.now(); }, { once: true });
+    });
+    await page.mouse.move(x0, from);
+    await page.mouse.down();
+    for (let i = 1; i <= 5; i++) {
+      await page.mouse.move(x0, from + ((to - from) * i) / 5);
+      await page.waitForTimeout(40);
+    }
+    await page.mouse.up();
+    await page.waitForFunction(() => window.__up !== null && !window.dupin.dragPending && ['done', 'warning'].includes(document.querySelector('[data-testid=metrics]').dataset.phase), null, { timeout: 120_000 });
+    const d = await page.evaluate(() => {
+      const log = window.dupin.stepLog.filter((s) => s.dragSeq === window.dupin.dragSeq);
+      const sum = (f) => Math.round(log.reduce((a, s) => a + (Number.isFinite(f(s)) ? f(s) : 0), 0));
+      const last = log.at(-1);
+      return {
+        states: log.length,
+        workerMs: sum((s) => s.timing.solve + s.timing.metrics + s.timing.mesh),
+        solveMs: sum((s) => s.timing.solve),
+        afterReleaseMs: Math.round(Math.max(0, last.at - window.__up)),
+        phase: last.phase,
+        faces: last.faces,
+        maxPlanarity: last.maxPlanarity,
+      };
+    });
+    console.log(JSON.stringify({ reshape: r + 1, ...d }));
   }
 } finally {
   await browser.close();
