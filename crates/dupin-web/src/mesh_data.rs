@@ -342,16 +342,32 @@ impl MeshData {
 
 /// `mesh`'s `panelPositions` array (see [`MeshData::panel_faces`]).
 fn panel_position_array(mesh: &PolyMesh) -> Vec<f64> {
-    mesh.positions
+    panel_positions_from(mesh, 0, Vec3::zeros())
+}
+
+/// The `panelPositions` of `mesh`'s vertices `from..`, relative to `origin`.
+pub(crate) fn panel_positions_from(mesh: &PolyMesh, from: usize, origin: Vec3) -> Vec<f64> {
+    mesh.positions[from..]
         .iter()
-        .flat_map(|p| [p.x, p.y, p.z])
+        .flat_map(|p| {
+            let q = p - origin;
+            [q.x, q.y, q.z]
+        })
         .collect()
 }
 
 /// `mesh`'s `panelFaces` array (see [`MeshData::panel_faces`]).
 fn panel_face_array(mesh: &PolyMesh) -> Vec<u32> {
-    mesh.faces()
-        .flat_map(|f| std::iter::once(f.len() as u32).chain(f.iter().copied()))
+    panel_faces_from(mesh, 0)
+}
+
+/// The `panelFaces` of `mesh`'s faces `from..`.
+pub(crate) fn panel_faces_from(mesh: &PolyMesh, from: usize) -> Vec<u32> {
+    (from..mesh.num_faces())
+        .flat_map(|i| {
+            let f = mesh.face(i);
+            std::iter::once(f.len() as u32).chain(f.iter().copied())
+        })
         .collect()
 }
 

@@ -2,7 +2,7 @@
 
 use crate::import::Imported;
 use crate::js::{err, refuse_unknown_keys, to_js};
-use crate::mesh_data::{MeshData, MeshKey};
+use crate::mesh_data::{MeshData, MeshKey, panel_faces_from, panel_positions_from};
 use crate::shown_mesh::ShownMesh;
 use dupin_core::conical::{
     PqMode, PqSceneMeasures, PqSceneStepInfo, PqSceneStepper, offset_mesh, pq_scene_shortfall,
@@ -1135,19 +1135,8 @@ impl Session {
         let origin = self.view_origin;
         let (tail, mesh) = self.shown.planarity_tail(since)?;
         // As `mesh_in` takes them: relative to the view origin.
-        let positions = mesh.positions[since.vertices..]
-            .iter()
-            .flat_map(|p| {
-                let q = p - origin;
-                [q.x, q.y, q.z]
-            })
-            .collect();
-        let faces = (since.faces..mesh.num_faces())
-            .flat_map(|i| {
-                let f = mesh.face(i);
-                std::iter::once(f.len() as u32).chain(f.iter().copied())
-            })
-            .collect();
+        let positions = panel_positions_from(mesh, since.vertices, origin);
+        let faces = panel_faces_from(mesh, since.faces);
         Some(MeshData::tail(tail, (positions, faces), origin, since, key))
     }
 

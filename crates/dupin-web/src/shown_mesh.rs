@@ -214,16 +214,7 @@ impl Figures {
                 self.hi[k] = self.hi[k].max(c);
             }
         }
-        // As `PolyMesh::mean_edge` sums them.
-        for i in faces..mesh.num_faces() {
-            let f = mesh.face(i);
-            for k in 0..f.len() {
-                self.edge_sum += (mesh.positions[f[(k + 1) % f.len()] as usize]
-                    - mesh.positions[f[k] as usize])
-                    .norm();
-                self.edges += 1;
-            }
-        }
+        (self.edge_sum, self.edges) = mesh.sum_edge_lengths(faces, (self.edge_sum, self.edges));
     }
 
     /// Adds the planarity of the next faces.

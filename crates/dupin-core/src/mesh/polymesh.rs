@@ -181,8 +181,15 @@ impl PolyMesh {
     /// Mean edge length over all faces, each face's edges counted once per face (an interior
     /// edge twice); 0 for a mesh without faces. The mesh's scale, e.g. to size panels.
     pub fn mean_edge(&self) -> f64 {
-        let (mut sum, mut n) = (0.0, 0usize);
-        for i in 0..self.num_faces() {
+        let (sum, n) = self.sum_edge_lengths(0, (0.0, 0));
+        if n == 0 { 0.0 } else { sum / n as f64 }
+    }
+
+    /// Adds the edge lengths of faces `from..` (each face's edges, in face order) to the
+    /// running `(sum, count)`: a mesh that grows by faces keeps [`PolyMesh::mean_edge`]'s sum
+    /// bit for bit by adding its new faces.
+    pub fn sum_edge_lengths(&self, from: usize, (mut sum, mut n): (f64, usize)) -> (f64, usize) {
+        for i in from..self.num_faces() {
             let f = self.face(i);
             for k in 0..f.len() {
                 sum += (self.positions[f[(k + 1) % f.len()] as usize]
@@ -191,7 +198,7 @@ impl PolyMesh {
                 n += 1;
             }
         }
-        if n == 0 { 0.0 } else { sum / n as f64 }
+        (sum, n)
     }
 
     /// Mean length of the edges of face `i`.
