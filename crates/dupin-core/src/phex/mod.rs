@@ -29,7 +29,9 @@ pub use duality::{
     dupin_center, dupin_center_3d, dupin_conic_through, ideal_apex_3d, ideal_triangle,
     is_affine_quasi_regular_hexagon, is_affine_regular_hexagon, project_star, tangent_dual_point,
 };
-pub use pipeline::{PhexConfig, PhexMetrics, PhexPhase, PhexPipeline, PhexResult, phex_run};
+pub use pipeline::{
+    MAX_FOLLOW_STEPS, PhexConfig, PhexMetrics, PhexPhase, PhexPipeline, PhexResult, phex_run,
+};
 pub use planarity_optimisation::{PlanarityOptimiser, PlanarityOptions, PlanarityStep};
 pub use report::{
     FaceInfo, PhexGoals, PhexReport, count_invalid_and_non_convex_faces, count_invalid_faces,

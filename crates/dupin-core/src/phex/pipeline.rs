@@ -18,6 +18,9 @@ use crate::surface::{
 };
 use std::sync::Arc;
 
+mod follow;
+pub use follow::MAX_FOLLOW_STEPS;
+
 /// Everything a run needs. Build it from a scene ([`crate::scenes::phex_scene`]) or with
 /// [`PhexConfig::for_surface`].
 #[derive(Debug, Clone, PartialEq)]
