@@ -1,6 +1,6 @@
 // The control net of an opened NURBS surface, drawn over the 3D view in edit mode and picked
 // there: main.js drags a picked control point in the plane through it facing the view, and the
-// worker reshapes the surface (Session.moveControlPoint) and runs P-Hex on it again.
+// worker reshapes the surface (Session.moveControlPoint) and the panelling follows it.
 //
 // The net is a few dozen to a few thousand points, so it is drawn on a 2D canvas from
 // Viewer.project and picked in screen space here; the surface and its panels stay in wasm.

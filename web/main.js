@@ -392,8 +392,10 @@ function showPanel() {
   const t3 = performance.now();
   // history.replaceState took 10-80 ms of wall time per call on the loaded box (it waits on the
   // browser process; entry.panelParts.hash): the URL follows a playing run only when it stops
-  // (done, a step, a pause: see the play button).
-  if (!playing || done) syncHash();
+  // (done, a step, a pause: see the play button). While a control point is dragged the states
+  // are of a net the URL does not have yet (the release writes it): a follow that is done
+  // mid-drag must not write its steps under the net before the drag, Undo's entry.
+  if ((!playing || done) && !netDrag) syncHash();
   const t4 = performance.now();
   updateButtons();
   entry.panelMs = performance.now() - t1;
@@ -766,9 +768,9 @@ function dragEnd() {
 
 // ---- dragging a control point of an opened NURBS surface (edit mode) -------------------------
 // A press near a control point of the drawn net picks it; moving the pointer drags it in the
-// plane through it facing the view. The worker reshapes the surface and starts P-Hex on it
-// again (Session.moveControlPoint), stepping it while the pointer moves, one state in flight;
-// the panelling follows progressively (triangulation layers, hexagons, optimisation). On release
+// plane through it facing the view. The worker reshapes the surface and the panelling follows
+// it (Session.moveControlPoint: the hexagons moved with the surface, then optimised), stepping
+// it while the pointer moves, one state in flight. On release
 // the point is committed to the URL (`cp`), so Undo gives back the surface before it.
 let netDrag = null; // { id, x, y, index, point, direction, inFlight, sent }
 
@@ -785,14 +787,20 @@ function netDragStart(e) {
   return true;
 }
 
-function sendReshape(d = netDrag, force = false) {
-  if (!d || (d.inFlight && !force)) return;
+// While dragging, the panelling shown follows each position in one step (`live`,
+// Session.dragControlPoint); the release sends the last position once more, not live
+// (Session.moveControlPoint: the panelling of the design as opened follows it, the run a reload
+// of the URL gives).
+function sendReshape(d = netDrag, release = false) {
+  if (!d || (d.inFlight && !release)) return;
   let q;
   try { q = dragPoint(d); } catch { q = null; }
-  if (!q || (d.sent && q.every((c, k) => c === d.sent[k]))) return;
+  const same = q && d.sent && q.every((c, k) => c === d.sent[k]);
+  if (release && !q) q = d.sent;
+  if (!q || (same && !release)) return;
   d.inFlight = true;
   d.sent = q;
-  postNumbered('reshape', { index: d.index, point: net.toDesign(q) });
+  postNumbered('reshape', { index: d.index, point: net.toDesign(q), live: !release });
   net.place(d.index, q);
   dirty = true;
 }
@@ -809,7 +817,8 @@ function netDragEnd() {
   net.active = -1;
   dirty = true;
   if (!d) return;
-  // The last position goes even if a state is still in flight (the worker takes them in order).
+  // The last position goes even if a state is still in flight (the worker takes them in order),
+  // and even if it was sent live.
   sendReshape(d, true);
   if (!d.sent) return;
   const moves = config.imported.controlPoints.filter(([i]) => i !== d.index);

@@ -5,7 +5,8 @@
 //        | step | play | pause | ack | mode {mode} | resync (the next state's mesh is whole)
 //        | drag {vertex, point, group?, start} (Session.dragVertices; start: a new drag)
 //        | select {viewProj, rect} (Session.verticesInRect: a box selection)
-//        | reshape {index, point} (Session.moveControlPoint: a dragged NURBS control point)
+//        | reshape {index, point, live} (a dragged NURBS control point: Session.dragControlPoint
+//          while dragging, Session.moveControlPoint on release)
 //        | layers {layers} (offset/support, Session.setLayers) | export {kind, panelEdge} (obj, json, svg, dxf, csv, glb, 3dm)
 //        | pick {origin, direction, panels} (a view ray; panels: Session.pickPanelVertex)
 //        | fault {kind} (debugFault: a deliberate trap or out-of-memory, for recovery tests)
@@ -220,12 +221,13 @@ const handlers = {
       postMessage({ type: 'pick', gen, panels: !!msg.panels, drag: !!msg.drag, pick });
     } catch (e) { postMessage({ type: 'pick', gen, drag: !!msg.drag, error: e?.message ?? String(e) }); }
   },
-  // A dragged NURBS control point: the surface is reshaped and P-Hex starts again on it, its
+  // A dragged NURBS control point: the surface is reshaped and the panelling follows it, its
   // steps counted from there (a reload replays that many on the reshaped surface).
   reshape(msg) {
     if (!session) return;
     try {
-      session.moveControlPoint(msg.index, msg.point[0], msg.point[1], msg.point[2]);
+      const reshape = msg.live ? session.dragControlPoint : session.moveControlPoint;
+      reshape.call(session, msg.index, msg.point[0], msg.point[1], msg.point[2]);
       dragSeq = msg.seq ?? null;
     } catch (e) {
       if (e instanceof WebAssembly.RuntimeError) { fail(e); return; }

@@ -4,6 +4,7 @@
 //! perturbation makes planar (planar, conical or circular), keeping the design. The file never
 //! leaves the page: the bytes come from the browser and stay in the worker.
 
+use dupin_core::Stepper;
 use dupin_core::conical::{MeshRule, PqMode, PqOptions, PqSceneStepper};
 use dupin_core::fabrication::LengthUnit;
 use dupin_core::mesh::PolyMesh;
@@ -11,6 +12,7 @@ use dupin_core::mesh::io::{ImportOptions, read_mesh};
 use dupin_core::phex::{LayerRule, PhexConfig, PhexGoals, PhexPipeline, TriangulationMethod};
 use dupin_core::surface::{MeshFitOptions, NurbsSurface, Surface, fit_mesh_surface};
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 use wasm_bindgen::prelude::*;
 
 /// The options of `Session.fromFile`: `{ importAs, unit, size, method, init, bound, lambda, mu,
@@ -204,22 +206,86 @@ pub(crate) fn import_run(
         serde_wasm_bindgen::from_value(config)
             .map_err(|e| JsError::new(&format!("bad import config: {e}")))?
     };
-    let (run, info) = import_design(name, bytes, &cfg).map_err(|e| JsError::new(&e))?;
+    let mut start = None;
+    let (run, info) = import_design_from(name, bytes, &cfg, &mut FollowFrom::Opened(&mut start))
+        .map_err(|e| JsError::new(&e))?;
     let source = info.control_net.is_some().then(|| NurbsSource {
         name: name.to_string(),
         bytes: bytes.to_vec(),
         cfg,
+        start,
     });
     Ok((run, info, source))
 }
 
 /// An opened NURBS surface as it was read: the file and its options, the moved control points
 /// among them. Moving a point reads the design again with one more move, so a drag ends on
-/// exactly the run a reload of the same options gives.
+/// exactly the run a reload of the same options gives (see [`following_run`]).
 pub(crate) struct NurbsSource {
     name: String,
     bytes: Vec<u8>,
     cfg: ImportConfig,
+    /// The finished run on the design as opened, kept for the next move ([`FollowStart`]).
+    start: FollowStart,
+}
+
+/// A finished P-Hex run on a design as opened (no control point moved) and its configuration:
+/// every reshaped design follows from it ([`following_run`]).
+pub(crate) type FollowStart = Option<(PhexConfig, Box<PhexPipeline>)>;
+
+/// Where a reshaped design's panelling follows from ([`following_run`]).
+pub(crate) enum FollowFrom<'a> {
+    /// The finished run on the design as opened (kept here once computed): the run a reload
+    /// of the same control points gives.
+    Opened(&'a mut FollowStart),
+    /// The run shown, in one step: a pointer position of a drag, cheap and close to the last
+    /// one, but depending on the drag's path (the release then moves the point with
+    /// [`FollowFrom::Opened`]). A run with no hexagons yet follows as `Opened` would.
+    Current(&'a PhexPipeline),
+}
+
+/// The P-Hex run on a design whose control points moved (`config`, its surface reshaped from
+/// `opened`): the finished run on the design as opened, followed to the reshaped one in steps
+/// ([`PhexPipeline::follow_in_steps`]), or during a drag the run shown followed in one step
+/// ([`FollowFrom`]). A new run on the reshaped surface would triangulate
+/// along parameter lines the move bent away from conjugate and come out with self-intersecting
+/// hexagons near the point (section 5.2; measured in `dupin_core::phex::pipeline::follow`).
+/// The result depends only on the file, its options and the final net, so a drag and a reload
+/// of the same `controlPoints` give the same panels. The finished start is kept in `start` and
+/// reused while its configuration is the same. Where the design as opened gives no hexagonal
+/// mesh, or following fails, the run is a new one on the reshaped surface.
+fn following_run(
+    config: PhexConfig,
+    opened: NurbsSurface,
+    start: &mut FollowFrom,
+) -> Result<PhexPipeline, String> {
+    if let (FollowFrom::Current(current), Some(reshaped)) = (&*start, config.nurbs.as_deref()) {
+        // A pointer position of a drag: one step from the hexagons shown.
+        if let Ok(p) = current.follow(reshaped.clone()) {
+            return Ok(p);
+        }
+    }
+    let start = match start {
+        FollowFrom::Opened(kept) => kept,
+        FollowFrom::Current(_) => &mut None,
+    };
+    let mut first = config.clone();
+    first.nurbs = Some(Arc::new(opened));
+    if !matches!(start, Some((c, _)) if *c == first) {
+        *start = None;
+        let mut p = PhexPipeline::new(first.clone()).map_err(|e| format!("{e}"))?;
+        if p.run_to_end().is_ok() {
+            *start = Some((first, Box::new(p)));
+        }
+    }
+    let followed = match (start.as_ref(), config.nurbs.as_deref()) {
+        (Some((_, p)), Some(reshaped)) => p.follow_in_steps(reshaped.clone()).ok(),
+        _ => None,
+    };
+    match followed {
+        Some(p) => Ok(p),
+        None => PhexPipeline::new(config).map_err(|e| format!("{e}")),
+    }
 }
 
 impl NurbsSource {
@@ -232,17 +298,54 @@ impl NurbsSource {
     ) -> Result<(Imported, DesignInfo), String> {
         let mut cfg = self.cfg.clone();
         cfg.move_control_point(index, p);
-        let out = import_design(&self.name, &self.bytes, &cfg)?;
+        let out = import_design_from(
+            &self.name,
+            &self.bytes,
+            &cfg,
+            &mut FollowFrom::Opened(&mut self.start),
+        )?;
+        self.cfg = cfg;
+        Ok(out)
+    }
+
+    /// [`NurbsSource::move_control_point`] for a pointer position of a drag: the panelling of
+    /// `current` (the run shown) follows in one step ([`FollowFrom::Current`]).
+    pub(crate) fn drag_control_point(
+        &mut self,
+        index: usize,
+        p: [f64; 3],
+        current: &PhexPipeline,
+    ) -> Result<(Imported, DesignInfo), String> {
+        let mut cfg = self.cfg.clone();
+        cfg.move_control_point(index, p);
+        let out = import_design_from(
+            &self.name,
+            &self.bytes,
+            &cfg,
+            &mut FollowFrom::Current(current),
+        )?;
         self.cfg = cfg;
         Ok(out)
     }
 }
 
-/// [`import_run`] after its options are read (plain Rust, tested natively).
+/// [`import_design_from`] with no finished run kept.
+#[cfg(test)]
 fn import_design(
     name: &str,
     bytes: &[u8],
     cfg: &ImportConfig,
+) -> Result<(Imported, DesignInfo), String> {
+    import_design_from(name, bytes, cfg, &mut FollowFrom::Opened(&mut None))
+}
+
+/// [`import_run`] after its options are read (plain Rust, tested natively), with the finished
+/// run a reshaped NURBS design follows from, if one was kept ([`following_run`]).
+fn import_design_from(
+    name: &str,
+    bytes: &[u8],
+    cfg: &ImportConfig,
+    start: &mut FollowFrom,
 ) -> Result<(Imported, DesignInfo), String> {
     let named = |e: &dyn std::fmt::Display| format!("{name}: {e}");
     let wanted = match cfg.import_as.as_deref() {
@@ -270,6 +373,8 @@ fn import_design(
     };
     let t0 = now_ms();
     let read_ms: f64;
+    // The NURBS surface as the file has it, when control points moved.
+    let mut opened = None;
     let mut fit_ms = None;
     let (surface, mesh, fit_distance) = if is_json {
         if wanted == Some(false) {
@@ -279,6 +384,9 @@ fn import_design(
         }
         let text = std::str::from_utf8(bytes).map_err(|e| named(&e))?;
         let mut s = NurbsSurface::from_json(text).map_err(|e| named(&e))?;
+        if cfg.control_points.as_ref().is_some_and(|m| !m.is_empty()) {
+            opened = Some(s.clone());
+        }
         for &[index, x, y, z] in cfg.control_points.iter().flatten() {
             if !(index >= 0.0 && index.fract() == 0.0 && index < u32::MAX as f64) {
                 return Err(named(&format_args!(
@@ -379,7 +487,10 @@ fn import_design(
                 cfg.init.as_deref(),
             )?;
             let goals = PhexGoals::of(&config, true);
-            let pipeline = PhexPipeline::new(config).map_err(|e| named(&e))?;
+            let pipeline = match opened {
+                Some(opened) => following_run(config, opened, start).map_err(|e| named(&e))?,
+                None => PhexPipeline::new(config).map_err(|e| named(&e))?,
+            };
             Imported::Phex(Box::new(pipeline), goals)
         }
         (None, Some(mesh)) => panels_run(&mesh, cfg, unit).map_err(|e| named(&e))?,
@@ -619,6 +730,81 @@ mod tests {
         assert!(refused("a.obj", b"", &as_what).contains("use `surface` or `panels`"));
     }
 
+    /// A control point of the translational roof dragged up 0.3 m in four pointer positions:
+    /// the panelling shown follows each with planar, simple hexagons, so does the release's
+    /// (a new run on that surface has self-intersecting ones), and a reload of the same move
+    /// gives the release's panels bit for bit.
+    #[test]
+    fn a_dragged_roof_point_is_followed_to_planar_simple_panels() {
+        use dupin_core::phex::count_invalid_faces;
+        let roof = NurbsSurface::try_from(dupin_core::scenes::benchmark_meshes::nurbs_roof())
+            .unwrap()
+            .to_json();
+        let mut source = NurbsSource {
+            name: "roof.json".into(),
+            bytes: roof.as_bytes().to_vec(),
+            cfg: ImportConfig::default(),
+            start: None,
+        };
+        let index = 6 * 9 + 4;
+        let [x, y, z] = NurbsSurface::from_json(&roof).unwrap().control_points()[index];
+        // Pointer positions follow the run shown, each to its end ...
+        let (mut shown, _) = import_design("roof.json", roof.as_bytes(), &source.cfg).unwrap();
+        for dz in [0.05, 0.1, 0.2, 0.3] {
+            let Imported::Phex(current, _) = &mut shown else {
+                panic!("a P-Hex run");
+            };
+            current.run_to_end().unwrap();
+            (shown, _) = source
+                .drag_control_point(index, [x, y, z + dz], current)
+                .unwrap();
+            let Imported::Phex(live, _) = &shown else {
+                panic!("a P-Hex run");
+            };
+            assert_eq!(
+                live.metrics().phase,
+                dupin_core::phex::PhexPhase::Optimisation
+            );
+        }
+        let Imported::Phex(mut live, _) = shown else {
+            panic!("a P-Hex run");
+        };
+        live.run_to_end().unwrap();
+        assert_eq!(count_invalid_faces(&live.mesh()), 0);
+        assert!(dupin_core::mesh::max_planarity(&live.mesh()) <= 1e-9);
+        // ... and the release follows from the design as opened.
+        let (released, _) = source.move_control_point(index, [x, y, z + 0.3]).unwrap();
+        let Imported::Phex(mut dragged, _) = released else {
+            panic!("a P-Hex run");
+        };
+        assert_eq!(
+            dragged.metrics().phase,
+            dupin_core::phex::PhexPhase::Optimisation
+        );
+        dragged.run_to_end().unwrap();
+        let mesh = dragged.mesh();
+        assert_eq!(count_invalid_faces(&mesh), 0);
+        assert!(dupin_core::mesh::max_planarity(&mesh) <= 1e-9);
+        let replay = ImportConfig {
+            control_points: Some(vec![[index as f64, x, y, z + 0.3]]),
+            ..ImportConfig::default()
+        };
+        let (again, _) = import_design("roof.json", roof.as_bytes(), &replay).unwrap();
+        let Imported::Phex(mut again, _) = again else {
+            panic!("a P-Hex run");
+        };
+        again.run_to_end().unwrap();
+        assert_eq!(again.mesh(), mesh);
+        // A new run on the reshaped roof, as before following.
+        let mut reshaped = NurbsSurface::from_json(&roof).unwrap();
+        reshaped
+            .set_control_point(index, dupin_core::Vec3::new(x, y, z + 0.3))
+            .unwrap();
+        let mut fresh = PhexPipeline::new(PhexConfig::for_nurbs("roof", reshaped, None)).unwrap();
+        fresh.run_to_end().unwrap();
+        assert!(count_invalid_faces(&fresh.mesh()) > 0);
+    }
+
     /// Moved control points reshape an opened NURBS surface and show in its control net; a
     /// drag (`NurbsSource::move_control_point`, one entry per point however often it moves)
     /// gives the run that opening with the same `controlPoints` gives, bit for bit; bad moves
@@ -634,6 +820,7 @@ mod tests {
             name: "dome.json".into(),
             bytes: json.as_bytes().to_vec(),
             cfg: ImportConfig::default(),
+            start: None,
         };
         let (_, first) =
             import_design("dome.json", json.as_bytes(), &ImportConfig::default()).unwrap();

@@ -456,11 +456,11 @@ impl Session {
     }
 
     /// Moves control point `index` (row-major, `i * nv + j` of the `controlNet` in
-    /// `metrics().design`) of an opened NURBS surface to `(x, y, z)` (the file's unit) and
-    /// restarts the P-Hex run on the reshaped surface from its first step, as a page opened
-    /// with that move in `controlPoints` would (so a dragged net replays bit for bit). Throws
-    /// for a run that is not an opened NURBS surface, an index past the net or a point that is
-    /// not finite, leaving the run as it was.
+    /// `metrics().design`) of an opened NURBS surface to `(x, y, z)` (the file's unit); the
+    /// P-Hex panelling of the design as opened follows the reshaped surface
+    /// (`import::following_run`), as a page opened with that move in `controlPoints` would (so
+    /// a dragged net replays bit for bit). Throws for a run that is not an opened NURBS
+    /// surface, an index past the net or a point that is not finite, leaving the run as it was.
     #[wasm_bindgen(js_name = moveControlPoint)]
     pub fn move_control_point(
         &mut self,
@@ -470,6 +470,30 @@ impl Session {
         y: f64,
         z: f64,
     ) -> Result<(), JsError> {
+        self.reshape(index, [x, y, z], false)
+    }
+
+    /// [`Session::move_control_point`] for a pointer position of a drag: the panelling shown
+    /// follows in one step, cheap and close to the last position, but depending on the drag's
+    /// path; the release then calls `moveControlPoint` with the final position, whose run a
+    /// reload gives. A run with no hexagons yet follows as `moveControlPoint` does. Throws as
+    /// `moveControlPoint` does.
+    #[wasm_bindgen(js_name = dragControlPoint)]
+    pub fn drag_control_point(
+        &mut self,
+        index: f64,
+        x: f64,
+        y: f64,
+        z: f64,
+    ) -> Result<(), JsError> {
+        self.reshape(index, [x, y, z], true)
+    }
+}
+
+impl Session {
+    /// Control point `index` to `p`, the panelling following from the run shown (`live`) or
+    /// from the design as opened.
+    fn reshape(&mut self, index: f64, p: [f64; 3], live: bool) -> Result<(), JsError> {
         if !(index >= 0.0 && index.fract() == 0.0 && index < u32::MAX as f64) {
             return Err(JsError::new(&format!(
                 "{index} is not a control point index"
@@ -481,15 +505,20 @@ impl Session {
                 "control points are for an opened NURBS surface (open a .json or .3dm surface)",
             ));
         };
-        let (imported, design) = source
-            .move_control_point(index, [x, y, z])
-            .map_err(|e| JsError::new(&e))?;
+        let (imported, design) = match &self.run {
+            Run::Phex(current, _) if live => source.drag_control_point(index, p, current),
+            _ => source.move_control_point(index, p),
+        }
+        .map_err(|e| JsError::new(&e))?;
         self.run = imported_run(imported);
         self.shown_is_current = false;
         self.design = Some(design);
         Ok(())
     }
+}
 
+#[wasm_bindgen]
+impl Session {
     /// Advances one observable step (a triangulation layer, the dual mesh, one Gauss-Newton
     /// iteration; for PQ scenes the control mesh, one perturbation iteration or one
     /// subdivision) and returns the metrics.
