@@ -91,6 +91,11 @@ pub struct PlanarityOptions {
     pub tolerance: f64,
     /// Largest number of Gauss-Newton iterations.
     pub max_iterations: usize,
+    /// `max_planarity` up to which an open start without self-intersecting faces counts as
+    /// near planar: λ and μ start shrunk once and least-move steps go first (see
+    /// [`PlanarityOptimiser::new`]; 1e-3 by default). A start made of planar, simple faces
+    /// moved a little (a reshaped design followed, `PhexPipeline::follow`) takes 1e-2.
+    pub near_planar_start: f64,
 }
 
 impl Default for PlanarityOptions {
@@ -100,6 +105,7 @@ impl Default for PlanarityOptions {
             mu: 1e-6,
             tolerance: 1e-10,
             max_iterations: 10,
+            near_planar_start: SHRUNK_START_PLANARITY,
         }
     }
 }
@@ -132,7 +138,8 @@ const INITIAL_DIRECT_DAMPING: f64 = 1e-7;
 /// factorisation and 3 chords against 2 and 4); at 1e-8 the first step raised the cost.
 const INITIAL_SHRUNK_DAMPING: f64 = 3e-8;
 /// `max_planarity` up to which an open start without self-intersecting faces begins with λ and
-/// μ shrunk once (see [`PlanarityOptimiser::new`]).
+/// μ shrunk once (see [`PlanarityOptimiser::new`]); the default of
+/// [`PlanarityOptions::near_planar_start`].
 const SHRUNK_START_PLANARITY: f64 = 1e-3;
 /// Factor by which λ and μ shrink after an iteration of truncated-CG steps (the paper shrinks
 /// λ; the CG path's safeguards were tuned with this rate).
@@ -455,7 +462,7 @@ impl PlanarityOptimiser {
         // after one that does not, the weighted iterations above go on from where the least
         // moves left the mesh.
         let start_planarity = max_planarity(mesh);
-        let shrunk_start = open && !tangled && start_planarity <= SHRUNK_START_PLANARITY;
+        let shrunk_start = open && !tangled && start_planarity <= options.near_planar_start;
         let start_shrink = if shrunk_start { DIRECT_SHRINK } else { 1.0 };
         Ok(PlanarityOptimiser {
             options,

@@ -21,9 +21,14 @@ use crate::Vec3;
 use crate::mesh::SolverFrame;
 use crate::phex::PhexError;
 use crate::phex::pipeline::{PhexMetrics, PhexPhase};
-use crate::phex::planarity_optimisation::PlanarityOptimiser;
+use crate::phex::planarity_optimisation::{PlanarityOptimiser, PlanarityOptions};
 use crate::surface::{NurbsSurface, Surface};
 use std::sync::Arc;
+
+/// [`PlanarityOptions::near_planar_start`] of a followed mesh: its faces were planar and simple
+/// before the move. The roof's 10 203 hexagons (size 0.22) moved with control point (6, 4) up
+/// 0.1 m start 1.4e-2 from planar; at 1e-2 they took the weighted steps.
+const FOLLOW_NEAR_PLANAR: f64 = 1e-1;
 
 /// Most steps [`PhexPipeline::follow_in_steps`] splits a change into: each optimises the whole
 /// mesh to its end, so this bounds a move's cost to that many optimisations; a larger move
@@ -102,7 +107,14 @@ impl PhexPipeline {
                 Some((build_surface(&config, &SolverFrame::identity())?, user_tri))
             }
         };
-        let opt = PlanarityOptimiser::new(&dual.mesh, Some(&feet), config.planarity_options())?;
+        // Planar, simple hexagons moved a little: least-move steps first (10 203 faces, control
+        // point (6, 4) up 0.1 m: 0.39 s of optimisation natively against 2.1 s for the
+        // weighted steps; they give way to those where they do not keep every face simple).
+        let options = PlanarityOptions {
+            near_planar_start: FOLLOW_NEAR_PLANAR,
+            ..config.planarity_options()
+        };
+        let opt = PlanarityOptimiser::new(&dual.mesh, Some(&feet), options)?;
         let phase = if config.optimize && !opt.is_done() {
             PhexPhase::Optimisation
         } else {
