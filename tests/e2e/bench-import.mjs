@@ -102,6 +102,7 @@ try {
         phase: last.phase,
         faces: last.faces,
         maxPlanarity: last.maxPlanarity,
+        cp: new URLSearchParams(location.hash.slice(1)).get('cp'),
       };
     });
     console.log(JSON.stringify({ reshape: r + 1, ...d }));
