@@ -290,40 +290,21 @@ fn following_run(
 
 impl NurbsSource {
     /// The run and design with control point `index` at `p` (file unit); the source keeps the
-    /// move only when it succeeds.
+    /// move only when it succeeds. The panelling follows from the design as opened, or for a
+    /// pointer position of a drag from `current`, the run shown, in one step ([`FollowFrom`]).
     pub(crate) fn move_control_point(
         &mut self,
         index: usize,
         p: [f64; 3],
+        current: Option<&PhexPipeline>,
     ) -> Result<(Imported, DesignInfo), String> {
         let mut cfg = self.cfg.clone();
         cfg.move_control_point(index, p);
-        let out = import_design_from(
-            &self.name,
-            &self.bytes,
-            &cfg,
-            &mut FollowFrom::Opened(&mut self.start),
-        )?;
-        self.cfg = cfg;
-        Ok(out)
-    }
-
-    /// [`NurbsSource::move_control_point`] for a pointer position of a drag: the panelling of
-    /// `current` (the run shown) follows in one step ([`FollowFrom::Current`]).
-    pub(crate) fn drag_control_point(
-        &mut self,
-        index: usize,
-        p: [f64; 3],
-        current: &PhexPipeline,
-    ) -> Result<(Imported, DesignInfo), String> {
-        let mut cfg = self.cfg.clone();
-        cfg.move_control_point(index, p);
-        let out = import_design_from(
-            &self.name,
-            &self.bytes,
-            &cfg,
-            &mut FollowFrom::Current(current),
-        )?;
+        let mut from = match current {
+            Some(c) => FollowFrom::Current(c),
+            None => FollowFrom::Opened(&mut self.start),
+        };
+        let out = import_design_from(&self.name, &self.bytes, &cfg, &mut from)?;
         self.cfg = cfg;
         Ok(out)
     }
@@ -756,7 +737,7 @@ mod tests {
             };
             current.run_to_end().unwrap();
             (shown, _) = source
-                .drag_control_point(index, [x, y, z + dz], current)
+                .move_control_point(index, [x, y, z + dz], Some(current))
                 .unwrap();
             let Imported::Phex(live, _) = &shown else {
                 panic!("a P-Hex run");
@@ -773,7 +754,9 @@ mod tests {
         assert_eq!(count_invalid_faces(&live.mesh()), 0);
         assert!(dupin_core::mesh::max_planarity(&live.mesh()) <= 1e-9);
         // ... and the release follows from the design as opened.
-        let (released, _) = source.move_control_point(index, [x, y, z + 0.3]).unwrap();
+        let (released, _) = source
+            .move_control_point(index, [x, y, z + 0.3], None)
+            .unwrap();
         let Imported::Phex(mut dragged, _) = released else {
             panic!("a P-Hex run");
         };
@@ -829,9 +812,11 @@ mod tests {
         assert_eq!(&net.points[12..15], &[2.0, 2.0, 1.5]);
         // A drag of the middle point in three moves, then a corner.
         for z in [1.7, 1.9, 2.5] {
-            source.move_control_point(4, [2.0, 2.0, z]).unwrap();
+            source.move_control_point(4, [2.0, 2.0, z], None).unwrap();
         }
-        let (run, info) = source.move_control_point(0, [0.0, 0.0, -0.5]).unwrap();
+        let (run, info) = source
+            .move_control_point(0, [0.0, 0.0, -0.5], None)
+            .unwrap();
         assert_eq!(source.cfg.control_points.as_ref().unwrap().len(), 2);
         let net = info.control_net.unwrap();
         assert_eq!(&net.points[12..15], &[2.0, 2.0, 2.5]);
@@ -850,13 +835,13 @@ mod tests {
         assert_eq!(a.mesh(), b.mesh(), "the dragged net replays bit for bit");
 
         let kept = source.cfg.control_points.clone();
-        let e = source.move_control_point(9, [0.0; 3]).err().unwrap();
+        let e = source.move_control_point(9, [0.0; 3], None).err().unwrap();
         assert_eq!(
             e,
             "dome.json: controlPoints: control point 9 is not in the 3 x 3 net"
         );
         let e = source
-            .move_control_point(1, [f64::NAN, 0.0, 0.0])
+            .move_control_point(1, [f64::NAN, 0.0, 0.0], None)
             .err()
             .unwrap();
         assert!(e.contains("not finite"), "{e}");

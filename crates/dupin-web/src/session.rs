@@ -505,11 +505,13 @@ impl Session {
                 "control points are for an opened NURBS surface (open a .json or .3dm surface)",
             ));
         };
-        let (imported, design) = match &self.run {
-            Run::Phex(current, _) if live => source.drag_control_point(index, p, current),
-            _ => source.move_control_point(index, p),
-        }
-        .map_err(|e| JsError::new(&e))?;
+        let current = match &self.run {
+            Run::Phex(current, _) if live => Some(current.as_ref()),
+            _ => None,
+        };
+        let (imported, design) = source
+            .move_control_point(index, p, current)
+            .map_err(|e| JsError::new(&e))?;
         self.run = imported_run(imported);
         self.shown_is_current = false;
         self.design = Some(design);

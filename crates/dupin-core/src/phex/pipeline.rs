@@ -600,13 +600,10 @@ impl PhexPipeline {
             .collect()
     }
 
-    /// The report of the current hexagonal mesh (`None` before it exists), measured in the
-    /// user's coordinates: the mesh a fabricator gets, not the solver's.
-    pub fn report(&self) -> Option<PhexReport> {
-        let d = self.dual.as_ref()?;
-        // The optimiser's last foot points seed the distance searches: the vertices have moved
-        // since the dual mesh's parameters.
-        let seeds: Vec<crate::Vec2> = match &self.optimiser {
+    /// Surface parameters near every vertex of `d`: the optimiser's last foot points (the
+    /// vertices have moved since the dual mesh's parameters), or the dual mesh's.
+    fn foot_parameters(&self, d: &DualMesh) -> Vec<crate::Vec2> {
+        match &self.optimiser {
             Some(o) => o
                 .foot_parameters()
                 .iter()
@@ -614,7 +611,14 @@ impl PhexPipeline {
                 .map(|(foot, &start)| foot.unwrap_or(start))
                 .collect(),
             None => d.vertex_uv.clone(),
-        };
+        }
+    }
+
+    /// The report of the current hexagonal mesh (`None` before it exists), measured in the
+    /// user's coordinates: the mesh a fabricator gets, not the solver's.
+    pub fn report(&self) -> Option<PhexReport> {
+        let d = self.dual.as_ref()?;
+        let seeds = self.foot_parameters(d);
         Some(phex_report(
             &self.to_user(d.mesh.clone()),
             self.surface(),

@@ -71,16 +71,7 @@ impl PhexPipeline {
         config.nurbs = Some(Arc::new(surface));
         let solver = build_surface(&config, &self.frame)?;
         let dom = solver.domain();
-        // The vertices moved since the dual mesh's parameters: the optimiser's feet are nearer.
-        let feet: Vec<crate::Vec2> = match &self.optimiser {
-            Some(o) => o
-                .foot_parameters()
-                .iter()
-                .zip(&dual.vertex_uv)
-                .map(|(foot, &start)| foot.unwrap_or(start))
-                .collect(),
-            None => dual.vertex_uv.clone(),
-        };
+        let feet = self.foot_parameters(dual);
         let mut dual = dual.clone();
         for (p, uv) in dual.mesh.positions.iter_mut().zip(&feet) {
             let (u, v) = dom.normalize(uv.x, uv.y);
