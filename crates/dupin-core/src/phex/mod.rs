@@ -71,4 +71,8 @@ pub enum PhexError {
     /// The sparse solver failed.
     #[error("planarity optimisation failed: {0}")]
     Solver(#[from] crate::solver::SolverError),
+    /// A reshaped design cannot be followed from this run: the run, or a step on the way, has
+    /// self-intersecting or non-planar faces, which following would only carry along.
+    #[error("not followed: {0}")]
+    NotFollowed(String),
 }
