@@ -106,6 +106,7 @@ fn main() -> ExitCode {
             runs,
             seconds,
             keep,
+            quick_build: false,
         }),
         Command::Layering { workspace } => layering::print(workspace.as_deref()),
     };

@@ -80,6 +80,7 @@ pub fn run() -> Result<()> {
             runs: None,
             seconds: Some(5),
             keep: false,
+            quick_build: true,
         })
     })?;
     step("docs", &mut || {
@@ -94,13 +95,18 @@ pub fn run() -> Result<()> {
         &mut || free_native_tests_if_short(),
     )?;
     step("core tests on wasm32 (Node)", &mut || {
-        // The core's wasm32 test files run under wasm-bindgen-test-runner in Node.
+        // The core's wasm32 test files run under wasm-bindgen-test-runner in Node. `-p
+        // dupin-web` (which has no such test) only unifies features with the web crate's
+        // build below, so that build reuses this one's faer, gemm and nalgebra instead of
+        // compiling them again (bytemuck's features differ otherwise): 2 minutes less.
         util::run(
             cargo()
                 .args([
                     "test",
                     "-p",
                     "dupin-core",
+                    "-p",
+                    "dupin-web",
                     "--target",
                     "wasm32-unknown-unknown",
                 ])
