@@ -5,7 +5,7 @@ use crate::common::{CliError, write_report, write_text};
 use clap::Args;
 use dupin_core::Stepper;
 use dupin_core::mesh::write_obj;
-use dupin_core::phex::{PhexConfig, PhexGoals, PhexPipeline, TriangulationMethod};
+use dupin_core::phex::{PhexConfig, PhexError, PhexGoals, PhexPipeline, TriangulationMethod};
 use dupin_core::scenes::{PHEX_SCENES, phex_scene};
 use dupin_core::surface::parse_assignment;
 use dupin_core::surface::{MeshFitOptions, MeshSurface, NurbsSurface, fit_mesh_surface};
@@ -52,6 +52,16 @@ pub struct PhexArgs {
     /// while its triangulation is built.
     #[arg(long)]
     pub max_faces: Option<usize>,
+    /// Extension: panel --input, a NURBS design reshaped from ORIGINAL (a NURBS JSON with the
+    /// same knots, degrees and net: only control points moved), by following ORIGINAL's
+    /// panels, as the page does when a control point is dragged: ORIGINAL is panelled with the
+    /// same options, its hexagons moved with the reshaped surface and optimised again, in steps
+    /// of at most a hexagon edge of control-point travel. A new run on a reshaped design can
+    /// fold hexagons where the move bent the parameter lines away from conjugate. Where
+    /// ORIGINAL's panels cannot be followed (its run ends with invalid faces), --input is
+    /// panelled afresh, with a note.
+    #[arg(long, value_name = "ORIGINAL", requires = "input")]
+    pub follow: Option<PathBuf>,
     /// Print the scene names, one a line.
     #[arg(long)]
     pub list_scenes: bool,
@@ -127,32 +137,28 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
             ));
         }
     };
-    if let Some(m) = method {
-        config.method = m;
-    }
-    if let Some(h) = args.size {
-        config.size = Some(h);
-    }
-    if let Some(n) = args.iterations {
-        config.iterations = n;
-    }
-    if args.no_optimize {
-        config.optimize = false;
-    }
-    if let Some(deg) = args.field_angle {
-        if !(deg.is_finite() && deg.abs() <= 90.0) {
-            return Err(CliError::Input(format!(
-                "--field-angle {deg}: use degrees in [-90, 90]"
-            )));
+    apply_options(&args, &mut config)?;
+    // The design before the change, panelled with the same options, to follow from.
+    let original = match &args.follow {
+        None => None,
+        Some(path) => {
+            let name = path.display().to_string();
+            if fitted.is_some() {
+                return Err(CliError::Input(
+                    "--follow applies to a NURBS design (.json), not to a fitted mesh".into(),
+                ));
+            }
+            let (surface, mesh) = read_design_surface(path)?;
+            if mesh.is_some() {
+                return Err(CliError::Input(format!(
+                    "--follow {name}: the original must be a NURBS design (.json), not a mesh"
+                )));
+            }
+            let mut first = PhexConfig::for_nurbs(&name, surface, None);
+            apply_options(&args, &mut first)?;
+            Some((name, first))
         }
-        config.field_angle = Some(deg.to_radians());
-    }
-    if args.no_boundary_faces {
-        config.boundary_faces = false;
-    }
-    if let Some(n) = args.max_faces {
-        config.max_faces = n;
-    }
+    };
     let label = args
         .scene
         .clone()
@@ -163,9 +169,23 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
     // invalid ones).
     let goals = PhexGoals::of(&config, expect_valid);
     let start = std::time::Instant::now();
-    let r = PhexPipeline::new(config)
-        .and_then(Stepper::finish)
-        .map_err(|e| CliError::input("", e))?;
+    // With --follow: whether it followed, or why not.
+    let mut followed: Option<Result<(), String>> = None;
+    let mut pipeline = None;
+    if let Some((name, first)) = original {
+        match following_run(&name, first, &config)? {
+            Ok(p) => {
+                pipeline = Some(p);
+                followed = Some(Ok(()));
+            }
+            Err(why) => followed = Some(Err(why)),
+        }
+    }
+    let pipeline = match pipeline {
+        Some(p) => p,
+        None => PhexPipeline::new(config).map_err(|e| CliError::input("", e))?,
+    };
+    let r = pipeline.finish().map_err(|e| CliError::input("", e))?;
     let seconds = start.elapsed().as_secs_f64();
     write_text(&out, &write_obj(&r.mesh))?;
     let rep = &r.report;
@@ -198,6 +218,12 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
     if let Some(u) = unit {
         report["unit"] = json!(u.name());
     }
+    if let Some(f) = &followed {
+        report["followed"] = json!(f.is_ok());
+        if let Err(why) = f {
+            report["follow_note"] = json!(why);
+        }
+    }
     if let Some(f) = &fitted {
         // How far the fitted surface is from the mesh, and the panels from the mesh itself.
         let far = r
@@ -226,6 +252,67 @@ pub fn run(args: PhexArgs) -> Result<(), CliError> {
     match reason {
         Some(r) => Err(CliError::Unmet(r)),
         None => Ok(()),
+    }
+}
+
+/// The options of the command line on `config` (they apply to --input and --follow alike).
+fn apply_options(args: &PhexArgs, config: &mut PhexConfig) -> Result<(), CliError> {
+    if let Some(m) = args.method {
+        config.method = m;
+    }
+    if let Some(h) = args.size {
+        config.size = Some(h);
+    }
+    if let Some(n) = args.iterations {
+        config.iterations = n;
+    }
+    if args.no_optimize {
+        config.optimize = false;
+    }
+    if let Some(deg) = args.field_angle {
+        if !(deg.is_finite() && deg.abs() <= 90.0) {
+            return Err(CliError::Input(format!(
+                "--field-angle {deg}: use degrees in [-90, 90]"
+            )));
+        }
+        config.field_angle = Some(deg.to_radians());
+    }
+    if args.no_boundary_faces {
+        config.boundary_faces = false;
+    }
+    if let Some(n) = args.max_faces {
+        config.max_faces = n;
+    }
+    Ok(())
+}
+
+/// `--follow`: the run of `first` (the design before the change, file `name`) to its end, then
+/// followed onto the reshaped surface of `config` (`PhexPipeline::follow_in_steps`). Ok(Err)
+/// with the reason, also printed as a note, when the original's panels cannot be followed (the
+/// reshaped design is then panelled afresh); Err when the two designs do not match or the
+/// original cannot be panelled.
+fn following_run(
+    name: &str,
+    first: PhexConfig,
+    config: &PhexConfig,
+) -> Result<Result<PhexPipeline, String>, CliError> {
+    let Some(reshaped) = config.nurbs.as_deref() else {
+        return Err(CliError::Input(
+            "--follow applies to a NURBS design (.json) given with --input".into(),
+        ));
+    };
+    let mut original = PhexPipeline::new(first).map_err(|e| CliError::input(name, e))?;
+    original
+        .run_to_end()
+        .map_err(|e| CliError::input(name, e))?;
+    match original.follow_in_steps(reshaped.clone()) {
+        Ok(p) => Ok(Ok(p)),
+        Err(PhexError::NotFollowed(why)) => {
+            let why = format!("{name}: {why}; the design is panelled afresh");
+            eprintln!("note: {why}");
+            Ok(Err(why))
+        }
+        Err(e) => Err(CliError::input(&format!("--follow {name}"), e)),
     }
 }
 

@@ -308,3 +308,100 @@ fn input_fits_and_panels_a_cylinder_mesh() {
     );
     let _ = std::fs::remove_file(design);
 }
+
+/// The 20 x 15 m translational roof with control point (6, 4) raised by `dz` metres, as the
+/// documented JSON.
+fn roof_json(dz: f64) -> String {
+    use dupin_core::surface::NurbsSurface;
+    let mut roof =
+        NurbsSurface::try_from(dupin_core::scenes::benchmark_meshes::nurbs_roof()).unwrap();
+    let nv = roof.control_net_size().1;
+    let [x, y, z] = roof.control_points()[6 * nv + 4];
+    roof.set_control_point(6 * nv + 4, [x, y, z + dz].into())
+        .unwrap();
+    roof.to_json()
+}
+
+/// `--follow ORIGINAL`: a reshaped design panelled afresh folds hexagons where the move bent
+/// the parameter lines away from conjugate (exit 3); following the original's panels gives
+/// planar, simple ones (exit 0), as the page's control-point drag does.
+#[test]
+fn follow_panels_a_reshaped_design_from_the_original() {
+    let (original, reshaped) = (tmp("roof-original.json"), tmp("roof-raised.json"));
+    std::fs::write(&original, roof_json(0.0)).unwrap();
+    std::fs::write(&reshaped, roof_json(0.3)).unwrap();
+    let (original, reshaped) = (original.to_str().unwrap(), reshaped.to_str().unwrap());
+    let fresh = run_reported(
+        "roof-fresh",
+        &["phex", "--input", reshaped, "--size", "0.8"],
+    );
+    let fresh = fresh.unmet();
+    assert!(fresh["invalid_faces"].as_u64().unwrap() > 0, "{fresh}");
+    assert!(fresh.get("followed").is_none());
+    let run = run_reported(
+        "roof-followed",
+        &[
+            "phex", "--input", reshaped, "--follow", original, "--size", "0.8",
+        ],
+    );
+    let r = run.ok();
+    assert_eq!(r["followed"], true);
+    assert_eq!(r["invalid_faces"], 0, "{r}");
+    assert!(r["max_planarity"].as_f64().unwrap() <= 1e-10, "{r}");
+    assert_eq!(r["faces"], fresh["faces"]);
+    // The panels lie on the reshaped roof, not the original: within 1% of the diagonal.
+    assert!(
+        r["max_surface_distance"].as_f64().unwrap() <= 0.01 * r["bbox_diagonal"].as_f64().unwrap(),
+        "{r}"
+    );
+    // An original whose own panels fold cannot be followed: said, then panelled afresh.
+    let unfollowed = run_reported(
+        "roof-unfollowed",
+        &[
+            "phex", "--input", original, "--follow", reshaped, "--size", "0.8",
+        ],
+    );
+    let u = unfollowed.ok();
+    assert_eq!(u["followed"], false);
+    assert!(
+        u["follow_note"]
+            .as_str()
+            .unwrap()
+            .contains("self-intersecting faces; the design is panelled afresh"),
+        "{u}"
+    );
+    assert!(
+        unfollowed.stderr().starts_with("note: "),
+        "{}",
+        unfollowed.stderr()
+    );
+    // A design with another net is no reshape of the original; --follow needs --input.
+    let dome = tmp("follow-dome.json");
+    std::fs::write(&dome, nurbs_dome_json()).unwrap();
+    let out = tmp("follow-bad.obj");
+    let out = out.to_str().unwrap();
+    let (_, err) = refused(&[
+        "phex",
+        "--input",
+        dome.to_str().unwrap(),
+        "--follow",
+        original,
+        "--size",
+        "0.8",
+        "--out",
+        out,
+    ]);
+    assert!(err.contains("only control points move"), "{err}");
+    refused(&[
+        "phex",
+        "--scene",
+        "torus-bound",
+        "--follow",
+        original,
+        "--out",
+        out,
+    ]);
+    for p in [original, reshaped, dome.to_str().unwrap()] {
+        let _ = std::fs::remove_file(p);
+    }
+}

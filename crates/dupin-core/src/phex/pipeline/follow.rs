@@ -53,26 +53,7 @@ impl PhexPipeline {
     /// surface, has no hexagonal mesh yet, or `surface` has other knots, degrees or net size;
     /// [`PhexError::Solver`] when the moved mesh is not finite.
     pub fn follow(&self, surface: NurbsSurface) -> Result<PhexPipeline, PhexError> {
-        let Some(old) = &self.config.nurbs else {
-            return Err(PhexError::BadParameter(
-                "only a run on an imported NURBS surface follows a reshaped surface".into(),
-            ));
-        };
-        let Some(dual) = &self.dual else {
-            return Err(PhexError::BadParameter(
-                "the run has no hexagonal mesh to follow the surface with yet".into(),
-            ));
-        };
-        if old.degrees() != surface.degrees()
-            || old.control_net_size() != surface.control_net_size()
-            || old.domain() != surface.domain()
-        {
-            return Err(PhexError::BadParameter(
-                "a reshaped surface must keep the knots, degrees and net size: only control \
-                 points move"
-                    .into(),
-            ));
-        }
+        let (_, dual) = self.reshapable_to(&surface)?;
         let mut config = self.config.clone();
         config.nurbs = Some(Arc::new(surface));
         let solver = build_surface(&config, &self.frame)?;
@@ -162,16 +143,8 @@ impl PhexPipeline {
     /// Errors: those of [`PhexPipeline::follow`] and of the optimisation steps;
     /// [`PhexError::NotFollowed`] as above.
     pub fn follow_in_steps(&self, surface: NurbsSurface) -> Result<PhexPipeline, PhexError> {
+        let (old, dual) = self.reshapable_to(&surface)?;
         self.followable("the run")?;
-        let Some(old) = self.config.nurbs.as_deref() else {
-            return self.follow(surface);
-        };
-        let Some(dual) = &self.dual else {
-            return self.follow(surface);
-        };
-        if old.control_net_size() != surface.control_net_size() {
-            return self.follow(surface);
-        }
         let (from, to) = (old.control_points(), surface.control_points());
         let largest = from
             .iter()
@@ -202,6 +175,35 @@ impl PhexPipeline {
             current = Some(next);
         }
         current.as_ref().unwrap_or(self).follow(surface)
+    }
+
+    /// This run's NURBS surface and hexagonal mesh when `surface` is a reshape of the surface
+    /// (the same degrees, domain and net size); [`PhexPipeline::follow`]'s errors otherwise.
+    fn reshapable_to(
+        &self,
+        surface: &NurbsSurface,
+    ) -> Result<(&NurbsSurface, &super::DualMesh), PhexError> {
+        let Some(old) = self.config.nurbs.as_deref() else {
+            return Err(PhexError::BadParameter(
+                "only a run on an imported NURBS surface follows a reshaped surface".into(),
+            ));
+        };
+        let Some(dual) = &self.dual else {
+            return Err(PhexError::BadParameter(
+                "the run has no hexagonal mesh to follow the surface with yet".into(),
+            ));
+        };
+        if old.degrees() != surface.degrees()
+            || old.control_net_size() != surface.control_net_size()
+            || old.domain() != surface.domain()
+        {
+            return Err(PhexError::BadParameter(
+                "a reshaped surface must keep the knots, degrees and net size: only control \
+                 points move"
+                    .into(),
+            ));
+        }
+        Ok((old, dual))
     }
 
     /// Ok when this run has ended with every face simple and planar to
@@ -320,13 +322,18 @@ mod tests {
             format!("{e}").contains(&format!("the run has {n} self-intersecting faces")),
             "{e}"
         );
-        // An unfinished run neither.
-        let fresh = PhexPipeline::new(PhexConfig::for_nurbs(
+        // An unfinished run neither: one with no hexagons yet, or still optimising.
+        let mut fresh = PhexPipeline::new(PhexConfig::for_nurbs(
             "roof",
             translational_roof_nurbs(),
             Some(0.8),
         ))
         .unwrap();
+        let e = fresh.follow_in_steps(raised(6, 4, 0.1)).err().unwrap();
+        assert!(format!("{e}").contains("no hexagonal mesh"), "{e}");
+        while fresh.metrics().phase != PhexPhase::Optimisation {
+            fresh.step().unwrap();
+        }
         let e = fresh.follow_in_steps(raised(6, 4, 0.1)).err().unwrap();
         assert!(format!("{e}").contains("the run has not ended"), "{e}");
     }
