@@ -52,14 +52,13 @@ export function readHash(hash, { scenes, catalog, torusParams }) {
     c.imported.anchors = [...new Set(anchors)].slice(0, 100000);
     if (h.has('closeness')) c.imported.closeness = num(h.get('closeness'));
     if (h.has('tol')) c.imported.toleranceMm = num(h.get('tol'));
-    // Moved NURBS control points `cp=4:2,2,2.5;0:0,0,-0.5` (index:x,y,z, one entry a point).
-    const seen = new Set();
+    // NURBS control-point moves `cp=4:2,2,2.4;4:2,2,2.5;0:0,0,-0.5` (index:x,y,z, one entry a
+    // move, in order; the session refuses more than it replays).
     for (const e of (h.get('cp') ?? '').split(';').slice(0, 100000)) {
       const m = /^(\d+):([^,]+),([^,]+),([^,]+)$/.exec(e);
       const xyz = m ? [m[2], m[3], m[4]].map(Number) : [];
       const i = m ? Number(m[1]) : -1;
-      if (m && i < 2 ** 31 && !seen.has(i) && xyz.every(Number.isFinite)) {
-        seen.add(i);
+      if (m && i < 2 ** 31 && xyz.every(Number.isFinite)) {
         c.imported.controlPoints.push([i, ...xyz]);
       }
     }

@@ -317,7 +317,7 @@ function applyState(s) {
   setProp($('edit-vertices'), 'textContent', net.available ? 'Drag control points' : 'Drag vertices');
   if (!canEdit && editMode) setEditMode(false);
   dragStateArrived(m.phase);
-  netStateArrived();
+  netStateArrived(s.dragSeq, m.phase);
   if (playing) requestAnimationFrame(() => solver.post('ack'));
 }
 
@@ -768,11 +768,15 @@ function dragEnd() {
 
 // ---- dragging a control point of an opened NURBS surface (edit mode) -------------------------
 // A press near a control point of the drawn net picks it; moving the pointer drags it in the
-// plane through it facing the view. The worker reshapes the surface and the panelling follows
-// it (Session.moveControlPoint: the hexagons moved with the surface, then optimised), stepping
-// it while the pointer moves, one state in flight. On release
-// the point is committed to the URL (`cp`), so Undo gives back the surface before it.
-let netDrag = null; // { id, x, y, index, point, direction, inFlight, sent }
+// plane through it facing the view. Each position sent is a move (Session.moveControlPoint):
+// the worker reshapes the surface and the panelling shown follows it (the hexagons moved with
+// the surface, then optimised), stepping it state by state. The next pointer position goes once
+// that run has ended (the latest position wins), so every position starts from a finished run,
+// and a drag is a function of its positions: on release they are committed to the URL (`cp`,
+// one entry a move), a reload or Undo replays them bit for bit, and the release costs one short
+// move rather than the whole drag again.
+let netDrag = null; // { id, x, y, index, point, direction, inFlight, sent, seq, path }
+const MAX_CONTROL_POINT_MOVES = 1000; // import::MAX_CONTROL_POINT_MOVES
 
 function netDragStart(e) {
   const r = canvas.getBoundingClientRect();
@@ -780,33 +784,38 @@ function netDragStart(e) {
   const index = net.pick(x, y, (...p) => viewer.project(...p));
   if (index < 0) return false;
   const { direction } = rayAt(x, y);
-  netDrag = { id: e.pointerId, x, y, index, point: net.point(index), direction, inFlight: false, sent: null };
+  netDrag = { id: e.pointerId, x, y, index, point: net.point(index), direction, inFlight: false, sent: null, seq: null, path: [] };
   net.active = index;
   userMoved = true; // the view stays put while the panelling follows
   dirty = true;
   return true;
 }
 
-// While dragging, the panelling shown follows each position in one step (`live`,
-// Session.dragControlPoint); the release sends the last position once more, not live
-// (Session.moveControlPoint: the panelling of the design as opened follows it, the run a reload
-// of the URL gives).
+/** Sends the pointer's position as the next move once the run for the last one has ended; the
+ * release's goes at once (the worker runs the last one to its end first, Session.moveControlPoint). */
 function sendReshape(d = netDrag, release = false) {
   if (!d || (d.inFlight && !release)) return;
+  if (config.imported.controlPoints.length + d.path.length >= MAX_CONTROL_POINT_MOVES) {
+    reportError(`this design has ${MAX_CONTROL_POINT_MOVES} control-point moves, the most a reload replays; Undo frees some`, 'edit-vertices');
+    return;
+  }
   let q;
   try { q = dragPoint(d); } catch { q = null; }
-  const same = q && d.sent && q.every((c, k) => c === d.sent[k]);
-  if (release && !q) q = d.sent;
-  if (!q || (same && !release)) return;
+  if (!q || (d.sent && q.every((c, k) => c === d.sent[k]))) return;
+  const p = net.toDesign(q);
   d.inFlight = true;
   d.sent = q;
-  postNumbered('reshape', { index: d.index, point: net.toDesign(q), live: !release });
+  d.path.push(p);
+  postNumbered('reshape', { index: d.index, point: p });
+  d.seq = dragSeq;
   net.place(d.index, q);
   dirty = true;
 }
 
-function netStateArrived() {
-  if (!netDrag) return;
+/** A state arrived with `phase`: once the run for the last position sent has ended, the next
+ * may go. */
+function netStateArrived(seq, phase) {
+  if (!netDrag || seq !== netDrag.seq || !['done', 'warning'].includes(phase)) return;
   netDrag.inFlight = false;
   sendReshape();
 }
@@ -817,12 +826,9 @@ function netDragEnd() {
   net.active = -1;
   dirty = true;
   if (!d) return;
-  // The last position goes even if a state is still in flight (the worker takes them in order),
-  // and even if it was sent live.
   sendReshape(d, true);
-  if (!d.sent) return;
-  const moves = config.imported.controlPoints.filter(([i]) => i !== d.index);
-  config.imported.controlPoints = [...moves, [d.index, ...net.toDesign(d.sent)]];
+  if (!d.path.length) return;
+  config.imported.controlPoints = [...config.imported.controlPoints, ...d.path.map((p) => [d.index, ...p])];
   welcome = false;
   syncHash();
 }

@@ -5,8 +5,8 @@
 //        | step | play | pause | ack | mode {mode} | resync (the next state's mesh is whole)
 //        | drag {vertex, point, group?, start} (Session.dragVertices; start: a new drag)
 //        | select {viewProj, rect} (Session.verticesInRect: a box selection)
-//        | reshape {index, point, live} (a dragged NURBS control point: Session.dragControlPoint
-//          while dragging, Session.moveControlPoint on release)
+//        | reshape {index, point} (a dragged NURBS control point's next position:
+//          Session.moveControlPoint)
 //        | layers {layers} (offset/support, Session.setLayers) | export {kind, panelEdge} (obj, json, svg, dxf, csv, glb, 3dm)
 //        | pick {origin, direction, panels} (a view ray; panels: Session.pickPanelVertex)
 //        | fault {kind} (debugFault: a deliberate trap or out-of-memory, for recovery tests)
@@ -221,13 +221,13 @@ const handlers = {
       postMessage({ type: 'pick', gen, panels: !!msg.panels, drag: !!msg.drag, pick });
     } catch (e) { postMessage({ type: 'pick', gen, drag: !!msg.drag, error: e?.message ?? String(e) }); }
   },
-  // A dragged NURBS control point: the surface is reshaped and the panelling follows it, its
-  // steps counted from there (a reload replays that many on the reshaped surface).
+  // A dragged NURBS control point's next position: the run shown is run to its end if it has
+  // not ended, the surface reshaped and the panelling follows it, its steps counted from there
+  // (a reload replays the moves, then that many steps).
   reshape(msg) {
     if (!session) return;
     try {
-      const reshape = msg.live ? session.dragControlPoint : session.moveControlPoint;
-      reshape.call(session, msg.index, msg.point[0], msg.point[1], msg.point[2]);
+      session.moveControlPoint(msg.index, msg.point[0], msg.point[1], msg.point[2]);
       dragSeq = msg.seq ?? null;
     } catch (e) {
       if (e instanceof WebAssembly.RuntimeError) { fail(e); return; }

@@ -8,8 +8,10 @@
 // (solver, metrics, render buffers), its steps' time as `session.step()` measures it (solver and
 // metrics, `ms`), and the wall time from Play to `done` (every state also drawn and posted).
 // Then `reshapes` control-point drags (default 0): control point (6, 4) 8 px up, then back, in
-// 5 pointer moves 40 ms apart; per drag the worker's time over the run the release leaves (the
+// `moves` pointer moves (default 5) `gap` ms apart (default 40); per drag the positions the
+// panelling followed (the hash's moves), the worker's time over the run the release leaves (the
 // states of the last position sent) and the wall time from the release to its `done`.
+//   DUPIN_URL=... node tests/e2e/bench-import.mjs 1 2 20 100   (a slow drag: 2 s)
 import { byId, onScreen, openPage, waitDone } from './harness.mjs';
 
 /** Control point (i, j) of the roof's net. */
@@ -71,6 +73,8 @@ try {
     console.log(JSON.stringify({ run: r + 1, ...r0, invalidFaces: m.invalidFaces, phase: m.phase }));
   }
   const reshapes = Number(process.argv[3] ?? 0);
+  const moves = Number(process.argv[4] ?? 5);
+  const gap = Number(process.argv[5] ?? 40);
   if (reshapes > 0) {
     await byId(page, 'edit-vertices').click();
     await byId(page, 'control-net').waitFor({ state: 'visible', timeout: 5000 });
@@ -84,9 +88,9 @@ try {
     });
     await page.mouse.move(x0, from);
     await page.mouse.down();
-    for (let i = 1; i <= 5; i++) {
-      await page.mouse.move(x0, from + ((to - from) * i) / 5);
-      await page.waitForTimeout(40);
+    for (let i = 1; i <= moves; i++) {
+      await page.mouse.move(x0, from + ((to - from) * i) / moves);
+      await page.waitForTimeout(gap);
     }
     await page.mouse.up();
     await page.waitForFunction(() => window.__up !== null && !window.dupin.dragPending && ['done', 'warning'].includes(document.querySelector('[data-testid=metrics]').dataset.phase), null, { timeout: 120_000 });
@@ -102,7 +106,7 @@ try {
         phase: last.phase,
         faces: last.faces,
         maxPlanarity: last.maxPlanarity,
-        cp: new URLSearchParams(location.hash.slice(1)).get('cp'),
+        followed: new URLSearchParams(location.hash.slice(1)).get('cp').split(';').length,
       };
     });
     console.log(JSON.stringify({ reshape: r + 1, ...d }));

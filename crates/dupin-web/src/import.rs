@@ -48,21 +48,18 @@ struct ImportConfig {
     closeness: Option<f64>,
     /// Panels: the largest distance of a panel corner from its plane, in millimetres.
     tolerance_mm: Option<f64>,
-    /// NURBS surface: moved control points, `[index, x, y, z]` each (index row-major,
-    /// `i * nv + j`; coordinates in the file's unit), applied in order.
+    /// NURBS surface: control-point moves, `[index, x, y, z]` each (index row-major,
+    /// `i * nv + j`; coordinates in the file's unit), applied and followed in order (a point
+    /// may move more than once: a drag is the positions the panelling followed).
     control_points: Option<Vec<[f64; 4]>>,
 }
 
 impl ImportConfig {
-    /// Moves control point `index` to `p` in these options: the entry for `index` is
-    /// replaced (or added), so a drag leaves one entry per point however long it ran.
+    /// Moves control point `index` to `p` in these options: one more move after those before
+    /// (the panelling follows each in turn, [`following_run`]).
     fn move_control_point(&mut self, index: usize, p: [f64; 3]) {
-        let moves = self.control_points.get_or_insert_with(Vec::new);
         let entry = [index as f64, p[0], p[1], p[2]];
-        match moves.iter_mut().find(|m| m[0] == index as f64) {
-            Some(m) => *m = entry,
-            None => moves.push(entry),
-        }
+        self.control_points.get_or_insert_with(Vec::new).push(entry);
     }
 }
 
@@ -206,127 +203,126 @@ pub(crate) fn import_run(
         serde_wasm_bindgen::from_value(config)
             .map_err(|e| JsError::new(&format!("bad import config: {e}")))?
     };
-    let mut start = None;
-    let (run, info) = import_design_from(name, bytes, &cfg, &mut FollowFrom::Opened(&mut start))
-        .map_err(|e| JsError::new(&e))?;
+    let (run, info) = import_design_from(name, bytes, &cfg, None).map_err(|e| JsError::new(&e))?;
     let source = info.control_net.is_some().then(|| NurbsSource {
         name: name.to_string(),
         bytes: bytes.to_vec(),
         cfg,
-        start,
     });
     Ok((run, info, source))
 }
 
-/// An opened NURBS surface as it was read: the file and its options, the moved control points
+/// An opened NURBS surface as it was read: the file and its options, the control-point moves
 /// among them. Moving a point reads the design again with one more move, so a drag ends on
 /// exactly the run a reload of the same options gives (see [`following_run`]).
 pub(crate) struct NurbsSource {
     name: String,
     bytes: Vec<u8>,
     cfg: ImportConfig,
-    /// The finished run on the design as opened, kept for the next move ([`FollowStart`]).
-    start: FollowStart,
 }
 
-/// A finished P-Hex run on a design as opened (no control point moved) and its configuration:
-/// every reshaped design follows from it ([`following_run`]).
-pub(crate) type FollowStart = Option<(PhexConfig, Box<PhexPipeline>)>;
+/// The most control-point moves a design replays. Each move is followed from the run before it
+/// to that run's end (a Gauss-Newton optimisation of the whole mesh: up to a second or two
+/// for 10k panels in the page), so a reload costs that many optimisations; more are refused.
+pub(crate) const MAX_CONTROL_POINT_MOVES: usize = 1000;
 
-/// Where a reshaped design's panelling follows from ([`following_run`]).
-pub(crate) enum FollowFrom<'a> {
-    /// The finished run on the design as opened (kept here once computed): the run a reload
-    /// of the same control points gives.
-    Opened(&'a mut FollowStart),
-    /// The run shown, in one step: a pointer position of a drag, cheap and close to the last
-    /// one, but depending on the drag's path (the release then moves the point with
-    /// [`FollowFrom::Opened`]). A run with no hexagons yet follows as `Opened` would.
-    Current(&'a PhexPipeline),
-}
-
-/// The P-Hex run on a design whose control points moved (`config`, its surface reshaped from
-/// `opened`): the finished run on the design as opened, followed to the reshaped one in steps
-/// ([`PhexPipeline::follow_in_steps`]), or during a drag the run shown followed in one step
-/// ([`FollowFrom`]). A new run on the reshaped surface would triangulate
-/// along parameter lines the move bent away from conjugate and come out with self-intersecting
-/// hexagons near the point (section 5.2; measured in `dupin_core::phex::pipeline::follow`).
-/// The result depends only on the file, its options and the final net, so a drag and a reload
-/// of the same `controlPoints` give the same panels. The finished start is kept in `start` and
-/// reused while its configuration is the same. Where the design as opened gives no hexagonal
-/// mesh, or following fails, the run is a new one on the reshaped surface.
+/// The P-Hex run on a design whose control points moved (`config`, its surface `opened` with
+/// `moves` applied). A new run on a reshaped surface would triangulate along parameter lines
+/// the move bent away from conjugate and come out with self-intersecting hexagons near the
+/// point (section 5.2; measured in `dupin_core::phex::pipeline::follow`), so the panelling
+/// follows the moves instead, one at a time: the finished run before each move is followed to
+/// it ([`PhexPipeline::follow_in_steps`]) and run to its end before the next one. The last
+/// move's run is returned before its first step.
+///
+/// A drag is recorded as the pointer positions the panelling followed (a move each), so the
+/// result depends only on the file, its options and the moves: a drag and a reload of the same
+/// `controlPoints` give the same panels bit for bit, and the release costs one short move, not
+/// the whole drag again. Where a run before a move gives no panels to follow (no hexagonal
+/// mesh, invalid panels: [`PhexError::NotFollowed`](dupin_core::phex::PhexError)), the move
+/// takes a new run on its surface.
+///
+/// `previous`: the run for every move but the last (the run shown during a drag), which is run
+/// to its end if it has not ended and followed to the last move: the same run as following
+/// every move from the design as opened (`None`), for one optimisation instead of one a move.
 fn following_run(
     config: PhexConfig,
     opened: NurbsSurface,
-    start: &mut FollowFrom,
+    moves: &[[f64; 4]],
+    previous: Option<&mut PhexPipeline>,
 ) -> Result<PhexPipeline, String> {
-    if let (FollowFrom::Current(current), Some(reshaped)) = (&*start, config.nurbs.as_deref()) {
-        // A pointer position of a drag: one step from the hexagons shown.
-        if let Ok(p) = current.follow(reshaped.clone()) {
+    if previous.is_some() {
+        return follow_move(previous, config);
+    }
+    let mut surface = opened;
+    let mut run = {
+        let mut first = config.clone();
+        first.nurbs = Some(Arc::new(surface.clone()));
+        PhexPipeline::new(first).ok()
+    };
+    for &[index, x, y, z] in moves {
+        surface
+            .set_control_point(index as usize, dupin_core::Vec3::new(x, y, z))
+            .map_err(|e| format!("controlPoints: {e}"))?;
+        let mut next = config.clone();
+        next.nurbs = Some(Arc::new(surface.clone()));
+        run = Some(follow_move(run.as_mut(), next)?);
+    }
+    run.map_or_else(|| PhexPipeline::new(config).map_err(|e| format!("{e}")), Ok)
+}
+
+/// One move of [`following_run`]: `previous` (the run before the move) run to its end and
+/// followed to `config`'s surface, or a new run there when it gives nothing to follow.
+fn follow_move(
+    previous: Option<&mut PhexPipeline>,
+    config: PhexConfig,
+) -> Result<PhexPipeline, String> {
+    if let (Some(previous), Some(surface)) = (previous, config.nurbs.as_deref()) {
+        // A step that fails leaves the run unfinished, and following refuses it below.
+        let _ = previous.run_to_end();
+        if let Ok(p) = previous.follow_in_steps(surface.clone()) {
             return Ok(p);
         }
     }
-    let start = match start {
-        FollowFrom::Opened(kept) => kept,
-        FollowFrom::Current(_) => &mut None,
-    };
-    let mut first = config.clone();
-    first.nurbs = Some(Arc::new(opened));
-    if !matches!(start, Some((c, _)) if *c == first) {
-        *start = None;
-        let mut p = PhexPipeline::new(first.clone()).map_err(|e| format!("{e}"))?;
-        if p.run_to_end().is_ok() {
-            *start = Some((first, Box::new(p)));
-        }
-    }
-    let followed = match (start.as_ref(), config.nurbs.as_deref()) {
-        (Some((_, p)), Some(reshaped)) => p.follow_in_steps(reshaped.clone()).ok(),
-        _ => None,
-    };
-    match followed {
-        Some(p) => Ok(p),
-        None => PhexPipeline::new(config).map_err(|e| format!("{e}")),
-    }
+    PhexPipeline::new(config).map_err(|e| format!("{e}"))
 }
 
 impl NurbsSource {
-    /// The run and design with control point `index` at `p` (file unit); the source keeps the
-    /// move only when it succeeds. The panelling follows from the design as opened, or for a
-    /// pointer position of a drag from `current`, the run shown, in one step ([`FollowFrom`]).
+    /// The run and design with control point `index` moved to `p` (file unit), one more move
+    /// after those before; the source keeps the move only when it succeeds. The panelling
+    /// follows from `previous`, the run for the moves before (the run shown), else from the
+    /// design as opened through every move ([`following_run`]).
     pub(crate) fn move_control_point(
         &mut self,
         index: usize,
         p: [f64; 3],
-        current: Option<&PhexPipeline>,
+        previous: Option<&mut PhexPipeline>,
     ) -> Result<(Imported, DesignInfo), String> {
         let mut cfg = self.cfg.clone();
         cfg.move_control_point(index, p);
-        let mut from = match current {
-            Some(c) => FollowFrom::Current(c),
-            None => FollowFrom::Opened(&mut self.start),
-        };
-        let out = import_design_from(&self.name, &self.bytes, &cfg, &mut from)?;
+        let out = import_design_from(&self.name, &self.bytes, &cfg, previous)?;
         self.cfg = cfg;
         Ok(out)
     }
 }
 
-/// [`import_design_from`] with no finished run kept.
+/// [`import_design_from`] of a design as read (every move followed from the design as opened).
 #[cfg(test)]
 fn import_design(
     name: &str,
     bytes: &[u8],
     cfg: &ImportConfig,
 ) -> Result<(Imported, DesignInfo), String> {
-    import_design_from(name, bytes, cfg, &mut FollowFrom::Opened(&mut None))
+    import_design_from(name, bytes, cfg, None)
 }
 
-/// [`import_run`] after its options are read (plain Rust, tested natively), with the finished
-/// run a reshaped NURBS design follows from, if one was kept ([`following_run`]).
+/// [`import_run`] after its options are read (plain Rust, tested natively); for a NURBS design
+/// with moved control points, `previous` is the run for every move but the last, if the caller
+/// has it ([`following_run`]).
 fn import_design_from(
     name: &str,
     bytes: &[u8],
     cfg: &ImportConfig,
-    start: &mut FollowFrom,
+    previous: Option<&mut PhexPipeline>,
 ) -> Result<(Imported, DesignInfo), String> {
     let named = |e: &dyn std::fmt::Display| format!("{name}: {e}");
     let wanted = match cfg.import_as.as_deref() {
@@ -367,6 +363,13 @@ fn import_design_from(
         let mut s = NurbsSurface::from_json(text).map_err(|e| named(&e))?;
         if cfg.control_points.as_ref().is_some_and(|m| !m.is_empty()) {
             opened = Some(s.clone());
+        }
+        let moves = cfg.control_points.as_ref().map_or(0, Vec::len);
+        if moves > MAX_CONTROL_POINT_MOVES {
+            return Err(named(&format_args!(
+                "controlPoints: {moves} moves; a design replays at most \
+                 {MAX_CONTROL_POINT_MOVES} (each is followed by an optimisation of the panels)"
+            )));
         }
         for &[index, x, y, z] in cfg.control_points.iter().flatten() {
             if !(index >= 0.0 && index.fract() == 0.0 && index < u32::MAX as f64) {
@@ -469,7 +472,10 @@ fn import_design_from(
             )?;
             let goals = PhexGoals::of(&config, true);
             let pipeline = match opened {
-                Some(opened) => following_run(config, opened, start).map_err(|e| named(&e))?,
+                Some(opened) => {
+                    let moves = cfg.control_points.as_deref().unwrap_or_default();
+                    following_run(config, opened, moves, previous).map_err(|e| named(&e))?
+                }
                 None => PhexPipeline::new(config).map_err(|e| named(&e))?,
             };
             Imported::Phex(Box::new(pipeline), goals)
@@ -711,10 +717,11 @@ mod tests {
         assert!(refused("a.obj", b"", &as_what).contains("use `surface` or `panels`"));
     }
 
-    /// A control point of the translational roof dragged up 0.3 m in four pointer positions:
-    /// the panelling shown follows each with planar, simple hexagons, so does the release's
-    /// (a new run on that surface has self-intersecting ones), and a reload of the same move
-    /// gives the release's panels bit for bit.
+    /// A control point of the translational roof dragged up 0.3 m in four pointer positions,
+    /// each followed from the run before it (the run shown): every position ends with planar,
+    /// simple hexagons (a new run on the last surface has self-intersecting ones), the drag is
+    /// four moves, and a reload of them replays the panels bit for bit, whether the run shown
+    /// had ended before the next move or not.
     #[test]
     fn a_dragged_roof_point_is_followed_to_planar_simple_panels() {
         use dupin_core::phex::count_invalid_faces;
@@ -725,51 +732,43 @@ mod tests {
             name: "roof.json".into(),
             bytes: roof.as_bytes().to_vec(),
             cfg: ImportConfig::default(),
-            start: None,
         };
         let index = 6 * 9 + 4;
         let [x, y, z] = NurbsSurface::from_json(&roof).unwrap().control_points()[index];
-        // Pointer positions follow the run shown, each to its end ...
         let (mut shown, _) = import_design("roof.json", roof.as_bytes(), &source.cfg).unwrap();
-        for dz in [0.05, 0.1, 0.2, 0.3] {
+        for (k, dz) in [0.05, 0.1, 0.2, 0.3].into_iter().enumerate() {
             let Imported::Phex(current, _) = &mut shown else {
                 panic!("a P-Hex run");
             };
-            current.run_to_end().unwrap();
+            // The page waits for the end; an API caller may move on at once.
+            if k % 2 == 0 {
+                current.run_to_end().unwrap();
+                assert_eq!(count_invalid_faces(&current.mesh()), 0, "position {k}");
+                assert!(dupin_core::mesh::max_planarity(&current.mesh()) <= 1e-9);
+            }
             (shown, _) = source
                 .move_control_point(index, [x, y, z + dz], Some(current))
                 .unwrap();
-            let Imported::Phex(live, _) = &shown else {
+            let Imported::Phex(next, _) = &shown else {
                 panic!("a P-Hex run");
             };
             assert_eq!(
-                live.metrics().phase,
+                next.metrics().phase,
                 dupin_core::phex::PhexPhase::Optimisation
             );
         }
-        let Imported::Phex(mut live, _) = shown else {
+        let Imported::Phex(mut dragged, _) = shown else {
             panic!("a P-Hex run");
         };
-        live.run_to_end().unwrap();
-        assert_eq!(count_invalid_faces(&live.mesh()), 0);
-        assert!(dupin_core::mesh::max_planarity(&live.mesh()) <= 1e-9);
-        // ... and the release follows from the design as opened.
-        let (released, _) = source
-            .move_control_point(index, [x, y, z + 0.3], None)
-            .unwrap();
-        let Imported::Phex(mut dragged, _) = released else {
-            panic!("a P-Hex run");
-        };
-        assert_eq!(
-            dragged.metrics().phase,
-            dupin_core::phex::PhexPhase::Optimisation
-        );
         dragged.run_to_end().unwrap();
         let mesh = dragged.mesh();
         assert_eq!(count_invalid_faces(&mesh), 0);
         assert!(dupin_core::mesh::max_planarity(&mesh) <= 1e-9);
+        let moves = source.cfg.control_points.clone().unwrap();
+        assert_eq!(moves.len(), 4);
+        assert_eq!(moves[3], [index as f64, x, y, z + 0.3]);
         let replay = ImportConfig {
-            control_points: Some(vec![[index as f64, x, y, z + 0.3]]),
+            control_points: Some(moves),
             ..ImportConfig::default()
         };
         let (again, _) = import_design("roof.json", roof.as_bytes(), &replay).unwrap();
@@ -789,9 +788,9 @@ mod tests {
     }
 
     /// Moved control points reshape an opened NURBS surface and show in its control net; a
-    /// drag (`NurbsSource::move_control_point`, one entry per point however often it moves)
-    /// gives the run that opening with the same `controlPoints` gives, bit for bit; bad moves
-    /// and moves on a mesh are refused, naming the file, and leave the source as it was.
+    /// drag (`NurbsSource::move_control_point`, a move per position) gives the run that opening
+    /// with the same `controlPoints` gives, bit for bit; bad moves, too many moves and moves on
+    /// a mesh are refused, naming the file, and leave the source as it was.
     #[test]
     fn moved_control_points_reshape_an_opened_surface() {
         let json = r#"{"degree_u": 2, "degree_v": 2, "knots_u": [0, 0, 0, 1, 1, 1],
@@ -803,27 +802,37 @@ mod tests {
             name: "dome.json".into(),
             bytes: json.as_bytes().to_vec(),
             cfg: ImportConfig::default(),
-            start: None,
         };
         let (_, first) =
             import_design("dome.json", json.as_bytes(), &ImportConfig::default()).unwrap();
         let net = first.control_net.clone().unwrap();
         assert_eq!((net.nu, net.nv, net.points.len()), (3, 3, 27));
         assert_eq!(&net.points[12..15], &[2.0, 2.0, 1.5]);
-        // A drag of the middle point in three moves, then a corner.
-        for z in [1.7, 1.9, 2.5] {
-            source.move_control_point(4, [2.0, 2.0, z], None).unwrap();
+        // A drag of the middle point in three moves, then a corner, each from the run before.
+        let mut run = None;
+        let mut info = None;
+        for (i, p) in [(4, 1.7), (4, 1.9), (4, 2.5), (0, -0.5)] {
+            let previous = match &mut run {
+                Some(Imported::Phex(p, _)) => Some(p.as_mut()),
+                _ => None,
+            };
+            let point = if i == 4 { [2.0, 2.0, p] } else { [0.0, 0.0, p] };
+            let (r, d) = source.move_control_point(i, point, previous).unwrap();
+            (run, info) = (Some(r), Some(d));
         }
-        let (run, info) = source
-            .move_control_point(0, [0.0, 0.0, -0.5], None)
-            .unwrap();
-        assert_eq!(source.cfg.control_points.as_ref().unwrap().len(), 2);
+        let (run, info) = (run.unwrap(), info.unwrap());
+        assert_eq!(source.cfg.control_points.as_ref().unwrap().len(), 4);
         let net = info.control_net.unwrap();
         assert_eq!(&net.points[12..15], &[2.0, 2.0, 2.5]);
         assert_eq!(&net.points[0..3], &[0.0, 0.0, -0.5]);
         assert!(info.dimensions_m[2] > first.dimensions_m[2]);
         let replay = ImportConfig {
-            control_points: Some(vec![[4.0, 2.0, 2.0, 2.5], [0.0, 0.0, 0.0, -0.5]]),
+            control_points: Some(vec![
+                [4.0, 2.0, 2.0, 1.7],
+                [4.0, 2.0, 2.0, 1.9],
+                [4.0, 2.0, 2.0, 2.5],
+                [0.0, 0.0, 0.0, -0.5],
+            ]),
             ..ImportConfig::default()
         };
         let (again, _) = import_design("dome.json", json.as_bytes(), &replay).unwrap();
@@ -852,6 +861,32 @@ mod tests {
         };
         let e = refused("dome.json", json.as_bytes(), &fractional);
         assert!(e.contains("1.5 is not a control point index"), "{e}");
+        let too_many = ImportConfig {
+            control_points: Some(vec![[4.0, 2.0, 2.0, 1.5]; MAX_CONTROL_POINT_MOVES + 1]),
+            ..ImportConfig::default()
+        };
+        let e = refused("dome.json", json.as_bytes(), &too_many);
+        assert!(
+            e.contains("1001 moves; a design replays at most 1000"),
+            "{e}"
+        );
+        let mut full = NurbsSource {
+            name: "dome.json".into(),
+            bytes: json.as_bytes().to_vec(),
+            cfg: ImportConfig {
+                control_points: Some(vec![[4.0, 2.0, 2.0, 1.5]; MAX_CONTROL_POINT_MOVES]),
+                ..ImportConfig::default()
+            },
+        };
+        let e = full
+            .move_control_point(4, [2.0, 2.0, 1.6], None)
+            .err()
+            .unwrap();
+        assert!(e.contains("a design replays at most 1000"), "{e}");
+        assert_eq!(
+            full.cfg.control_points.unwrap().len(),
+            MAX_CONTROL_POINT_MOVES
+        );
         let e = refused("x.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", &replay);
         assert!(
             e.starts_with("x.obj: controlPoints are for a NURBS surface"),

@@ -456,11 +456,14 @@ impl Session {
     }
 
     /// Moves control point `index` (row-major, `i * nv + j` of the `controlNet` in
-    /// `metrics().design`) of an opened NURBS surface to `(x, y, z)` (the file's unit); the
-    /// P-Hex panelling of the design as opened follows the reshaped surface
-    /// (`import::following_run`), as a page opened with that move in `controlPoints` would (so
-    /// a dragged net replays bit for bit). Throws for a run that is not an opened NURBS
-    /// surface, an index past the net or a point that is not finite, leaving the run as it was.
+    /// `metrics().design`) of an opened NURBS surface to `(x, y, z)` (the file's unit), one
+    /// move after those before: the run shown is run to its end (if it has not ended) and its
+    /// P-Hex panelling follows the reshaped surface (`import::following_run`). The move joins
+    /// `controlPoints`, and a page opened with them replays every move in turn to the same
+    /// panels, bit for bit. A drag moves the point to each pointer position once the run for
+    /// the one before has ended. Throws for a run that is not an opened NURBS surface, an index
+    /// past the net, a point that is not finite or more moves than a design replays (1 000),
+    /// leaving the run as it was.
     #[wasm_bindgen(js_name = moveControlPoint)]
     pub fn move_control_point(
         &mut self,
@@ -470,30 +473,6 @@ impl Session {
         y: f64,
         z: f64,
     ) -> Result<(), JsError> {
-        self.reshape(index, [x, y, z], false)
-    }
-
-    /// [`Session::move_control_point`] for a pointer position of a drag: the panelling shown
-    /// follows in one step, cheap and close to the last position, but depending on the drag's
-    /// path; the release then calls `moveControlPoint` with the final position, whose run a
-    /// reload gives. A run with no hexagons yet follows as `moveControlPoint` does. Throws as
-    /// `moveControlPoint` does.
-    #[wasm_bindgen(js_name = dragControlPoint)]
-    pub fn drag_control_point(
-        &mut self,
-        index: f64,
-        x: f64,
-        y: f64,
-        z: f64,
-    ) -> Result<(), JsError> {
-        self.reshape(index, [x, y, z], true)
-    }
-}
-
-impl Session {
-    /// Control point `index` to `p`, the panelling following from the run shown (`live`) or
-    /// from the design as opened.
-    fn reshape(&mut self, index: f64, p: [f64; 3], live: bool) -> Result<(), JsError> {
         if !(index >= 0.0 && index.fract() == 0.0 && index < u32::MAX as f64) {
             return Err(JsError::new(&format!(
                 "{index} is not a control point index"
@@ -505,17 +484,30 @@ impl Session {
                 "control points are for an opened NURBS surface (open a .json or .3dm surface)",
             ));
         };
-        let current = match &self.run {
-            Run::Phex(current, _) if live => Some(current.as_ref()),
-            _ => None,
+        let previous = match &mut self.run {
+            Run::Phex(current, _) => Some(current.as_mut()),
+            Run::Pq { .. } => None,
         };
         let (imported, design) = source
-            .move_control_point(index, p, current)
+            .move_control_point(index, [x, y, z], previous)
             .map_err(|e| JsError::new(&e))?;
         self.run = imported_run(imported);
         self.shown_is_current = false;
         self.design = Some(design);
         Ok(())
+    }
+
+    /// [`Session::move_control_point`], by the name earlier pages used for a drag's pointer
+    /// positions (a drag's positions are moves like any other).
+    #[wasm_bindgen(js_name = dragControlPoint)]
+    pub fn drag_control_point(
+        &mut self,
+        index: f64,
+        x: f64,
+        y: f64,
+        z: f64,
+    ) -> Result<(), JsError> {
+        self.move_control_point(index, x, y, z)
     }
 }
 
