@@ -530,6 +530,12 @@ impl PhexPipeline {
         &self.config
     }
 
+    /// The planarity optimiser (section 7), once the hexagons exist: its counters say how the
+    /// optimisation went (iterations, factorisations, least moves).
+    pub fn optimiser(&self) -> Option<&PlanarityOptimiser> {
+        self.optimiser.as_ref()
+    }
+
     /// The surface being meshed, in the user's coordinates.
     pub fn surface(&self) -> &dyn Surface {
         match &self.user {

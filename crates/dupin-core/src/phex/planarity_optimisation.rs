@@ -98,10 +98,11 @@ pub struct PlanarityOptions {
     pub near_planar_start: f64,
     /// Least-move steps go on while each leaves `max_planarity` at most this times what it was
     /// (and every face simple); the first that does not hands over to the weighted steps.
-    /// 0.25 by default (as a chord step). A followed design takes 0.5: the roof's moved
-    /// hexagons, planar before, went 7.5e-4 -> 2.9e-4 in their first least move and then
-    /// converged quadratically, where the weighted steps took 4-6 times as long per move to
-    /// the same distance from the surface (`a_drag_is_followed_by_least_moves`).
+    /// 0.25 by default (as a chord step). A followed design takes 0.9 (any real progress): the
+    /// roof's moved hexagons, planar before, had first least moves that divided the largest
+    /// planarity by 1.5 to 2.6 only, then converged quadratically, where the weighted steps
+    /// took 4-6 times as long per move to the same distance from the surface
+    /// (`a_drag_is_followed_by_least_moves`).
     pub least_move_progress: f64,
 }
 

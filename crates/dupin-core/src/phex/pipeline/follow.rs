@@ -31,8 +31,9 @@ use std::sync::Arc;
 const FOLLOW_NEAR_PLANAR: f64 = 1e-1;
 
 /// [`PlanarityOptions::least_move_progress`] for a followed run: moved planar hexagons converge
-/// by least moves even where the first one only halves their planarity (see there).
-const FOLLOW_LEAST_MOVE_PROGRESS: f64 = 0.5;
+/// by least moves even where the first ones divide their largest planarity by 1.5 only (see
+/// there); a least move that gains less than a tenth hands over to the weighted steps.
+const FOLLOW_LEAST_MOVE_PROGRESS: f64 = 0.9;
 
 /// How planar a run (and each step on the way) must have ended for
 /// [`PhexPipeline::follow_in_steps`] to follow from it. Looser than the optimiser's tolerance:
@@ -296,34 +297,59 @@ mod tests {
     }
 
     /// A drag, each position followed from the finished run before it: the moved hexagons,
-    /// planar before, converge by least moves alone. On the 10k roof (size 0.22) the second
-    /// position's first least move only divided the planarity by 2.6: at the chord steps' 1/4
-    /// it handed over to the weighted steps, which took 4-6 times as long per position and
-    /// ended as far from the surface (0.0265 against 0.0262 m at +0.176 m).
+    /// planar before, converge by least moves alone. Measured on the 10k roof (size 0.22):
+    /// straight up, the second position's first least move divided the planarity by 2.6 only;
+    /// on the page's oblique path below, 9.9 then 1.5 and 1.8. Each time quadratic convergence
+    /// followed (to 1e-14 in five least moves), where the weighted steps the optimiser handed
+    /// over to at a 1/4 or 1/2 bar took 4-6 times as long and ended as far from the surface
+    /// (0.0265 against 0.0262 m at +0.176 m).
     #[test]
     fn a_drag_is_followed_by_least_moves() {
         let mut run = finished(translational_roof_nurbs(), 0.22);
         let before = run.report().unwrap().max_surface_distance;
-        for dz in [0.088, 0.176, 0.264] {
-            let mut next = run.follow_in_steps(raised(6, 4, dz)).unwrap();
+        let check = |next: &mut PhexPipeline, what: &str| {
             next.run_to_end().unwrap();
             let mesh = next.mesh();
-            assert_eq!(count_invalid_faces(&mesh), 0, "dz {dz}");
+            assert_eq!(count_invalid_faces(&mesh), 0, "{what}");
             assert!(
                 max_planarity(&mesh) <= 1e-10,
-                "dz {dz}: {}",
+                "{what}: {}",
                 max_planarity(&mesh)
             );
-            let opt = next.optimiser.as_ref().unwrap();
+            let opt = next.optimiser().unwrap();
             assert!(
                 opt.least_moves_only(),
-                "dz {dz}: {} iterations",
+                "{what}: {} iterations",
                 opt.iteration()
             );
+            next.report().unwrap().max_surface_distance
+        };
+        for dz in [0.088, 0.176, 0.264] {
+            let mut next = run.follow_in_steps(raised(6, 4, dz)).unwrap();
             // Bending planar hexagons over the bump costs distance to the design (measured:
             // 0.014, 0.026, 0.038 m), reported and bounded.
-            let near = next.report().unwrap().max_surface_distance;
+            let near = check(&mut next, &format!("up {dz}"));
             assert!(near <= before + 0.2 * dz, "dz {dz}: {near} vs {before}");
+            run = next;
+        }
+        // The page's quick drag of control point (6, 4) 8 px up in the default view: a first
+        // position, then the release 0.34 m on, which follows in three equal steps.
+        let moved = |d: [f64; 3]| {
+            let mut s = translational_roof_nurbs();
+            let i = 6 * s.control_net_size().1 + 4;
+            let p = Vec3::from(s.control_points()[i]) + Vec3::from(d);
+            s.set_control_point(i, p).unwrap();
+            s
+        };
+        let (first, last) = (
+            Vec3::new(-0.0335, 0.0425, 0.0800),
+            Vec3::new(-0.1522, 0.1926, 0.3626),
+        );
+        let mut run = finished(translational_roof_nurbs(), 0.22);
+        for k in 0..=3 {
+            let d = first + (last - first) * (k as f64 / 3.0);
+            let mut next = run.follow(moved(d.into())).unwrap();
+            check(&mut next, &format!("oblique step {k}"));
             run = next;
         }
     }
