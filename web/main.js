@@ -4,7 +4,7 @@
 //   config.js (configuration <-> hash), controls.js (picker and fields), metrics.js (panel,
 //   histogram, legend), solver.js (worker client). Other tabs plug in through `window.dupin`.
 import { forcedWebgl2, loadWasm, openView, workerUrl } from './wasm.js';
-import { FREE, IMPORTED, defaults, readHash, sessionConfig, useSchema, writeHash } from './config.js';
+import { FREE, IMPORTED, defaults, readHash, schema, sessionConfig, useSchema, writeHash } from './config.js';
 import { buildFields, clearFieldErrors, fillScenePicker, showFieldError } from './controls.js';
 import { drawHistogram, drawLegend, legendCaption, showMetrics, showProgress } from './metrics.js';
 import { SettingsHistory } from './undo.js';
@@ -776,7 +776,6 @@ function dragEnd() {
 // one entry a move), a reload or Undo replays them bit for bit, and the release costs one short
 // move rather than the whole drag again.
 let netDrag = null; // { id, x, y, index, point, direction, inFlight, sent, seq, path }
-const MAX_CONTROL_POINT_MOVES = 1000; // import::MAX_CONTROL_POINT_MOVES
 
 function netDragStart(e) {
   const r = canvas.getBoundingClientRect();
@@ -795,8 +794,9 @@ function netDragStart(e) {
  * release's goes at once (the worker runs the last one to its end first, Session.moveControlPoint). */
 function sendReshape(d = netDrag, release = false) {
   if (!d || (d.inFlight && !release)) return;
-  if (config.imported.controlPoints.length + d.path.length >= MAX_CONTROL_POINT_MOVES) {
-    reportError(`this design has ${MAX_CONTROL_POINT_MOVES} control-point moves, the most a reload replays; Undo frees some`, 'edit-vertices');
+  const most = schema().maxControlPointMoves;
+  if (config.imported.controlPoints.length + d.path.length >= most) {
+    reportError(`this design has ${most} control-point moves, the most a reload replays; Undo frees some`, 'edit-vertices');
     return;
   }
   let q;

@@ -1,6 +1,7 @@
 //! `pageSchema()`: the names, defaults and bounds the page shows, read from the core so the
 //! page never types them again.
 
+use crate::import::MAX_CONTROL_POINT_MOVES;
 use crate::js::to_js;
 use crate::session::{DEFAULT_OFFSET, INITIALISATIONS, METHODS};
 use dupin_core::hex_delaunay::HexDelaunayMode;
@@ -54,6 +55,8 @@ pub(crate) struct PageSchema {
     torus: Vec<TorusParam>,
     /// The 2D triangulator's modes, the default first.
     hex_delaunay_modes: Vec<HexdMode>,
+    /// The most control-point moves an opened NURBS design replays (`controlPoints`).
+    max_control_point_moves: usize,
 }
 
 pub(crate) fn schema() -> PageSchema {
@@ -83,12 +86,14 @@ pub(crate) fn schema() -> PageSchema {
                 angle_bounds: m.angle_bounds_deg(),
             })
             .collect(),
+        max_control_point_moves: MAX_CONTROL_POINT_MOVES,
     }
 }
 
 /// The page's names, defaults and bounds: `{ colorModes, methods: [{ name, label }],
 /// initialisations: [{ name, label }], offsetDistance, torus: [{ key, default }],
-/// hexDelaunayModes: [{ name, angleBounds: [min, max] }] }` (lists start with the default).
+/// hexDelaunayModes: [{ name, angleBounds: [min, max] }], maxControlPointMoves }` (lists start
+/// with the default).
 #[wasm_bindgen(js_name = pageSchema)]
 pub fn page_schema() -> Result<JsValue, JsError> {
     to_js(&schema())
@@ -110,6 +115,7 @@ mod tests {
         }
         assert_eq!(s.offset_distance, DEFAULT_OFFSET_DISTANCE);
         assert_eq!(s.offset_distance, 0.15);
+        assert_eq!(s.max_control_point_moves, 1000);
         let names = |c: &[Choice]| c.iter().map(|c| c.name).collect::<Vec<_>>();
         assert_eq!(names(&s.methods), ["progressive", "prescribed"]);
         assert_eq!(METHODS[0].2, TriangulationMethod::Progressive);
