@@ -17,6 +17,14 @@ pub struct FuzzRun<'a> {
     pub runs: Option<u64>,
     /// Stop each target after this many seconds (libFuzzer's `-max_total_time`).
     pub seconds: Option<u64>,
+    /// The random seed (libFuzzer's `-seed`; a new one each run when `None`).
+    pub seed: Option<u64>,
+    /// CI's run: every kept input and regression through the instrumented binary under the
+    /// limits, no mutations (overrides `runs`, `seconds` and `seed`). Mutation is not
+    /// reproducible even with a fixed seed (coverage depends on hash seeds and addresses), and a
+    /// CI that fails on one run and passes on the next lands nothing; fuzzing campaigns run with
+    /// `--seconds` or `--runs`, and what they find becomes a regression input.
+    pub replay: bool,
     /// Add the new inputs that reach new coverage to the kept corpus (`fuzz/corpus/TARGET`),
     /// minimised; otherwise the kept corpus is only read.
     pub keep: bool,
@@ -128,15 +136,23 @@ pub fn run(r: &FuzzRun) -> Result<()> {
             .arg(format!("-max_len={}", max_len(t)))
             .arg(format!("-artifact_prefix={}/", artifacts.display()))
             .arg("-print_final_stats=1");
-        if let Some(n) = r.runs {
-            cmd.arg(format!("-runs={n}"));
-        }
-        if let Some(s) = r.seconds {
-            cmd.arg(format!("-max_total_time={s}"));
+        let regressions = fuzz.join("regressions").join(t);
+        if r.replay {
+            // libFuzzer replays the folders it is given before it counts runs.
+            cmd.arg("-runs=0");
+        } else {
+            if let Some(n) = r.runs {
+                cmd.arg(format!("-runs={n}"));
+            }
+            if let Some(s) = r.seconds {
+                cmd.arg(format!("-max_total_time={s}"));
+            }
+            if let Some(s) = r.seed {
+                cmd.arg(format!("-seed={s}"));
+            }
         }
         // New inputs go to the scratch folder; the kept corpus and the regressions are read.
         cmd.arg(&scratch).arg(&kept);
-        let regressions = fuzz.join("regressions").join(t);
         if regressions.is_dir() {
             cmd.arg(&regressions);
         }

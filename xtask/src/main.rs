@@ -7,7 +7,7 @@
 //! - `cargo xtask serve [--port 8080]`: set up, build, and serve `web/` at http://127.0.0.1:8080/.
 //! - `cargo xtask dist --out DIR`: set up, build, and write the page as static files to DIR.
 //! - `cargo xtask test`: everything CI runs (`.ci/run` is exactly this).
-//! - `cargo xtask fuzz [TARGET...] [--runs N] [--seconds S] [--keep]`: coverage-guided fuzzing
+//! - `cargo xtask fuzz [TARGET...] [--runs N] [--seconds S] [--seed N] [--replay] [--keep]`: coverage-guided fuzzing
 //!   of the `dupin-fuzz` targets with libFuzzer on the stable toolchain.
 //! - `cargo xtask layering`: print each crate's top-level module graph; fails on a cycle (also a
 //!   step of `test`).
@@ -69,6 +69,13 @@ enum Command {
         /// Seconds per target.
         #[arg(long)]
         seconds: Option<u64>,
+        /// libFuzzer's random seed (a new one each run by default).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// CI's run, exactly: the kept inputs and regressions only, no mutations, built at
+        /// opt-level 1; overrides --runs, --seconds and --seed.
+        #[arg(long)]
+        replay: bool,
         /// Add the inputs that reach new coverage to fuzz/corpus/TARGET (minimised).
         #[arg(long)]
         keep: bool,
@@ -100,13 +107,17 @@ fn main() -> ExitCode {
             targets,
             runs,
             seconds,
+            seed,
+            replay,
             keep,
         } => fuzz::run(&fuzz::FuzzRun {
             targets: &targets,
             runs,
             seconds,
+            seed,
+            replay,
             keep,
-            quick_build: false,
+            quick_build: replay,
         }),
         Command::Layering { workspace } => layering::print(workspace.as_deref()),
     };

@@ -74,11 +74,13 @@ pub fn run() -> Result<()> {
     step("native tests", &mut || {
         util::run(cargo().args(["test", "--workspace"]))
     })?;
-    step("short fuzz run (5 s per target)", &mut || {
+    step("fuzz binaries replay the kept inputs", &mut || {
         fuzz::run(&FuzzRun {
             targets: &[],
             runs: None,
-            seconds: Some(5),
+            seconds: None,
+            seed: None,
+            replay: true,
             keep: false,
             quick_build: true,
         })

@@ -39,6 +39,32 @@ fn a_dome_mesh_is_fitted_within_a_millimetre_and_the_map_is_one_to_one() {
     }
 }
 
+/// A sliver triangle (three nearly collinear vertices, an angle of almost 180 degrees) gives its
+/// apex a mean-value weight near 1e16; the map must still keep every vertex inside the square
+/// (found by the `mesh_fit` fuzz target: a vertex was put at u = 18).
+#[test]
+fn a_sliver_triangle_keeps_every_parameter_inside_the_square() {
+    let data = include_bytes!(
+        "../../../fuzz/regressions/mesh_fit/crash-87c6a8a0eddffdbd42961af247a5dcfb2bf7cce4"
+    );
+    let options = dupin_core::mesh::io::ImportOptions::default();
+    let mesh = dupin_core::mesh::io::read_mesh("sliver.obj", data, &options)
+        .unwrap()
+        .mesh;
+    // The sliver: vertices 11, 16 and 12 (OBJ numbering) on one line to 1e-15.
+    let [a, b, c] = [10, 15, 11].map(|v| mesh.positions[v]);
+    assert!((b - a).cross(&(c - a)).norm() < 1e-12 * (b - a).norm() * (c - a).norm());
+    let fit = fit_mesh_surface(&mesh, &MeshFitOptions::default()).unwrap();
+    for t in &fit.uv {
+        assert!(
+            (-1e-12..=1.0 + 1e-12).contains(&t.x) && (-1e-12..=1.0 + 1e-12).contains(&t.y),
+            "{t:?} is outside the square"
+        );
+    }
+    // The one vertex whose neighbours all lie on the side v = 1 is there too.
+    assert!((fit.uv[6].y - 1.0).abs() < 1e-12, "{:?}", fit.uv[6]);
+}
+
 #[test]
 fn phex_panels_the_fitted_dome_close_to_the_mesh() {
     use dupin_core::Stepper;

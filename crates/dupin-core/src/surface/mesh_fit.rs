@@ -458,6 +458,24 @@ fn mean_value_map(
             }
         }
     }
+    // Each row divided by its diagonal (the vertex's total weight): the row becomes "the vertex
+    // minus a convex combination of its neighbours", diagonally dominant with a unit diagonal, so
+    // the LU's partial pivoting keeps the diagonal. Unscaled, a sliver triangle (an angle near
+    // 180 degrees, weight ~1e16) made it pivot on a neighbour's small entry and put a vertex at
+    // u = 18, far outside the square Floater's theorem promises.
+    let mut diagonal = vec![0.0; ni];
+    for t in &triplets {
+        if t.row == t.col {
+            diagonal[t.row as usize] += t.val;
+        }
+    }
+    for t in &mut triplets {
+        t.val /= diagonal[t.row as usize];
+    }
+    for (r, d) in diagonal.iter().enumerate() {
+        rhs[(r, 0)] /= d;
+        rhs[(r, 1)] /= d;
+    }
     let mut uv: Vec<Vec2> = fixed
         .iter()
         .map(|f| f.unwrap_or_else(Vec2::zeros))
