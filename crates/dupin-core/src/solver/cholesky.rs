@@ -16,7 +16,7 @@
 use super::SolverError;
 use super::supernodal_llt::{self, SupernodalPlan};
 use faer::Side;
-use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::cholesky::{
@@ -25,6 +25,7 @@ use faer::sparse::linalg::cholesky::{
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Conj, Par};
+use std::sync::Arc;
 
 /// A symbolic Cholesky analysis of one pattern with its numeric storage and workspace.
 pub(crate) struct SparseCholesky {
@@ -35,10 +36,13 @@ pub(crate) struct SparseCholesky {
     lower: SymbolicSparseColMat<u32>,
     /// For every entry of the input upper pattern (in its CSC order), its position in `lower`.
     positions: Vec<u32>,
-    symbolic: SymbolicCholesky<u32>,
+    /// Shared by copies ([`Self::try_clone`]): never changed after the analysis.
+    symbolic: Arc<SymbolicCholesky<u32>>,
     /// Values of the factor L.
     factor: Vec<f64>,
     scratch: MemBuffer,
+    /// What `scratch` was sized for.
+    scratch_req: StackReq,
     /// Permuted right-hand side.
     work: Vec<f64>,
     /// `factor` holds the factorisation of the last successful [`Self::factorize`].
@@ -114,12 +118,38 @@ impl SparseCholesky {
             positions,
             factor,
             scratch: MemBuffer::try_new(req).map_err(|e| fe(&e))?,
-            symbolic,
+            scratch_req: req,
+            symbolic: Arc::new(symbolic),
             work: vec![0.0; n],
             factored: false,
             by_hand: None,
             solve_by_hand: false,
         })
+    }
+
+    /// A copy with the same analysis (shared) and the same factor values, so it solves with the
+    /// last factorisation as this one does. faer's symbolic factorisation is not `Clone`, and
+    /// the scratch buffer is allocated afresh (so this can fail on memory, as the analysis can).
+    pub(crate) fn try_clone(&self) -> Result<Self, SolverError> {
+        Ok(SparseCholesky {
+            fwd: self.fwd.clone(),
+            inv: self.inv.clone(),
+            lower: self.lower.clone(),
+            positions: self.positions.clone(),
+            symbolic: Arc::clone(&self.symbolic),
+            factor: self.factor.clone(),
+            scratch: MemBuffer::try_new(self.scratch_req).map_err(|e| fe(&e))?,
+            scratch_req: self.scratch_req,
+            work: self.work.clone(),
+            factored: self.factored,
+            by_hand: self.by_hand.clone(),
+            solve_by_hand: self.solve_by_hand,
+        })
+    }
+
+    /// Whether a factorisation is there to solve with.
+    pub(crate) fn is_factored(&self) -> bool {
+        self.factored
     }
 
     /// Number of stored matrix entries (of the upper triangle, = of the permuted lower one).

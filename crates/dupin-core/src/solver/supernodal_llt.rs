@@ -33,6 +33,7 @@ const NONE: u32 = u32::MAX;
 
 /// Which supernodes update which: the descendants of supernode `s` (those whose pattern has
 /// a row among `s`'s columns) are `descendants[start[s]..start[s + 1]]`, in increasing order.
+#[derive(Clone)]
 pub(super) struct SupernodalPlan {
     start: Vec<u32>,
     descendants: Vec<u32>,

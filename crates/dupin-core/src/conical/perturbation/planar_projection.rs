@@ -46,6 +46,12 @@ const DAMPING: f64 = 1e-12;
 /// Step halvings tried when a full step raises the residual.
 const HALVINGS: usize = 4;
 
+/// How much a chord step ([`PlanarProjection::chord_step`]) must lower the determinants'
+/// squared sum to be kept: to a tenth (their norm to a third), else the step is made again
+/// with a new factorisation. A chord step costs two triangular solves where a Newton step
+/// costs a numeric factorisation as well, 5-10 times as much on the 10k-face roof.
+const CHORD_GAIN: f64 = 0.1;
+
 #[cfg(test)]
 thread_local! {
     /// Tests only: every step fails (to exercise what a live edit does when its fast way
@@ -73,6 +79,8 @@ pub(crate) struct PlanarProjection {
     cholesky: SparseCholesky,
     values: Vec<f64>,
     grads: Vec<[Vec3; 4]>,
+    /// The gradients the last factorisation was made of (`J₀`).
+    factor_grads: Vec<[Vec3; 4]>,
     residual: Vec<f64>,
     factorizations: usize,
 }
@@ -152,13 +160,34 @@ impl PlanarProjection {
             cholesky,
             values,
             grads: vec![[Vec3::zeros(); 4]; nr],
+            factor_grads: vec![[Vec3::zeros(); 4]; nr],
             residual: vec![0.0; nr],
             factorizations: 0,
         })
     }
 
+    /// A copy that solves with this one's last factorisation ([`Self::chord_step`]); the
+    /// symbolic analysis is shared. Fails only when the copy's memory cannot be had.
+    pub(crate) fn try_clone(&self) -> Result<Self, SolverError> {
+        Ok(PlanarProjection {
+            faces: self.faces.clone(),
+            var_of: self.var_of.clone(),
+            rows: self.rows.clone(),
+            start: self.start.clone(),
+            incident: self.incident.clone(),
+            slots: self.slots.clone(),
+            diagonal: self.diagonal.clone(),
+            cholesky: self.cholesky.try_clone()?,
+            values: self.values.clone(),
+            grads: self.grads.clone(),
+            factor_grads: self.factor_grads.clone(),
+            residual: self.residual.clone(),
+            factorizations: 0,
+        })
+    }
+
     /// Whether this projection was made for `mesh`'s faces with these unknowns.
-    pub(super) fn covers(&self, mesh: &PolyMesh, var_of: &[u32]) -> bool {
+    pub(crate) fn covers(&self, mesh: &PolyMesh, var_of: &[u32]) -> bool {
         self.var_of == var_of && mesh.faces().flatten().eq(self.faces.iter())
     }
 
@@ -206,26 +235,76 @@ impl PlanarProjection {
         self.assemble();
         self.cholesky.factorize(&self.values)?;
         self.factorizations += 1;
+        self.factor_grads.clone_from(&self.grads);
+        self.move_along(work, var_of, x, before, HALVINGS, 1.0)
+    }
+
+    /// A chord step: [`Self::step`] with the last factorisation and its gradients `J₀` (of the
+    /// positions it was made at) in place of `J` (a simplified Newton step,
+    /// `Δx = -J₀ᵀ (J₀ J₀ᵀ)⁻¹ c`, the least move onto `c + J₀ Δx = 0`, right to first order while
+    /// `J` stays near `J₀`). `J₀ᵀ`, not `Jᵀ`, maps the multipliers back: `J Jᵀ` is nearly
+    /// singular on P-Hex meshes (the damping holds it), and `Jᵀ` let the multipliers' large
+    /// near-null part through (every chord on the roof raised the residual 20-1000 fold). Kept when it
+    /// lowers the determinants' squared sum to [`CHORD_GAIN`] of what it was; otherwise, or
+    /// with no factorisation yet, the step is [`Self::step`]'s. Returns and fails as that does.
+    ///
+    /// Why: the exact phase of a followed P-Hex mesh ([`crate::phex::PhexPipeline::follow`])
+    /// starts from the factorisation of the run before, at positions a move away, and its
+    /// steps change `J` less and less; a factorisation is the bulk of a Newton step's time.
+    pub(crate) fn chord_step(
+        &mut self,
+        work: &mut [Vec3],
+        var_of: &[u32],
+        x: &mut [f64],
+    ) -> Result<(f64, f64), SolverError> {
+        #[cfg(test)]
+        if FAIL_STEPS.get() {
+            return Err(SolverError::Factorization("failing on purpose".into()));
+        }
+        if self.cholesky.is_factored() {
+            let before = self.evaluate(work)?;
+            if before == 0.0 {
+                return Ok((0.0, 0.0));
+            }
+            if let Ok(done) = self.move_along(work, var_of, x, before, 0, CHORD_GAIN) {
+                return Ok(done);
+            }
+        }
+        self.step(work, var_of, x)
+    }
+
+    /// Moves the free vertices along the least-move direction of the last factorisation and
+    /// the determinants last evaluated (at `work`), halving the step up to `halvings` times
+    /// until the squared sum is below `gain * before`; `work` and `x` unchanged on failure.
+    fn move_along(
+        &mut self,
+        work: &mut [Vec3],
+        var_of: &[u32],
+        x: &mut [f64],
+        before: f64,
+        halvings: usize,
+        gain: f64,
+    ) -> Result<(f64, f64), SolverError> {
         let mut lambda = self.residual.clone();
         self.cholesky.solve_in_place(&mut lambda)?;
-        // Δv = -Σ λ_q ∇_v c_q over the determinants at v.
+        // Δv = -Σ λ_q ∇_v c_q (of the factorisation) over the determinants at v.
         let nv = work.len();
         let mut delta = vec![Vec3::zeros(); nv];
         for (v, d) in delta.iter_mut().enumerate() {
             for &(q, k) in &self.incident[self.start[v] as usize..self.start[v + 1] as usize] {
-                *d -= self.grads[q as usize][k as usize] * lambda[q as usize];
+                *d -= self.factor_grads[q as usize][k as usize] * lambda[q as usize];
             }
         }
         let start: Vec<Vec3> = work.to_vec();
         let mut t = 1.0;
-        for _ in 0..=HALVINGS {
+        for _ in 0..=halvings {
             for v in 0..nv {
                 if var_of[v] != FIXED {
                     work[v] = start[v] + delta[v] * t;
                 }
             }
             if let Ok(after) = self.evaluate(work)
-                && after < before
+                && after < gain * before
             {
                 for v in 0..nv {
                     let b = var_of[v];
@@ -423,6 +502,64 @@ mod tests {
             .map(|(a, b)| (a - b).norm());
         let largest = moves.fold(0.0, f64::max);
         assert!(largest <= 1e-3 * e, "moved {:e} edges", largest / e);
+    }
+
+    /// Chord steps: with no factorisation a chord step is a Newton step; a copy of a projection
+    /// factored at planar hexagons takes the same hexagons moved by noise back to planar 1e-13
+    /// on that one factorisation, each chord lowering the determinants' squared sum at least
+    /// tenfold. (Mapping the multipliers back through the new gradients passes here too; on the
+    /// 10k roof it does not, which `a_drag_is_followed_by_least_moves` holds.)
+    #[test]
+    fn chord_steps_reuse_a_copied_factorisation() {
+        let planar = {
+            let mesh = noisy_hexagons(0.2);
+            let (work, ..) = converge_quadratically(&mesh, &[], 4);
+            PolyMesh::new(work, mesh.faces().map(|f| f.to_vec())).unwrap()
+        };
+        let (var_of, _) = unknowns(&planar, &[]);
+        let mut fresh = PlanarProjection::new(&planar, &var_of, usize::MAX, true).unwrap();
+        let mut moved = planar.clone();
+        let e = planar.mean_edge();
+        let mut seed = 11u64;
+        for p in &mut moved.positions {
+            for c in 0..3 {
+                seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
+                p[c] += 2e-3 * e * ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5);
+            }
+        }
+        // No factorisation yet: the chord step is the Newton step, bit for bit.
+        let (mut a, mut b) = (moved.positions.clone(), moved.positions.clone());
+        let (mut xa, mut xb) = (unknowns(&moved, &[]).1, unknowns(&moved, &[]).1);
+        let mut other = PlanarProjection::new(&planar, &var_of, usize::MAX, true).unwrap();
+        fresh.chord_step(&mut a, &var_of, &mut xa).unwrap();
+        other.step(&mut b, &var_of, &mut xb).unwrap();
+        assert_eq!((a, xa), (b, xb));
+        // Factored at the planar mesh (one Newton step there), then copied and moved on.
+        let (mut at_planar, mut x) = (planar.positions.clone(), unknowns(&planar, &[]).1);
+        other.step(&mut at_planar, &var_of, &mut x).unwrap();
+        let mut copy = other.try_clone().unwrap();
+        assert_eq!(copy.factorizations(), 0);
+        let (mut work, mut x) = (moved.positions.clone(), unknowns(&moved, &[]).1);
+        let mut chords = 0;
+        loop {
+            let (before, after) = copy.chord_step(&mut work, &var_of, &mut x).unwrap();
+            if copy.factorizations() > 0 {
+                break;
+            }
+            chords += 1;
+            assert!(after < CHORD_GAIN * before, "{before:e} to {after:e}");
+            let now = PolyMesh::new(work.clone(), planar.faces().map(|f| f.to_vec())).unwrap();
+            if max_planarity(&now) <= 1e-13 {
+                break;
+            }
+            assert!(
+                chords < 20,
+                "{chords} chords, planarity {:e}",
+                max_planarity(&now)
+            );
+        }
+        assert_eq!(copy.factorizations(), 0, "after {chords} chords");
+        assert!(chords >= 2, "{chords}");
     }
 
     /// An `n x n` grid over a translational surface z = f(x) + g(y), whose grid quads are
