@@ -224,29 +224,18 @@ impl PlanarProjection {
         var_of: &[u32],
         x: &mut [f64],
     ) -> Result<(f64, f64), SolverError> {
-        #[cfg(test)]
-        if FAIL_STEPS.get() {
-            return Err(SolverError::Factorization("failing on purpose".into()));
-        }
-        let before = self.evaluate(work)?;
-        if before == 0.0 {
-            return Ok((0.0, 0.0));
-        }
-        self.assemble();
-        self.cholesky.factorize(&self.values)?;
-        self.factorizations += 1;
-        self.factor_grads.clone_from(&self.grads);
-        self.move_along(work, var_of, x, before, HALVINGS, 1.0)
+        self.step_with(work, var_of, x, false)
     }
 
     /// A chord step: [`Self::step`] with the last factorisation and its gradients `J₀` (of the
     /// positions it was made at) in place of `J` (a simplified Newton step,
-    /// `Δx = -J₀ᵀ (J₀ J₀ᵀ)⁻¹ c`, the least move onto `c + J₀ Δx = 0`, right to first order while
-    /// `J` stays near `J₀`). `J₀ᵀ`, not `Jᵀ`, maps the multipliers back: `J Jᵀ` is nearly
-    /// singular on P-Hex meshes (the damping holds it), and `Jᵀ` let the multipliers' large
-    /// near-null part through (every chord on the roof raised the residual 20-1000 fold). Kept when it
-    /// lowers the determinants' squared sum to [`CHORD_GAIN`] of what it was; otherwise, or
-    /// with no factorisation yet, the step is [`Self::step`]'s. Returns and fails as that does.
+    /// `Δx = -J₀ᵀ (J₀ J₀ᵀ)⁻¹ c`, the least move onto `c + J₀ Δx = 0`, right to first order
+    /// while `J` stays near `J₀`). `J₀ᵀ`, not `Jᵀ`, maps the multipliers back: `J Jᵀ` is
+    /// nearly singular on P-Hex meshes (the damping holds it), and `Jᵀ` let the multipliers'
+    /// large near-null part through (every chord on the roof raised the residual 20-1000
+    /// fold). Kept when it lowers the determinants' squared sum to [`CHORD_GAIN`] of what it
+    /// was; otherwise, or with no factorisation yet, the step is [`Self::step`]'s. Returns and
+    /// fails as that does.
     ///
     /// Why: the exact phase of a followed P-Hex mesh ([`crate::phex::PhexPipeline::follow`])
     /// starts from the factorisation of the run before, at positions a move away, and its
@@ -257,20 +246,37 @@ impl PlanarProjection {
         var_of: &[u32],
         x: &mut [f64],
     ) -> Result<(f64, f64), SolverError> {
+        self.step_with(work, var_of, x, true)
+    }
+
+    /// [`Self::step`], or with `chord` [`Self::chord_step`].
+    fn step_with(
+        &mut self,
+        work: &mut [Vec3],
+        var_of: &[u32],
+        x: &mut [f64],
+        chord: bool,
+    ) -> Result<(f64, f64), SolverError> {
         #[cfg(test)]
         if FAIL_STEPS.get() {
             return Err(SolverError::Factorization("failing on purpose".into()));
         }
-        if self.cholesky.is_factored() {
-            let before = self.evaluate(work)?;
-            if before == 0.0 {
-                return Ok((0.0, 0.0));
-            }
+        let before = self.evaluate(work)?;
+        if before == 0.0 {
+            return Ok((0.0, 0.0));
+        }
+        if chord && self.cholesky.is_factored() {
             if let Ok(done) = self.move_along(work, var_of, x, before, 0, CHORD_GAIN) {
                 return Ok(done);
             }
+            // `work` is back at the start; its determinants were last evaluated at the chord's.
+            self.evaluate(work)?;
         }
-        self.step(work, var_of, x)
+        self.assemble();
+        self.cholesky.factorize(&self.values)?;
+        self.factorizations += 1;
+        self.factor_grads.clone_from(&self.grads);
+        self.move_along(work, var_of, x, before, HALVINGS, 1.0)
     }
 
     /// Moves the free vertices along the least-move direction of the last factorisation and
