@@ -966,53 +966,59 @@ impl PlanarityOptimiser {
             let made = PlanarProjection::new(mesh, &var_of, crate::solver::MAX_FACTOR_BYTES, false);
             self.projection = Some(made.ok()?);
         }
-        // A chord step that misses the progress asked for is made again as a Newton step.
-        let mut chord = self.least_move_chords;
-        let (before, after, planarity, invalid) = loop {
-            let projection = self.projection.as_mut()?;
-            let mut work = mesh.positions.clone();
-            let mut x: Vec<f64> = work.iter().flat_map(|p| p.iter().copied()).collect();
-            let factored_before = projection.factorizations();
-            let result = match chord {
-                true => projection.chord_step(&mut work, &var_of, &mut x),
-                false => projection.step(&mut work, &var_of, &mut x),
+        // A chord step that misses the progress asked for is made again as a Newton step
+        // (unless the projection already fell back to one).
+        let (before, after, planarity) =
+            match self.try_least_move(mesh, &var_of, self.least_move_chords) {
+                (Some(made), _) => made,
+                (None, true) => self.try_least_move(mesh, &var_of, false).0?,
+                (None, false) => return None,
             };
-            self.factorizations = projection.factorizations();
-            // A chord that fell back to a Newton step inside the projection is not made twice.
-            let newton = self.factorizations > factored_before;
-            let made = result.ok().map(|(before, after)| {
-                let start = std::mem::replace(&mut mesh.positions, work);
-                (
-                    before,
-                    after,
-                    start,
-                    max_planarity(mesh),
-                    count_invalid_faces(mesh),
-                )
-            });
-            match made {
-                Some((before, after, _, planarity, 0))
-                    if planarity <= self.options.least_move_progress * self.max_planarity =>
-                {
-                    break (before, after, planarity, 0);
-                }
-                Some((.., start, _, _)) => mesh.positions = start,
-                None => {}
-            }
-            if !chord || newton {
-                return None;
-            }
-            chord = false;
-        };
         self.iteration += 1;
         self.max_planarity = planarity;
-        self.invalid_faces = invalid;
+        self.invalid_faces = 0;
         Some(PlanarityStep {
             iteration: self.iteration,
             max_planarity: planarity,
             cost_before: 0.5 * before,
             cost_after: 0.5 * after,
         })
+    }
+
+    /// One least move of [`Self::least_move_step`] (a chord step with `chord`): `(before,
+    /// after, max_planarity)` with `mesh` moved when it keeps every face simple and makes the
+    /// progress asked for, else `mesh` unchanged; and whether a Newton step could still be
+    /// tried (a chord that made no factorisation).
+    fn try_least_move(
+        &mut self,
+        mesh: &mut PolyMesh,
+        var_of: &[u32],
+        chord: bool,
+    ) -> (Option<(f64, f64, f64)>, bool) {
+        let Some(projection) = self.projection.as_mut() else {
+            return (None, false);
+        };
+        let mut work = mesh.positions.clone();
+        let mut x: Vec<f64> = work.iter().flat_map(|p| p.iter().copied()).collect();
+        let factored_before = projection.factorizations();
+        let result = match chord {
+            true => projection.chord_step(&mut work, var_of, &mut x),
+            false => projection.step(&mut work, var_of, &mut x),
+        };
+        self.factorizations = projection.factorizations();
+        let retry = chord && self.factorizations == factored_before;
+        let Ok((before, after)) = result else {
+            return (None, retry);
+        };
+        let start = std::mem::replace(&mut mesh.positions, work);
+        let planarity = max_planarity(mesh);
+        if planarity <= self.options.least_move_progress * self.max_planarity
+            && count_invalid_faces(mesh) == 0
+        {
+            return (Some((before, after, planarity)), false);
+        }
+        mesh.positions = start;
+        (None, retry)
     }
 
     /// One Gauss-Newton iteration on `mesh` (positions updated in place) against `surface`.
